@@ -1,0 +1,283 @@
+"""PX4's numbering, in one place: nav_state, custom_mode (main/sub), landed state, results, severities.
+
+Sources (see ../shared/reference/px4-behaviour.md section 2):
+- nav_state numbers: PX4 msg/versioned/VehicleStatus.msg
+- custom_mode layout and main/sub numbers: src/modules/commander/px4_custom_mode.h
+- mode UI names: src/lib/modes/ui.hpp
+- base_mode flags per mode: src/modules/commander/ModeUtil/control_mode.cpp
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+
+class NavState(IntEnum):
+    """vehicle_status.nav_state (msg/versioned/VehicleStatus.msg)."""
+
+    MANUAL = 0
+    ALTCTL = 1
+    POSCTL = 2
+    AUTO_MISSION = 3
+    AUTO_LOITER = 4
+    AUTO_RTL = 5
+    POSITION_SLOW = 6
+    GUIDED_COURSE = 7
+    ALTITUDE_CRUISE = 8
+    ACRO = 10
+    DESCEND = 12
+    TERMINATION = 13
+    OFFBOARD = 14
+    STAB = 15
+    AUTO_TAKEOFF = 17
+    AUTO_LAND = 18
+    AUTO_FOLLOW_TARGET = 19
+    AUTO_PRECLAND = 20
+    ORBIT = 21
+    AUTO_VTOL_TAKEOFF = 22
+
+
+class MainMode(IntEnum):
+    MANUAL = 1
+    ALTCTL = 2
+    POSCTL = 3
+    AUTO = 4
+    ACRO = 5
+    OFFBOARD = 6
+    STABILIZED = 7
+    RATTITUDE_LEGACY = 8
+    SIMPLE = 9
+    TERMINATION = 10
+    ALTITUDE_CRUISE = 11
+
+
+class AutoSubMode(IntEnum):
+    READY = 1
+    TAKEOFF = 2
+    LOITER = 3
+    MISSION = 4
+    RTL = 5
+    LAND = 6
+    FOLLOW_TARGET = 8
+    PRECLAND = 9
+    VTOL_TAKEOFF = 10
+    GUIDED_COURSE = 19
+    DESCEND = 20
+
+
+class PosctlSubMode(IntEnum):
+    POSCTL = 0
+    ORBIT = 1
+    SLOW = 2
+
+
+class LandedState(IntEnum):
+    """MAV_LANDED_STATE."""
+
+    UNDEFINED = 0
+    ON_GROUND = 1
+    IN_AIR = 2
+    TAKEOFF = 3
+    LANDING = 4
+
+
+class MavResult(IntEnum):
+    ACCEPTED = 0
+    TEMPORARILY_REJECTED = 1
+    DENIED = 2
+    UNSUPPORTED = 3
+    FAILED = 4
+    IN_PROGRESS = 5
+    CANCELLED = 6
+
+
+class Severity(IntEnum):
+    """MAV_SEVERITY; PX4's mavlink_log_critical -> CRITICAL, _warning -> WARNING, _info -> INFO."""
+
+    EMERGENCY = 0
+    ALERT = 1
+    CRITICAL = 2
+    ERROR = 3
+    WARNING = 4
+    NOTICE = 5
+    INFO = 6
+    DEBUG = 7
+
+
+class MavState(IntEnum):
+    """MAV_STATE for HEARTBEAT.system_status."""
+
+    UNINIT = 0
+    BOOT = 1
+    CALIBRATING = 2
+    STANDBY = 3
+    ACTIVE = 4
+    CRITICAL = 5
+    EMERGENCY = 6
+    POWEROFF = 7
+    FLIGHT_TERMINATION = 8
+
+
+# MAV_MODE_FLAG bits (MAVLink minimal.xml)
+MODE_FLAG_CUSTOM_MODE_ENABLED = 1
+MODE_FLAG_TEST_ENABLED = 2
+MODE_FLAG_AUTO_ENABLED = 4
+MODE_FLAG_GUIDED_ENABLED = 8
+MODE_FLAG_STABILIZE_ENABLED = 16
+MODE_FLAG_HIL_ENABLED = 32
+MODE_FLAG_MANUAL_INPUT_ENABLED = 64
+MODE_FLAG_SAFETY_ARMED = 128
+
+# nav_state -> (main_mode, sub_mode) as get_px4_custom_mode() encodes it (v1.15-v1.17: DESCEND -> AUTO.LAND).
+_NAV_TO_MAIN_SUB: dict[NavState, tuple[int, int]] = {
+    NavState.MANUAL: (MainMode.MANUAL, 0),
+    NavState.ALTCTL: (MainMode.ALTCTL, 0),
+    NavState.POSCTL: (MainMode.POSCTL, PosctlSubMode.POSCTL),
+    NavState.AUTO_MISSION: (MainMode.AUTO, AutoSubMode.MISSION),
+    NavState.AUTO_LOITER: (MainMode.AUTO, AutoSubMode.LOITER),
+    NavState.AUTO_RTL: (MainMode.AUTO, AutoSubMode.RTL),
+    NavState.POSITION_SLOW: (MainMode.POSCTL, PosctlSubMode.SLOW),
+    NavState.GUIDED_COURSE: (MainMode.AUTO, AutoSubMode.GUIDED_COURSE),
+    NavState.ALTITUDE_CRUISE: (MainMode.ALTITUDE_CRUISE, 0),
+    NavState.ACRO: (MainMode.ACRO, 0),
+    NavState.DESCEND: (MainMode.AUTO, AutoSubMode.LAND),
+    NavState.TERMINATION: (MainMode.TERMINATION, 0),
+    NavState.OFFBOARD: (MainMode.OFFBOARD, 0),
+    NavState.STAB: (MainMode.STABILIZED, 0),
+    NavState.AUTO_TAKEOFF: (MainMode.AUTO, AutoSubMode.TAKEOFF),
+    NavState.AUTO_LAND: (MainMode.AUTO, AutoSubMode.LAND),
+    NavState.AUTO_FOLLOW_TARGET: (MainMode.AUTO, AutoSubMode.FOLLOW_TARGET),
+    NavState.AUTO_PRECLAND: (MainMode.AUTO, AutoSubMode.PRECLAND),
+    NavState.ORBIT: (MainMode.POSCTL, PosctlSubMode.ORBIT),
+    NavState.AUTO_VTOL_TAKEOFF: (MainMode.AUTO, AutoSubMode.VTOL_TAKEOFF),
+}
+
+# Mode names from src/lib/modes/ui.hpp, used in "Switching to %s is currently not available".
+UI_NAMES: dict[NavState, str] = {
+    NavState.MANUAL: "Manual",
+    NavState.ALTCTL: "Altitude",
+    NavState.POSCTL: "Position",
+    NavState.AUTO_MISSION: "Mission",
+    NavState.AUTO_LOITER: "Hold",
+    NavState.AUTO_RTL: "Return",
+    NavState.POSITION_SLOW: "Position Slow",
+    NavState.GUIDED_COURSE: "Guided Course",
+    NavState.ALTITUDE_CRUISE: "Altitude Cruise",
+    NavState.ACRO: "Acro",
+    NavState.DESCEND: "Descend",
+    NavState.TERMINATION: "Termination",
+    NavState.OFFBOARD: "Offboard",
+    NavState.STAB: "Stabilized",
+    NavState.AUTO_TAKEOFF: "Takeoff",
+    NavState.AUTO_LAND: "Land",
+    NavState.AUTO_FOLLOW_TARGET: "Follow Target",
+    NavState.AUTO_PRECLAND: "Precision Landing",
+    NavState.ORBIT: "Orbit",
+    NavState.AUTO_VTOL_TAKEOFF: "VTOL Takeoff",
+}
+
+# MAVROS / pymavlink style names ("AUTO.LOITER"), for logs and the console.
+_MAIN_NAMES = {
+    MainMode.MANUAL: "MANUAL",
+    MainMode.ALTCTL: "ALTCTL",
+    MainMode.POSCTL: "POSCTL",
+    MainMode.ACRO: "ACRO",
+    MainMode.OFFBOARD: "OFFBOARD",
+    MainMode.STABILIZED: "STABILIZED",
+    MainMode.RATTITUDE_LEGACY: "RATTITUDE",
+    MainMode.TERMINATION: "TERMINATION",
+    MainMode.ALTITUDE_CRUISE: "ALTITUDE_CRUISE",
+}
+
+# `commander mode <name>` (Commander.cpp custom_command) -> nav_state
+SHELL_MODE_NAMES: dict[str, NavState] = {
+    "manual": NavState.MANUAL,
+    "altctl": NavState.ALTCTL,
+    "posctl": NavState.POSCTL,
+    "position:slow": NavState.POSITION_SLOW,
+    "altitude_cruise": NavState.ALTITUDE_CRUISE,
+    "auto:mission": NavState.AUTO_MISSION,
+    "auto:loiter": NavState.AUTO_LOITER,
+    "auto:course": NavState.GUIDED_COURSE,
+    "auto:rtl": NavState.AUTO_RTL,
+    "acro": NavState.ACRO,
+    "offboard": NavState.OFFBOARD,
+    "stabilized": NavState.STAB,
+    "auto:takeoff": NavState.AUTO_TAKEOFF,
+    "auto:land": NavState.AUTO_LAND,
+    "auto:precland": NavState.AUTO_PRECLAND,
+}
+
+# Modes that need a manual control input (RC or MAVLink joystick), none in SITL without a joystick.
+MANUAL_INPUT_MODES = frozenset(
+    {NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ACRO,
+     NavState.STAB, NavState.ALTITUDE_CRUISE}
+)
+# mode_req_prevent_arming (ModeUtil/mode_requirements.cpp)
+ARMING_PREVENTING_MODES = frozenset(
+    {NavState.AUTO_RTL, NavState.AUTO_LAND, NavState.DESCEND, NavState.TERMINATION,
+     NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND, NavState.ORBIT}
+)
+AUTO_MODES = frozenset(
+    {NavState.AUTO_MISSION, NavState.AUTO_LOITER, NavState.AUTO_RTL, NavState.AUTO_TAKEOFF,
+     NavState.AUTO_LAND, NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND,
+     NavState.AUTO_VTOL_TAKEOFF, NavState.GUIDED_COURSE, NavState.DESCEND}
+)
+
+
+def main_sub(nav_state: NavState) -> tuple[int, int]:
+    return _NAV_TO_MAIN_SUB[nav_state]
+
+
+def custom_mode(nav_state: NavState) -> int:
+    """HEARTBEAT.custom_mode = (sub << 24) | (main << 16)."""
+    main, sub = _NAV_TO_MAIN_SUB[nav_state]
+    return (int(sub) << 24) | (int(main) << 16)
+
+
+def decode_custom_mode(value: int) -> tuple[int, int]:
+    """custom_mode -> (main_mode, sub_mode)."""
+    return (value >> 16) & 0xFF, (value >> 24) & 0xFF
+
+
+def mode_name(nav_state: NavState) -> str:
+    """The MAVROS/pymavlink name of a nav_state, e.g. 'AUTO.LOITER', 'OFFBOARD'."""
+    main, sub = _NAV_TO_MAIN_SUB[nav_state]
+    if main == MainMode.AUTO:
+        return "AUTO." + AutoSubMode(sub).name
+    return _MAIN_NAMES[MainMode(main)]
+
+
+def nav_state_from_main_sub(main: int, sub: int) -> NavState | None:
+    """DO_SET_MODE with the custom bit set -> nav_state, as Commander.cpp handle_command does; None if unsupported."""
+    if main == MainMode.MANUAL:
+        return NavState.MANUAL
+    if main == MainMode.ALTCTL:
+        return NavState.ALTCTL
+    if main == MainMode.ALTITUDE_CRUISE:
+        return NavState.ALTITUDE_CRUISE
+    if main == MainMode.POSCTL:
+        return NavState.POSITION_SLOW if sub == PosctlSubMode.SLOW else NavState.POSCTL
+    if main == MainMode.AUTO:
+        if sub == 0:
+            return NavState.AUTO_MISSION
+        return _AUTO_SUB_TO_NAV.get(sub)
+    if main == MainMode.ACRO:
+        return NavState.ACRO
+    if main == MainMode.STABILIZED:
+        return NavState.STAB
+    if main == MainMode.OFFBOARD:
+        return NavState.OFFBOARD
+    return None
+
+
+_AUTO_SUB_TO_NAV: dict[int, NavState] = {
+    AutoSubMode.LOITER: NavState.AUTO_LOITER,
+    AutoSubMode.MISSION: NavState.AUTO_MISSION,
+    AutoSubMode.RTL: NavState.AUTO_RTL,
+    AutoSubMode.TAKEOFF: NavState.AUTO_TAKEOFF,
+    AutoSubMode.LAND: NavState.AUTO_LAND,
+    AutoSubMode.FOLLOW_TARGET: NavState.AUTO_FOLLOW_TARGET,
+    AutoSubMode.PRECLAND: NavState.AUTO_PRECLAND,
+    AutoSubMode.GUIDED_COURSE: NavState.GUIDED_COURSE,
+}

@@ -1,0 +1,151 @@
+"""The vehicle's inputs and outputs: small frozen dataclasses, no MAVLink.
+
+The MAVLink receiver turns messages into these inputs; the telemetry side turns `VehicleSnapshot`s and
+`VehicleEvent`s into messages. NaN means "not controlled" throughout, as in PX4's uORB topics.
+Frames: NED world, FRD body, quaternions w-first. Units are in the names.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from sitl_emu.px4 import LandedState, NavState, Severity
+
+Vec3 = tuple[float, float, float]
+Vec4 = tuple[float, float, float, float]
+
+NAN = math.nan
+NAN3: Vec3 = (NAN, NAN, NAN)
+
+
+@dataclass(frozen=True, slots=True)
+class OffboardControlMode:
+    """PX4's offboard_control_mode: which setpoint kinds an offboard message carries (refreshes the 1 s watchdog)."""
+
+    position: bool = False
+    velocity: bool = False
+    acceleration: bool = False
+    attitude: bool = False
+    body_rate: bool = False
+
+    def any(self) -> bool:
+        return self.position or self.velocity or self.acceleration or self.attitude or self.body_rate
+
+
+@dataclass(frozen=True, slots=True)
+class TrajectorySetpoint:
+    """PX4's trajectory_setpoint in the local NED frame; NaN components are not controlled."""
+
+    position_ned_m: Vec3 = NAN3
+    velocity_ned_m_s: Vec3 = NAN3
+    acceleration_ned_m_s2: Vec3 = NAN3
+    yaw_rad: float = NAN
+    yawspeed_rad_s: float = NAN
+
+
+@dataclass(frozen=True, slots=True)
+class AttitudeSetpoint:
+    """From SET_ATTITUDE_TARGET: attitude (q_wxyz, or None) and/or body rates, with body-frame thrust (0..1)."""
+
+    q_wxyz: Vec4 | None = None
+    body_rates_rad_s: Vec3 = NAN3
+    thrust_body: Vec3 = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleCommand:
+    """PX4's vehicle_command; `command` uses MAV_CMD numbering, as PX4 does internally."""
+
+    command: int
+    params: tuple[float, float, float, float, float, float, float] = (NAN,) * 7  # type: ignore[assignment]
+    source_system: int = 255
+    source_component: int = 190
+    from_external: bool = True  # False for the pxh> shell ("Armed by internal command")
+
+    def param(self, i: int) -> float:
+        """1-based, as MAVLink names them: param(1) is param1."""
+        return self.params[i - 1]
+
+
+@dataclass(frozen=True, slots=True)
+class CommandAck:
+    command: int
+    result: int  # MavResult
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleEvent:
+    """A message PX4 would log: a console line and, where PX4 does, a STATUSTEXT.
+
+    `text` has no trailing tab; `is_event` True means PX4 also emits it as an event, so its STATUSTEXT ends in '\\t'.
+    `seq` increases by one per event from boot.
+    """
+
+    seq: int
+    time_us: int
+    severity: Severity
+    module: str  # 'commander', 'navigator', ...
+    text: str
+    is_event: bool = True
+    statustext: bool = True  # False: console only
+
+    @property
+    def statustext_text(self) -> str:
+        return self.text + ("\t" if self.is_event else "")
+
+    @property
+    def console_line(self) -> str:
+        level = {Severity.INFO: "INFO", Severity.WARNING: "WARN", Severity.CRITICAL: "ERROR",
+                 Severity.ERROR: "ERROR", Severity.EMERGENCY: "PANIC"}.get(self.severity, "INFO")
+        return f"{level:<5} [{self.module}] {self.text}"
+
+
+@dataclass(frozen=True, slots=True)
+class HomePosition:
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+    pos_ned_m: Vec3
+    yaw_rad: float
+
+
+@dataclass(frozen=True, slots=True)
+class VehicleSnapshot:
+    """Everything telemetry needs, at one instant of simulated time."""
+
+    time_us: int
+    # state machine
+    armed: bool
+    nav_state: NavState
+    user_intended_nav_state: NavState
+    failsafe: bool
+    landed_state: LandedState
+    pre_flight_checks_pass: bool  # arming checks pass for the current nav_state (system_status STANDBY)
+    position_valid: bool  # estimator has local + global position (SYS_STATUS GPS / local pos health)
+    takeoff_detected: bool
+    offboard_control: OffboardControlMode | None  # last offboard signal kinds (for base_mode in OFFBOARD)
+    # estimate (local frame origin = ref lat/lon/alt)
+    pos_ned_m: Vec3
+    vel_ned_m_s: Vec3
+    acc_ned_m_s2: Vec3
+    q_wxyz: Vec4
+    rates_frd_rad_s: Vec3
+    euler_rad: Vec3  # roll, pitch, yaw
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+    ref_lat_deg: float
+    ref_lon_deg: float
+    ref_alt_amsl_m: float
+    home: HomePosition | None
+    # controller internals, for POSITION_TARGET_LOCAL_NED / ATTITUDE_TARGET / VFR_HUD
+    local_setpoint: TrajectorySetpoint | None
+    attitude_setpoint_q_wxyz: Vec4 | None
+    rates_setpoint_rad_s: Vec3
+    thrust_setpoint: float  # collective, 0..1
+    motors: Vec4  # 0..1
+    # battery
+    battery_voltage_v: float = 16.2
+    battery_remaining: float = 1.0  # 0..1
+    extras: dict[str, float] = field(default_factory=dict)
