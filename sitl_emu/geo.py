@@ -1,0 +1,57 @@
+"""Local NED <-> geodetic conversion around a reference point.
+
+Azimuthal equidistant projection on a sphere, as PX4's MapProjection (src/lib/geo/geo.cpp, map_projection_project /
+reproject) with CONSTANTS_RADIUS_OF_EARTH = 6371000 m. Altitude: alt_amsl = ref_alt - down.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl_emu.types import Vec3
+
+EARTH_RADIUS_M = 6371000.0  # PX4 lib/geo/geo.h CONSTANTS_RADIUS_OF_EARTH
+
+
+@dataclass(frozen=True, slots=True)
+class GeoRef:
+    """The local frame's origin: NED (0, 0, 0) is here."""
+
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+
+
+def ned_to_global(ref: GeoRef, pos_ned_m: Vec3) -> tuple[float, float, float]:
+    """(lat_deg, lon_deg, alt_amsl_m) of a local NED position."""
+    ref_lat = math.radians(ref.lat_deg)
+    ref_lon = math.radians(ref.lon_deg)
+    x_rad = pos_ned_m[0] / EARTH_RADIUS_M
+    y_rad = pos_ned_m[1] / EARTH_RADIUS_M
+    c = math.hypot(x_rad, y_rad)
+    if c > 0.0:
+        sin_c, cos_c = math.sin(c), math.cos(c)
+        sin_ref, cos_ref = math.sin(ref_lat), math.cos(ref_lat)
+        lat = math.asin(max(-1.0, min(1.0, cos_c * sin_ref + x_rad * sin_c * cos_ref / c)))
+        lon = ref_lon + math.atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
+    else:
+        lat, lon = ref_lat, ref_lon
+    lon_deg = (math.degrees(lon) + 180.0) % 360.0 - 180.0
+    return math.degrees(lat), lon_deg, ref.alt_amsl_m - pos_ned_m[2]
+
+
+def global_to_ned(ref: GeoRef, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> Vec3:
+    """Local NED position (m) of a geodetic point."""
+    ref_lat = math.radians(ref.lat_deg)
+    lat = math.radians(lat_deg)
+    d_lon = math.radians(lon_deg - ref.lon_deg)
+    sin_ref, cos_ref = math.sin(ref_lat), math.cos(ref_lat)
+    sin_lat, cos_lat = math.sin(lat), math.cos(lat)
+    cos_d_lon = math.cos(d_lon)
+    arg = max(-1.0, min(1.0, sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))
+    c = math.acos(arg)
+    k = 1.0 if abs(c) < 1e-12 else c / math.sin(c)
+    north = k * (cos_ref * sin_lat - sin_ref * cos_lat * cos_d_lon) * EARTH_RADIUS_M
+    east = k * cos_lat * math.sin(d_lon) * EARTH_RADIUS_M
+    return north, east, ref.alt_amsl_m - alt_amsl_m
