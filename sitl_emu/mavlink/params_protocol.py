@@ -1,0 +1,214 @@
+"""PX4's PARAM protocol on one link (src/modules/mavlink/mavlink_parameters.cpp; px4-behaviour.md section 10).
+
+- PARAM_REQUEST_LIST: "_HASH_CHECK" first, then every parameter in index order, up to 20 PARAM_VALUE per tick.
+- PARAM_REQUEST_READ: by index (param_index >= 0) or by name (param_index -1); "_HASH_CHECK" by name answers the hash.
+- PARAM_SET: the new value is always echoed as PARAM_VALUE on the receiving link; "_HASH_CHECK" stops the stream.
+- Unknown names, out-of-range indices, unsupported or mismatched types: no reply and no change. This is PX4 v1.15/v1.16
+  behaviour; PX4 main (2025-10, commit f03131cfd3) answers PARAM_ERROR instead. We chose the v1.15-v1.17 behaviour.
+- Changed values are re-sent on every link (mavlink_parameters.cpp send_untransmitted): each link's instance notices a
+  change of the registry in tick() and sends the changed parameters on its own link, so changes made from another
+  link or from the pxh> shell reach every client too.
+
+INT32 values travel bytewise in the float field (MAV_PROTO capability PARAM_ENCODE_BYTEWISE): the int32's four bytes
+are reinterpreted as a float32. Limitation: CPython turns signalling-NaN float32 bit patterns into quiet NaNs, so the
+INT32 values 2139095041..2143289343 and -8388607..-4194305 cannot travel bytewise; no PX4 parameter uses them.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import struct
+import zlib
+from typing import Any, ClassVar
+
+from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
+from sitl_emu.px4 import Severity
+
+log = logging.getLogger(__name__)
+
+HASH_CHECK_NAME = "_HASH_CHECK"
+HASH_CHECK_INDEX = 65535  # param_index -1 as uint16
+MAV_PARAM_TYPE_UINT32 = 5
+MAV_PARAM_TYPE_INT32 = 6
+MAV_PARAM_TYPE_REAL32 = 9
+PARAMS_PER_TICK = 20  # mavlink_parameters.cpp: up to 20 PARAM_VALUE per main-loop iteration on UDP links
+
+_TYPE_CODES = {ParamType.INT32: MAV_PARAM_TYPE_INT32, ParamType.REAL32: MAV_PARAM_TYPE_REAL32}
+
+
+def int32_to_float_bits(value: int) -> float:
+    """The float whose four bytes are the int32 `value` (PX4's bytewise encoding)."""
+    return float(struct.unpack("<f", struct.pack("<i", int(value)))[0])
+
+
+def float_bits_to_int32(value: float) -> int:
+    return int(struct.unpack("<i", struct.pack("<f", value))[0])
+
+
+def uint32_to_float_bits(value: int) -> float:
+    return float(struct.unpack("<f", struct.pack("<I", int(value) & 0xFFFFFFFF))[0])
+
+
+def _crc32_part(data: bytes, state: int) -> int:
+    """PX4's crc32part() (src/lib/crc/crc.c): the reflected CRC-32 table step without pre/post inversion."""
+    return (~zlib.crc32(data, ~state & 0xFFFFFFFF)) & 0xFFFFFFFF
+
+
+def px4_param_hash(registry: ParamRegistry) -> int:
+    """param_hash_check() (src/lib/parameters/parameters.cpp): CRC over each used parameter's name and 4 value bytes.
+
+    QGC computes the same over its cache; when both match it stops the download with PARAM_SET "_HASH_CHECK".
+    """
+    state = 0
+    for d in registry:
+        value = registry.get(d.name)
+        raw = struct.pack("<i", int(value)) if d.type is ParamType.INT32 else struct.pack("<f", float(value))
+        state = _crc32_part(d.name.encode("ascii"), state)
+        state = _crc32_part(raw, state)
+    return state
+
+
+def _param_id(msg: Any) -> str:
+    raw = msg.param_id
+    if isinstance(raw, bytes):
+        raw = raw.decode("ascii", errors="replace")
+    return raw.split("\x00", 1)[0]
+
+
+class ParamProtocol:
+    """One instance per link; see the module docstring."""
+
+    MESSAGES: ClassVar[tuple[str, ...]] = ("PARAM_REQUEST_LIST", "PARAM_REQUEST_READ", "PARAM_SET")
+
+    def __init__(self) -> None:
+        self._next_index: int | None = None  # next index to stream, None when not streaming
+        self._send_hash = False
+        self._seen_version: int | None = None
+        self._seen_values: dict[str, float] = {}
+
+    # --- receive -----------------------------------------------------------------------------------------------
+    def handle(self, msg: Any, ctx: Any) -> None:
+        if not self._addressed_to_us(msg, ctx):
+            return
+        kind = msg.get_type()
+        if kind == "PARAM_REQUEST_LIST":
+            self._start_list()
+        elif kind == "PARAM_REQUEST_READ":
+            self._handle_read(msg, ctx)
+        elif kind == "PARAM_SET":
+            self._handle_set(msg, ctx)
+
+    @staticmethod
+    def _addressed_to_us(msg: Any, ctx: Any) -> bool:
+        # PX4 accepts only its own sysid exactly (0 is not a broadcast here) and its compid or 0 (section 10.1).
+        return msg.target_system == ctx.sysid and msg.target_component in (ctx.compid, 0)
+
+    def _start_list(self) -> None:
+        # A request during a running list restarts it from index 0 without the hash (section 10.1).
+        self._send_hash = self._next_index is None
+        self._next_index = 0
+
+    def _handle_read(self, msg: Any, ctx: Any) -> None:
+        registry: ParamRegistry = ctx.vehicle.params
+        if msg.param_index >= 0:
+            if msg.param_index < len(registry):
+                ctx.send(self._value_msg(ctx, registry.name_at(msg.param_index)))
+            else:
+                log.debug("PARAM_REQUEST_READ: no parameter at index %d (no reply, as PX4 <= v1.16)", msg.param_index)
+            return
+        name = _param_id(msg)
+        if name == HASH_CHECK_NAME:
+            ctx.send(self._hash_msg(ctx))
+        elif name in registry:
+            ctx.send(self._value_msg(ctx, name))
+        else:
+            log.debug("PARAM_REQUEST_READ: unknown parameter %r (no reply, as PX4 <= v1.16)", name)
+
+    def _handle_set(self, msg: Any, ctx: Any) -> None:
+        registry: ParamRegistry = ctx.vehicle.params
+        name = _param_id(msg)
+        if name == HASH_CHECK_NAME:
+            if self._hash_check_enabled(registry):
+                self._next_index = None  # the client's cache is current: stop streaming
+            return
+        if name not in registry:
+            log.debug("PARAM_SET: unknown parameter %r (no reply, as PX4 <= v1.16)", name)
+            return
+        definition = registry.definition(name)
+        if msg.param_type != _TYPE_CODES[definition.type]:
+            log.debug("PARAM_SET %s: type %d does not match (no reply, as PX4 <= v1.16)", name, msg.param_type)
+            return
+        if definition.type is ParamType.INT32:
+            value: float = float_bits_to_int32(msg.param_value)
+        else:
+            value = msg.param_value
+        try:
+            registry.set(name, value)
+        except ParamError as err:
+            # BE SAFER THAN PX4: PX4 stores NaN, infinity and out-of-range values as given. We refuse them and keep the
+            # value; the echo below carries the unchanged value so the client sees the set did not take.
+            ctx.vehicle.report(Severity.CRITICAL, "param", str(err), is_event=False)
+        ctx.send(self._value_msg(ctx, name))
+
+    @staticmethod
+    def _hash_check_enabled(registry: ParamRegistry) -> bool:
+        return "MAV_HASH_CHK_EN" not in registry or int(registry.get("MAV_HASH_CHK_EN")) == 1
+
+    # --- transmit ----------------------------------------------------------------------------------------------
+    def tick(self, ctx: Any) -> None:
+        self._send_changes(ctx)
+        self._stream(ctx)
+
+    def _stream(self, ctx: Any) -> None:
+        if self._next_index is None:
+            return
+        registry: ParamRegistry = ctx.vehicle.params
+        budget = PARAMS_PER_TICK
+        if self._send_hash:
+            ctx.send(self._hash_msg(ctx))
+            self._send_hash = False
+            budget -= 1
+        index = self._next_index
+        while budget > 0 and index < len(registry):
+            ctx.send(self._value_msg(ctx, registry.name_at(index)))
+            index += 1
+            budget -= 1
+        self._next_index = index if index < len(registry) else None
+
+    def _send_changes(self, ctx: Any) -> None:
+        """Re-send every parameter whose value changed since the last tick (PX4's send_untransmitted)."""
+        registry: ParamRegistry = ctx.vehicle.params
+        if self._seen_version == registry.version:
+            return
+        values = registry.values()
+        if self._seen_version is not None:
+            for name, value in values.items():
+                old = self._seen_values.get(name)
+                if old is None or not _same(old, value):
+                    ctx.send(self._value_msg(ctx, name))
+        self._seen_version = registry.version
+        self._seen_values = values
+
+    @staticmethod
+    def _value_msg(ctx: Any, name: str) -> Any:
+        registry: ParamRegistry = ctx.vehicle.params
+        definition = registry.definition(name)
+        value = registry.get(name)
+        if definition.type is ParamType.INT32:
+            wire = int32_to_float_bits(int(value))
+        else:
+            wire = float(value)
+        return ctx.mav.param_value_encode(name.encode("ascii"), wire, _TYPE_CODES[definition.type], len(registry),
+                                          registry.index_of(name))
+
+    @staticmethod
+    def _hash_msg(ctx: Any) -> Any:
+        registry: ParamRegistry = ctx.vehicle.params
+        wire = uint32_to_float_bits(px4_param_hash(registry))
+        return ctx.mav.param_value_encode(HASH_CHECK_NAME.encode("ascii"), wire, MAV_PARAM_TYPE_UINT32, len(registry),
+                                          HASH_CHECK_INDEX)
+
+
+def _same(a: float, b: float) -> bool:
+    return a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b))
