@@ -1,0 +1,235 @@
+"""The pxh> shell: PX4's console commands, shared by the terminal console and the MAVLink shell.
+
+What each command sends and prints follows PX4 (v1.15):
+- `commander ...`: src/modules/commander/Commander.cpp custom_command(): every subcommand publishes an internal
+  vehicle_command (from_external false, source = own sysid/compid); results appear later as log lines (events).
+- `param ...`: src/systemcmds/param/param.cpp (show/set formats); `param get` is our addition (= `param show -q`).
+- line handling and errors: platforms/posix/src/px4/common/px4_daemon/pxh.cpp process_line().
+Log-style output uses PX4's console format "%-5s [%s] %s" (platforms/common/px4_log.cpp).
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+from collections.abc import Callable
+from typing import Any
+
+from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
+from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavResult, NavState, main_sub
+from sitl_emu.types import VehicleCommand
+
+NAN = math.nan
+FORCE_MAGIC = 21196.0  # ARM_DISARM param2: force (Commander.cpp)
+CMD_NAV_LAND = 21
+CMD_NAV_TAKEOFF = 22
+CMD_DO_SET_MODE = 176
+CMD_ARM_DISARM = 400
+CMD_RUN_PREARM_CHECKS = 401
+
+# commander subcommands PX4 has and sitl_emu does not emulate (Commander.cpp custom_command, usage)
+_PX4_ONLY_SUBCOMMANDS = frozenset({"start", "stop", "calibrate", "transition", "lockdown", "pair", "set_ekf_origin",
+                                   "poweroff", "safety", "termination", "actuator_group_test", "set_heading"})
+
+_COMMANDER_USAGE = """Usage: commander <command> [arguments...]
+ Commands:
+   status        Print status
+   check         Run preflight checks
+   arm           [-f] Force arming (do not run preflight checks)
+   disarm        [-f] Force disarming (disarm in air)
+   takeoff
+   land
+   mode          Change flight mode
+     manual|altctl|posctl|position:slow|altitude_cruise|auto:mission|auto:loiter|auto:course|auto:rtl|acro|
+     offboard|stabilized|auto:takeoff|auto:land|auto:precland Flight mode
+"""
+
+_PARAM_USAGE = """Usage: param <command> [arguments...]
+ Commands:
+   show          Show parameter values
+     [-c]        Show only changed params
+     [-q]        quiet mode, print only param value (name needs to be exact)
+     [<filter>]  Filter by param name (wildcard at end allowed, eg. sys_*)
+   set           Set parameter to a value
+     <param_name> <value> Parameter name and value to set
+     [fail]      If provided, let the command fail if param is not found
+   get           Print a parameter's value (sitl_emu addition; same as show -q)
+     <param_name> Parameter name
+"""
+
+
+def log_line(level: str, module: str, text: str) -> str:
+    """One PX4 console log line, e.g. 'INFO  [commander] Armed by internal command'."""
+    return f"{level:<5} [{module}] {text}\n"
+
+
+class Shell:
+    """Runs one pxh> command line at a time; `execute` returns the text the command prints."""
+
+    def __init__(self, vehicle: Any, on_shutdown: Callable[[], None] | None = None) -> None:
+        self.vehicle = vehicle
+        self.on_shutdown = on_shutdown
+        self._apps: dict[str, Callable[[list[str]], tuple[int, str]]] = {
+            "commander": self._commander,
+            "param": self._param,
+            "shutdown": self._shutdown,
+            "ver": self._ver,
+        }
+
+    def execute(self, line: str) -> str:
+        words = line.split()
+        if not words or words[0].startswith("#"):
+            return ""
+        command = words[0]
+        if command == "help":
+            return "Builtin Commands:\n" + "".join(f"  {name}\n" for name in sorted([*self._apps, "help"]))
+        app = self._apps.get(command)
+        if app is None:
+            return f"Invalid command: {command}\ntype 'help' for a list of commands\n"
+        status, out = app(words[1:])
+        if status != 0:
+            out += f"Command '{command}' failed, returned {status}.\n"
+        return out
+
+    # --- commander ---------------------------------------------------------------------------------------------
+    def _commander(self, args: list[str]) -> tuple[int, str]:
+        sub = args[0] if args else ""
+        force = len(args) > 1 and args[1] == "-f"
+        if sub == "arm":
+            self._send(CMD_ARM_DISARM, 1.0, FORCE_MAGIC if force else 0.0)
+            return 0, ""
+        if sub == "disarm":
+            self._send(CMD_ARM_DISARM, 0.0, FORCE_MAGIC if force else 0.0)
+            return 0, ""
+        if sub == "takeoff":
+            return self._takeoff()
+        if sub == "land":
+            self._send(CMD_NAV_LAND)
+            return 0, ""
+        if sub == "mode":
+            return self._mode(args[1:])
+        if sub == "status":
+            return 0, self._status()
+        if sub == "check":
+            self._send(CMD_RUN_PREARM_CHECKS)
+            ok = self.vehicle.snapshot().pre_flight_checks_pass
+            return 0, log_line("INFO", "commander", f"Preflight check: {'OK' if ok else 'FAILED'}")
+        reason = f"{sub}: not supported by sitl_emu" if sub in _PX4_ONLY_SUBCOMMANDS else "unknown command"
+        return 1, log_line("WARN", "commander", reason) + _COMMANDER_USAGE
+
+    def _takeoff(self) -> tuple[int, str]:
+        """NAV_TAKEOFF with every param NaN (MIS_TAKEOFF_ALT above ground), then arm if it was accepted."""
+        ack = self._send(CMD_NAV_TAKEOFF)
+        if ack is not None and ack.result == MavResult.ACCEPTED:
+            self._send(CMD_ARM_DISARM, 1.0, 0.0)  # Commander.cpp sends param2 0 here: not forced, checks run
+        return 0, ""
+
+    def _mode(self, args: list[str]) -> tuple[int, str]:
+        if not args:
+            return 1, log_line("ERROR", "commander", "missing argument") + _COMMANDER_USAGE
+        nav_state = SHELL_MODE_NAMES.get(args[0])
+        if nav_state is None:
+            return 0, log_line("ERROR", "commander", f"argument {args[0]} unsupported.")
+        main, sub = main_sub(nav_state)
+        # base_mode 1 = custom; PX4 passes NaN as sub mode for non-AUTO modes, read as 0 by the (uint8) cast.
+        self._send(CMD_DO_SET_MODE, 1.0, float(main), float(sub))
+        return 0, ""
+
+    def _status(self) -> str:
+        snap = self.vehicle.snapshot()
+        lines = [
+            "Armed" if snap.armed else "Disarmed",
+            f"navigation mode: {_nav_name(snap.nav_state)}",
+            f"user intended navigation mode: {_nav_name(snap.user_intended_nav_state)}",
+            f"in failsafe: {'yes' if snap.failsafe else 'no'}",
+        ]
+        return "".join(log_line("INFO", "commander", text) for text in lines)
+
+    def _send(self, command: int, *params: float) -> Any:
+        values = tuple(params) + (NAN,) * (7 - len(params))
+        cmd = VehicleCommand(command=command, params=values,  # type: ignore[arg-type]
+                             source_system=self.vehicle.sysid, source_component=1, from_external=False)
+        return self.vehicle.handle_command(cmd)
+
+    # --- param -------------------------------------------------------------------------------------------------
+    def _param(self, args: list[str]) -> tuple[int, str]:
+        registry: ParamRegistry = self.vehicle.params
+        sub = args[0] if args else ""
+        if sub == "show":
+            return _param_show(registry, args[1:])
+        if sub == "set" and len(args) >= 3:
+            return _param_set(registry, args[1], args[2], fail=len(args) > 3 and args[3] == "fail")
+        if sub == "set":
+            name = args[1] if len(args) > 1 else "PARAM_NAME"
+            return 1, log_line("ERROR", "param", f"not enough arguments.\nTry 'param set {name} 3 [fail]'")
+        if sub == "get" and len(args) == 2:
+            if args[1] not in registry:
+                return 1, log_line("ERROR", "param", f"Parameter {args[1]} not found")
+            return 0, _format_value(registry, args[1]) + "\n"
+        return 1, _PARAM_USAGE
+
+    # --- system ------------------------------------------------------------------------------------------------
+    def _shutdown(self, args: list[str]) -> tuple[int, str]:
+        if self.on_shutdown is None:
+            return 1, log_line("ERROR", "shutdown", "not available from this shell")
+        self.on_shutdown()
+        return 0, "Exiting NOW.\n"
+
+    def _ver(self, args: list[str]) -> tuple[int, str]:
+        return 0, "HW arch: PX4_SITL\nPX4 version: emulated by sitl_emu (PX4 v1.15 behaviour)\nOS: Linux\n"
+
+
+def _nav_name(nav_state: NavState) -> str:
+    return UI_NAMES.get(nav_state, str(int(nav_state)))
+
+
+def _matches(name: str, pattern: str | None) -> bool:
+    """param.cpp do_show_print: case-insensitive, exact unless a '*' wildcard is given."""
+    return pattern is None or fnmatch.fnmatchcase(name, pattern.upper())
+
+
+def _format_value(registry: ParamRegistry, name: str) -> str:
+    value = registry.get(name)
+    if registry.definition(name).type is ParamType.INT32:
+        return f"{int(value)}"
+    return f"{float(value):4.4f}"
+
+
+def _param_show(registry: ParamRegistry, args: list[str]) -> tuple[int, str]:
+    if args[:1] == ["-q"]:
+        if len(args) < 2 or args[1] not in registry:
+            return 1, ""
+        return 0, _format_value(registry, args[1]) + "\n"
+    only_changed = args[:1] == ["-c"]
+    if only_changed:
+        args = args[1:]
+    pattern = args[0] if args else None
+    lines = ["Symbols: x = used, + = saved, * = unsaved\n"]
+    for d in registry:
+        if not _matches(d.name, pattern):
+            continue
+        changed = registry.get(d.name) != d.default
+        if only_changed and not changed:
+            continue
+        index = registry.index_of(d.name)
+        lines.append(f"x {'+' if changed else ' '} {d.name} [{index},{index}] : {_format_value(registry, d.name)}\n")
+    lines.append(f"\n {len(registry)}/{len(registry)} parameters used.\n")
+    return 0, "".join(lines)
+
+
+def _param_set(registry: ParamRegistry, name: str, text: str, fail: bool) -> tuple[int, str]:
+    if name not in registry:
+        return (1 if fail else 0), log_line("ERROR", "param", f"Parameter {name} not found.")
+    try:
+        value = float(text)  # BE SAFER THAN PX4: strtol/strtod would turn "abc" into 0 and set it
+    except ValueError:
+        return 1, log_line("ERROR", "param", f"'{text}' is not a number.")
+    old = _format_value(registry, name)
+    marker = "+" if registry.get(name) != registry.definition(name).default else " "
+    if registry.get(name) == value:
+        return 0, ""
+    try:
+        registry.set(name, value)
+    except ParamError as err:
+        return 1, log_line("ERROR", "param", str(err))
+    return 0, f"{marker} {name}: curr: {old} -> new: {_format_value(registry, name)}\n"
