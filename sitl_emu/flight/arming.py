@@ -1,0 +1,124 @@
+"""Mode requirements, "can run" and "can arm" for a multicopter, as PX4's health and arming checks decide them.
+
+Pure functions of a `CheckInputs` snapshot. Sources:
+- which mode needs what: src/modules/commander/ModeUtil/mode_requirements.cpp (rotary-wing branch)
+- how a failed requirement clears the can-run/arming bits and the reason texts:
+  src/modules/commander/HealthAndArmingChecks/checks/modeCheck.cpp
+- offboard signal freshness: HealthAndArmingChecks/checks/offboardCheck.cpp (timestamp + COM_OF_LOSS_T > now)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Flag, auto
+
+from sitl_emu.px4 import NavState
+
+
+class Req(Flag):
+    """One bit per mode requirement (failsafe_flags.mode_req_*)."""
+
+    NONE = 0
+    ATTITUDE = auto()  # angular velocity + attitude
+    POSITION = auto()  # local (relaxed or not), global position and local altitude
+    HOME = auto()
+    MISSION = auto()
+    OFFBOARD = auto()
+    MANUAL = auto()
+    PREVENT_ARMING = auto()
+
+
+_A, _P, _M = Req.ATTITUDE, Req.POSITION, Req.MANUAL
+
+# mode_requirements.cpp, multicopter (ROTARY_WING) branch
+_REQUIREMENTS: dict[NavState, Req] = {
+    NavState.MANUAL: _M,
+    NavState.ALTCTL: _A | _P | _M,
+    NavState.ALTITUDE_CRUISE: _A | _P | _M,
+    NavState.POSCTL: _A | _P | _M,
+    NavState.POSITION_SLOW: _A | _P | _M,
+    NavState.AUTO_MISSION: _A | _P | Req.MISSION,
+    NavState.AUTO_LOITER: _A | _P,
+    NavState.GUIDED_COURSE: _A | _P,
+    NavState.AUTO_RTL: _A | _P | Req.HOME | Req.PREVENT_ARMING,
+    NavState.ACRO: _M,
+    NavState.DESCEND: _A | Req.PREVENT_ARMING,
+    NavState.TERMINATION: Req.PREVENT_ARMING,
+    NavState.OFFBOARD: _A | Req.OFFBOARD,
+    NavState.STAB: _A | _M,
+    NavState.AUTO_TAKEOFF: _A | _P,
+    NavState.AUTO_LAND: _A | _P | Req.PREVENT_ARMING,
+    NavState.AUTO_FOLLOW_TARGET: _A | _P | Req.PREVENT_ARMING,
+    NavState.AUTO_PRECLAND: _A | _P | Req.PREVENT_ARMING,
+    NavState.ORBIT: _A | _P | Req.PREVENT_ARMING,
+    NavState.AUTO_VTOL_TAKEOFF: _A | _P,
+}
+
+# The reasons modeCheck.cpp reports (as events) for each failed requirement, in its order.
+_REASONS: tuple[tuple[Req, str], ...] = (
+    (Req.ATTITUDE, "No valid attitude estimate"),
+    (Req.POSITION, "Navigation error: No valid position estimate"),
+    (Req.MISSION, "No valid mission available"),
+    (Req.HOME, "Home position not set"),
+    (Req.MANUAL, "No manual control input"),
+    (Req.OFFBOARD, "No offboard signal"),
+)
+
+
+@dataclass(frozen=True, slots=True)
+class CheckInputs:
+    """What the checks look at, at one instant."""
+
+    estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
+    home_valid: bool
+    offboard_signal: bool  # an offboard_control_mode with a setpoint kind, younger than COM_OF_LOSS_T
+    manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
+    mission_valid: bool = False  # sitl_emu has no mission storage
+
+
+def requirements(nav_state: NavState) -> Req:
+    return _REQUIREMENTS.get(nav_state, Req.NONE)
+
+
+def mode_prevents_arming(nav_state: NavState) -> bool:
+    return Req.PREVENT_ARMING in requirements(nav_state)
+
+
+def missing(nav_state: NavState, c: CheckInputs) -> Req:
+    """The requirements of nav_state that are not met now (PREVENT_ARMING excluded)."""
+    have = Req.NONE
+    if c.estimator_ready:
+        have |= Req.ATTITUDE | Req.POSITION
+    if c.home_valid:
+        have |= Req.HOME
+    if c.mission_valid:
+        have |= Req.MISSION
+    if c.offboard_signal:
+        have |= Req.OFFBOARD
+    if c.manual_control:
+        have |= Req.MANUAL
+    need = requirements(nav_state) & ~Req.PREVENT_ARMING
+    return need & ~have
+
+
+def can_run(nav_state: NavState, c: CheckInputs) -> bool:
+    """True if nav_state's requirements are met (HealthAndArmingChecks::canRun)."""
+    return missing(nav_state, c) == Req.NONE
+
+
+def arming_failure(nav_state: NavState, c: CheckInputs) -> str | None:
+    """None if arming is allowed in nav_state, else the first failing check's text (canArm is False)."""
+    if not c.estimator_ready:
+        # Every arming check needs the estimator (ekf2 not ready: attitude/position invalid).
+        return "No valid attitude estimate"
+    if mode_prevents_arming(nav_state):
+        return "Mode not suitable for arming"
+    gaps = missing(nav_state, c)
+    for req, text in _REASONS:
+        if req in gaps:
+            return text
+    return None
+
+
+def can_arm(nav_state: NavState, c: CheckInputs) -> bool:
+    return arming_failure(nav_state, c) is None

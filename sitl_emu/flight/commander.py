@@ -1,0 +1,280 @@
+"""PX4's commander for a SITL multicopter: arming, user mode intention vs mode in force, failsafes, auto-disarm.
+
+A pure state machine: simulated time comes in as `now_us`, texts go out through the `emit` callback, requests for
+the navigator (takeoff altitude, reposition, altitude change) queue in `nav_commands`. Commands are handled in
+`sitl_emu.flight.commands`. Sources: src/modules/commander/Commander.cpp (arm ~l.663, disarm ~l.744,
+handleAutoDisarm ~l.2455, takeoff completion ~l.2208, land detector texts ~l.2310), UserModeIntention.cpp,
+failsafe/failsafe.cpp. See ../shared/reference/px4-behaviour.md sections 2-5.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from sitl_emu.flight import arming
+from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
+from sitl_emu.flight.mode_intention import ModeIntention
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
+from sitl_emu.types import NAN, CommandAck, HomePosition, OffboardControlMode, Vec3, VehicleCommand
+
+# emit(severity, module, text, is_event, statustext)
+Emit = Callable[[Severity, str, str, bool, bool], None]
+# geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
+NedOf = Callable[[float, float, float], Vec3]
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """What the commander sees of the vehicle at the start of a step."""
+
+    now_us: int
+    estimator_ready: bool
+    here: HomePosition | None  # the current position as a home candidate; None while the estimator is not ready
+    task_finished: bool = False  # the navigator's current task says it is done (takeoff reached)
+
+
+@dataclass(frozen=True, slots=True)
+class NavCommand:
+    """A request for the navigator that comes with a command (global coordinates, NaN = keep current)."""
+
+    kind: str  # "takeoff" | "reposition" | "change_altitude"
+    lat_deg: float = NAN
+    lon_deg: float = NAN
+    alt_amsl_m: float = NAN
+    yaw_rad: float = NAN
+    speed_m_s: float = NAN
+
+
+class Commander:
+    """The vehicle's brain; see the module docstring."""
+
+    def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None) -> None:
+        self.params = params
+        self._emit = emit
+        self._ned_of = ned_of
+        self.intention = ModeIntention(NavState.AUTO_LOITER)
+        self._failsafe = Failsafe()
+        self.armed = False
+        self.nav_state: NavState = NavState.AUTO_LOITER
+        self.failsafe = False
+        self.terminated = False
+        self.home: HomePosition | None = None
+        self.have_taken_off = False
+        self.landed = True
+        self.maybe_landed = True
+        self.nav_commands: list[NavCommand] = []
+        self.reboot_requested = False
+        self._obs = Observation(0, False, None)
+        self._ready_announced = False
+        self._armed_at_us = 0
+        self._landed_since_us: int | None = None
+        self._offboard_last_us: int | None = None
+        self._offboard_mode: OffboardControlMode | None = None
+        self._last_reject_text_us: int | None = None
+
+    # ---- inputs -------------------------------------------------------------------------------------------------
+    def observe(self, obs: Observation) -> None:
+        self._obs = obs
+
+    @property
+    def now_us(self) -> int:
+        return self._obs.now_us
+
+    @property
+    def estimator_ready(self) -> bool:
+        return self._obs.estimator_ready
+
+    def offboard_signal(self, now_us: int, mode: OffboardControlMode) -> None:
+        """An offboard_control_mode arrived (any mode): refresh the COM_OF_LOSS_T watchdog."""
+        self._offboard_last_us = now_us
+        self._offboard_mode = mode
+
+    def offboard_fresh(self, now_us: int) -> bool:
+        """offboardCheck.cpp: a setpoint kind is set and now < timestamp + COM_OF_LOSS_T."""
+        if self._offboard_last_us is None or self._offboard_mode is None or not self._offboard_mode.any():
+            return False
+        return now_us < self._offboard_last_us + int(self.params["COM_OF_LOSS_T"] * 1e6)
+
+    @property
+    def offboard_mode(self) -> OffboardControlMode | None:
+        """The last offboard signal kinds while the signal is fresh, else None."""
+        return self._offboard_mode if self.offboard_fresh(self.now_us) else None
+
+    # ---- checks -------------------------------------------------------------------------------------------------
+    def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
+        t = self.now_us if now_us is None else now_us
+        return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
+                                  offboard_signal=self.offboard_fresh(t))
+
+    def can_run(self, nav_state: NavState) -> bool:
+        return arming.can_run(nav_state, self.check_inputs())
+
+    def pre_flight_checks_pass(self) -> bool:
+        """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT)."""
+        return arming.can_arm(self.nav_state, self.check_inputs())
+
+    def system_status(self) -> MavState:
+        """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
+        if self.nav_state == NavState.TERMINATION and self.armed:
+            return MavState.FLIGHT_TERMINATION
+        if self.armed:
+            return MavState.CRITICAL if self.failsafe else MavState.ACTIVE
+        return MavState.STANDBY if self.pre_flight_checks_pass() else MavState.UNINIT
+
+    # ---- texts --------------------------------------------------------------------------------------------------
+    def say(self, severity: Severity, text: str, is_event: bool = True, statustext: bool = True,
+            module: str = "commander") -> None:
+        self._emit(severity, module, text, is_event, statustext)
+
+    def reject_mode_text(self, nav_state: NavState, now_us: int, rate_limited: bool = False) -> None:
+        """printRejectMode: "Switching to %s is currently not available" (DO_SET_MODE: at most once per second)."""
+        if rate_limited and self._last_reject_text_us is not None and now_us - self._last_reject_text_us < 1_000_000:
+            return
+        self._last_reject_text_us = now_us
+        self.say(Severity.CRITICAL, f"Switching to {UI_NAMES[nav_state]} is currently not available")
+
+    # ---- arming -------------------------------------------------------------------------------------------------
+    def arm(self, now_us: int, *, external: bool, run_checks: bool) -> bool:
+        """Commander::arm: checks for the current nav_state, then arm, set home, start the auto-disarm timers."""
+        if self.armed:
+            return True
+        if run_checks:
+            failure = arming.arming_failure(self.nav_state, self.check_inputs(now_us))
+            if failure is not None:
+                self.say(Severity.CRITICAL, f"Preflight Fail: {failure}", is_event=False, statustext=False,
+                         module="health_and_arming_checks")
+                self.say(Severity.CRITICAL, "Arming denied: Resolve system health failures first")
+                return False
+        self.armed = True
+        self.have_taken_off = False
+        self._armed_at_us = now_us
+        self._landed_since_us = None
+        self._failsafe.reset()
+        if self.params["COM_HOME_EN"] and self._obs.here is not None:
+            self.home = self._obs.here
+        self.say(Severity.INFO, f"Armed by {'external' if external else 'internal'} command")
+        return True
+
+    def disarm(self, reason: str, *, forced: bool) -> bool:
+        """Commander::disarm: refused in the air unless forced; the mode reverts to the sticky user mode."""
+        if not self.armed:
+            return True
+        if not forced and not (self.landed or self.maybe_landed):
+            self.say(Severity.CRITICAL, "Disarming denied: not landed")
+            return False
+        self.armed = False
+        self.have_taken_off = False
+        self.say(Severity.INFO, f"Disarmed by {reason}")
+        self.intention.on_disarm()
+        self._failsafe.reset()
+        self.failsafe = False
+        if not self.terminated:
+            self.nav_state = self.intention.user_intended
+        return True
+
+    # ---- modes --------------------------------------------------------------------------------------------------
+    def change_mode(self, nav_state: NavState, *, force: bool = False) -> bool:
+        """UserModeIntention::change; on success the mode in force follows at once when it can run."""
+        ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
+                                   in_termination=self.nav_state == NavState.TERMINATION)
+        if ok:
+            self._apply_mode(self.now_us)
+        return ok
+
+    def _fallback_settings(self) -> FallbackSettings:
+        return FallbackSettings(obl_rc_act=int(self.params["COM_OBL_RC_ACT"]),
+                                rcl_act=int(self.params["NAV_RCL_ACT"]))
+
+    def _apply_mode(self, now_us: int) -> None:
+        inputs = self.check_inputs(now_us)
+        decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
+                                         can_run=lambda m: arming.can_run(m, inputs),
+                                         settings=self._fallback_settings(), terminated=self.terminated)
+        if self.nav_state == NavState.TERMINATION and self.armed:
+            decision_nav = NavState.TERMINATION  # never leave termination while armed
+        else:
+            decision_nav = decision.nav_state
+        self.nav_state = decision_nav
+        self.failsafe = decision.failsafe
+        if decision.activated:
+            self.say(Severity.CRITICAL, "Failsafe activated")
+        if decision.disarm:
+            self.disarm("failsafe", forced=True)
+
+    # ---- the periodic update ------------------------------------------------------------------------------------
+    def update(self, now_us: int) -> None:
+        """One commander cycle: readiness, home, auto-disarm, takeoff completion, the mode in force."""
+        self._update_ready()
+        self._auto_disarm(now_us)
+        self._takeoff_completion()
+        self._apply_mode(now_us)
+
+    def _update_ready(self) -> None:
+        if not self.estimator_ready:
+            return
+        if self.home is None and not self.armed and self.params["COM_HOME_EN"] and self._obs.here is not None:
+            self.home = self._obs.here  # HomePosition::update: first valid global position on the ground
+        if not self._ready_announced:
+            self._ready_announced = True
+            self.say(Severity.INFO, "Ready for takeoff!", is_event=False, statustext=False)
+
+    def _auto_disarm(self, now_us: int) -> None:
+        """handleAutoDisarm: COM_DISARM_LAND after landing, COM_SPOOLUP_TIME + COM_DISARM_PRFLT if never airborne."""
+        if not self.armed:
+            return
+        disarm_land_s = float(self.params["COM_DISARM_LAND"])
+        prflt_s = float(self.params["COM_DISARM_PRFLT"])
+        if self.have_taken_off:
+            if disarm_land_s <= 0 or not self.landed:
+                self._landed_since_us = None
+                return
+            if self._landed_since_us is None:
+                self._landed_since_us = now_us
+            if now_us - self._landed_since_us >= int(disarm_land_s * 1e6):
+                self.disarm("landing", forced=True)
+        elif prflt_s > 0:
+            limit_us = int((float(self.params["COM_SPOOLUP_TIME"]) + prflt_s) * 1e6)
+            if now_us - self._armed_at_us >= limit_us:
+                self.disarm("auto preflight disarming", forced=True)
+
+    def _takeoff_completion(self) -> None:
+        """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
+        if (self.armed and not self.landed and self.nav_state == NavState.AUTO_TAKEOFF
+                and self._obs.task_finished):
+            self.change_mode(NavState.AUTO_LOITER)
+
+    def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:
+        """Land detector output after physics: "Takeoff detected" / "Landing detected" while armed."""
+        was_landed = self.landed
+        self.landed, self.maybe_landed = landed, maybe_landed
+        if not self.armed or landed == was_landed:
+            return
+        if landed:
+            self.say(Severity.INFO, "Landing detected")
+        else:
+            self.say(Severity.INFO, "Takeoff detected")
+            self.have_taken_off = True
+
+    # ---- commands -----------------------------------------------------------------------------------------------
+    def handle_command(self, cmd: VehicleCommand, now_us: int) -> CommandAck | None:
+        from sitl_emu.flight.commands import handle_command
+
+        return handle_command(self, cmd, now_us)
+
+    def home_from_global(self, lat_deg: float, lon_deg: float, alt_amsl_m: float, yaw_rad: float) -> bool:
+        """HomePosition::setManually: needs a valid local position to place home in the local frame."""
+        if not self.estimator_ready or self._ned_of is None:
+            return False
+        pos = self._ned_of(lat_deg, lon_deg, alt_amsl_m)
+        yaw = yaw_rad if math.isfinite(yaw_rad) else (self.home.yaw_rad if self.home else 0.0)
+        self.home = HomePosition(lat_deg, lon_deg, alt_amsl_m, pos, yaw)
+        return True
+
+    def home_here(self) -> bool:
+        if not self.estimator_ready or self._obs.here is None:
+            return False
+        self.home = self._obs.here
+        return True

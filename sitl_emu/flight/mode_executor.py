@@ -1,0 +1,127 @@
+"""Which setpoint drives the controllers: the navigator task of the mode in force, or the offboard stream.
+
+PX4 splits this between navigator (navigator_main.cpp: one task per nav_state, vehicle_command parameters for
+takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
+- a new task starts when the mode in force changes, at arming, and when a command brings new navigator parameters;
+- Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
+  loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
+- OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
+- manual and termination modes have no setpoint (the controller idles or the motors stop).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl_emu.flight import tasks
+from sitl_emu.flight.commander import NavCommand
+from sitl_emu.geo import GeoRef, global_to_ned
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import NavState, Severity
+from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
+
+_TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
+                         NavState.AUTO_RTL})
+
+
+@dataclass(frozen=True, slots=True)
+class ExecutorOutput:
+    trajectory: TrajectorySetpoint | None
+    attitude: AttitudeSetpoint | None
+    setpoint_type: str  # "idle" | "position" | "takeoff" | "land" | "offboard" | "none"
+    task_finished: bool
+    messages: list[tuple[Severity, str]]
+
+
+class ModeExecutor:
+    """Owns the current navigator task and the latest offboard setpoints."""
+
+    def __init__(self, params: ParamRegistry) -> None:
+        self.params = params
+        self.task: tasks.Task | None = None
+        self._task_mode: NavState | None = None
+        self._task_armed = False
+        self._takeoff_target_ned_m: Vec3 | None = None
+        self._offboard_kind: OffboardControlMode | None = None
+        self._offboard_traj: TrajectorySetpoint | None = None
+        self._offboard_att: AttitudeSetpoint | None = None
+
+    def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
+                 attitude: AttitudeSetpoint | None) -> None:
+        self._offboard_kind = mode
+        if trajectory is not None:
+            self._offboard_traj = trajectory
+        if attitude is not None:
+            self._offboard_att = attitude
+
+    def update(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand], ref: GeoRef,
+               dt_s: float) -> ExecutorOutput:
+        self._select_task(nav_state, nav, commands, ref)
+        if nav_state == NavState.OFFBOARD:
+            return self._offboard_output()
+        if self.task is None:
+            return ExecutorOutput(None, None, "none", False, [])
+        sp = self.task.update(nav, dt_s)
+        return ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages())
+
+    def _offboard_output(self) -> ExecutorOutput:
+        kind = self._offboard_kind
+        use_traj = kind is not None and (kind.position or kind.velocity or kind.acceleration)
+        if use_traj or self._offboard_att is None:
+            return ExecutorOutput(self._offboard_traj, None, "offboard", False, [])
+        return ExecutorOutput(None, self._offboard_att, "offboard", False, [])
+
+    # ---- task selection -----------------------------------------------------------------------------------------
+    def _select_task(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand],
+                     ref: GeoRef) -> None:
+        if nav_state not in _TASK_MODES:
+            self.task, self._task_mode = None, None
+            commands.clear()
+            return
+        previous = self._task_mode
+        finished_takeoff = previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished
+        command = commands.pop() if commands else None
+        commands.clear()
+        changed = nav_state != previous or nav.armed != self._task_armed
+        if not changed and command is None:
+            return
+        self._task_mode, self._task_armed = nav_state, nav.armed
+        if nav_state == NavState.AUTO_TAKEOFF:
+            self.task = self._make_takeoff(nav, command, ref)
+        elif nav_state == NavState.AUTO_LOITER:
+            self.task = self._make_loiter(nav, command, ref, finished_takeoff)
+        elif nav_state == NavState.AUTO_RTL:
+            self.task = tasks.make_rtl(nav, self.params)
+        else:
+            self.task = tasks.make_land(nav, self.params)
+
+    def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
+        alt_up: float | None = None
+        if command is not None and command.kind == "takeoff" and math.isfinite(command.alt_amsl_m):
+            alt_up = command.alt_amsl_m - ref.alt_amsl_m
+        default_up = -nav.pos_ned_m[2] + float(self.params["MIS_TAKEOFF_ALT"])
+        self._takeoff_target_ned_m = (nav.pos_ned_m[0], nav.pos_ned_m[1], -(alt_up if alt_up is not None
+                                                                          else default_up))
+        return tasks.make_takeoff(nav, self.params, alt_up)
+
+    def _make_loiter(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
+                     finished_takeoff: bool) -> tasks.Task:
+        if command is not None and command.kind in ("reposition", "change_altitude") and nav.armed:
+            target = _command_target(command, nav, ref)
+            speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
+            yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else nav.yaw_rad
+            return tasks.make_reposition(nav, self.params, target, yaw, speed)
+        if finished_takeoff and self._takeoff_target_ned_m is not None:
+            return tasks.make_loiter(nav, self.params, hold_at_ned_m=self._takeoff_target_ned_m)
+        return tasks.make_loiter(nav, self.params)
+
+
+def _command_target(command: NavCommand, nav: tasks.NavInput, ref: GeoRef) -> Vec3:
+    """The reposition target in NED; NaN lat/lon/alt keep the current position's component."""
+    x, y, z = nav.pos_ned_m
+    if math.isfinite(command.lat_deg) and math.isfinite(command.lon_deg):
+        x, y, _ = global_to_ned(ref, command.lat_deg, command.lon_deg, ref.alt_amsl_m)
+    if math.isfinite(command.alt_amsl_m):
+        z = ref.alt_amsl_m - command.alt_amsl_m
+    return x, y, z

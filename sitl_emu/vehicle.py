@@ -1,0 +1,217 @@
+"""The emulated PX4 quadrotor: one deterministic step over simulated time, and the interface the MAVLink side uses.
+
+Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (4000 us, 250 Hz):
+ 1. pending reboot (PREFLIGHT_REBOOT_SHUTDOWN param1=1, acknowledged before): back to the boot state, time 0;
+ 2. estimate: the truth state (plus optional seeded noise) becomes the estimate everything else reads;
+ 3. commander: readiness ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
+ 4. mode executor: the navigator task of the mode in force, or the offboard setpoint (OFFBOARD);
+ 5. control cascade: setpoint -> motor commands (idle/zero when disarmed or terminated);
+ 6. physics: rigid-body step by dt;
+ 7. land detector on the new state -> commander ("Takeoff detected" / "Landing detected");
+ 8. events: the task's messages join the event stream.
+Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
+on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+from sitl_emu.flight.commander import Commander, Observation
+from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
+from sitl_emu.params import ParamRegistry, default_registry
+from sitl_emu.physics import RigidBodyState, SihConfig
+from sitl_emu.physics import step as physics_step
+from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
+from sitl_emu.types import (
+    AttitudeSetpoint,
+    CommandAck,
+    HomePosition,
+    OffboardControlMode,
+    TrajectorySetpoint,
+    Vec3,
+    Vec4,
+    VehicleCommand,
+    VehicleEvent,
+    VehicleSnapshot,
+)
+from sitl_emu.vehicle_parts import Parts, build_parts
+
+EVENT_HISTORY = 1000
+
+
+class Vehicle:
+    """A PX4 SITL multicopter in simulated time. See the module docstring for the step order."""
+
+    dt_us: int = 4000  # 250 Hz, SIH lockstep
+
+    def __init__(self, *, params: ParamRegistry | None = None,
+                 home: tuple[float, float, float] = (47.397742, 8.545594, 488.0), seed: int = 0, sysid: int = 1,
+                 ready_delay_s: float = 2.0, position_noise_m: float = 0.0) -> None:
+        """Boot disarmed in Hold on the ground at `home` (lat_deg, lon_deg, alt_amsl_m), the local frame's origin.
+
+        `ready_delay_s` is the simulated estimator warm-up before arming is possible; `position_noise_m` (default 0)
+        adds seeded Gaussian noise to the position estimate.
+        """
+        self.params: ParamRegistry = params if params is not None else default_registry()
+        self.sysid = sysid
+        self._home_tuple = home
+        self._seed = seed
+        self._ready_delay_us = round(ready_delay_s * 1e6)
+        self._noise_m = position_noise_m
+        self._events: deque[VehicleEvent] = deque(maxlen=EVENT_HISTORY)
+        self._seq = 0
+        self._boot()
+
+    def _boot(self) -> None:
+        self._time_us = 0
+        self.ref = GeoRef(*self._home_tuple)
+        self._rng = np.random.default_rng(self._seed)
+        self._state = RigidBodyState()
+        self._estimate = self._state
+        self._sih_version = -1
+        self._sih = SihConfig.from_params(self.params)
+        self.commander = Commander(self.params, self._emit, self._ned_of)
+        self.parts: Parts = build_parts(self.params)
+        self._setpoint_type = "none"
+        self._task_finished = False
+
+    # ---- time ---------------------------------------------------------------------------------------------------
+    @property
+    def time_us(self) -> int:
+        """Simulated time since boot (us), starting at 0."""
+        return self._time_us
+
+    def step(self) -> None:
+        """Advance exactly one physics tick (dt_us), in the fixed order of the module docstring."""
+        if self.commander.reboot_requested:
+            self._boot()
+            return
+        now = self._time_us + self.dt_us
+        self._time_us = now
+        dt_s = self.dt_us * 1e-6
+        c = self.commander
+        c.observe(Observation(now, now >= self._ready_delay_us, self._here(), self._task_finished))
+        c.update(now)
+        nav = self.parts.nav_input(now, self._estimate, c, self.ref)
+        out = self.parts.executor.update(c.nav_state, nav, c.nav_commands, self.ref, dt_s)
+        self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
+        armed = c.armed and c.nav_state != NavState.TERMINATION
+        motors = self.parts.control.update(self._estimate, out.trajectory, out.attitude, armed, c.landed, now, dt_s)
+        self._state = physics_step(self._state, motors, dt_s, self._sih_config())
+        self._estimate = self._estimate_from(self._state)
+        landed, maybe_landed = self.parts.land(self._estimate, c, out.setpoint_type, now)
+        c.on_land_detector(landed, maybe_landed)
+        for severity, text in out.messages:
+            self._emit(severity, "navigator", text, True, True)
+
+    def run_until(self, time_us: int) -> None:
+        """Step until time_us is reached (no-op if already there)."""
+        while self._time_us < time_us:
+            self.step()
+
+    def run_for(self, seconds: float) -> None:
+        """Step for `seconds` of simulated time."""
+        self.run_until(self._time_us + round(seconds * 1e6))
+
+    def _sih_config(self) -> SihConfig:
+        if self.params.version != self._sih_version:
+            self._sih, self._sih_version = SihConfig.from_params(self.params), self.params.version
+        return self._sih
+
+    def _estimate_from(self, truth: RigidBodyState) -> RigidBodyState:
+        if self._noise_m <= 0.0:
+            return truth
+        n = self._rng.normal(0.0, self._noise_m, 3)
+        p = truth.pos_ned_m
+        est = RigidBodyState(**{f: getattr(truth, f) for f in RigidBodyState.__slots__})  # type: ignore[attr-defined]
+        est.pos_ned_m = (p[0] + float(n[0]), p[1] + float(n[1]), p[2] + float(n[2]))
+        return est
+
+    # ---- inputs -------------------------------------------------------------------------------------------------
+    def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
+        """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
+        return self.commander.handle_command(cmd, self._time_us)
+
+    def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
+                       attitude: AttitudeSetpoint | None = None) -> None:
+        """An offboard message: refreshes the COM_OF_LOSS_T watchdog in any mode; setpoints are used in OFFBOARD."""
+        self.commander.offboard_signal(self._time_us, mode)
+        self.parts.executor.offboard(mode, trajectory, attitude)
+
+    def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
+        """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""
+        self._emit(severity, module, text, is_event, True)
+
+    def reboot(self) -> None:
+        """Back to the boot state now: time 0, disarmed in Hold, parameters kept (event seq keeps counting)."""
+        self._boot()
+
+    # ---- outputs ------------------------------------------------------------------------------------------------
+    def events_after(self, seq: int) -> list[VehicleEvent]:
+        """Events with seq > `seq` still in the history (the last ~1000)."""
+        return [e for e in self._events if e.seq > seq]
+
+    @property
+    def last_event_seq(self) -> int:
+        return self._seq
+
+    def _emit(self, severity: Severity, module: str, text: str, is_event: bool, statustext: bool) -> None:
+        self._seq += 1
+        self._events.append(VehicleEvent(self._seq, self._time_us, severity, module, text, is_event, statustext))
+
+    def _ned_of(self, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> Vec3:
+        return global_to_ned(self.ref, lat_deg, lon_deg, alt_amsl_m)
+
+    def _here(self) -> HomePosition | None:
+        if self._time_us < self._ready_delay_us:
+            return None
+        pos = self._estimate.pos_ned_m
+        lat, lon, alt = ned_to_global(self.ref, pos)
+        return HomePosition(lat, lon, alt, pos, _yaw(self._estimate.q_wxyz))
+
+    def landed_state(self) -> LandedState:
+        """EXTENDED_SYS_STATE.landed_state (reference 5.5)."""
+        c = self.commander
+        if c.landed:
+            return LandedState.ON_GROUND
+        if c.nav_state in AUTO_MODES and self._setpoint_type == "takeoff":
+            return LandedState.TAKEOFF
+        if c.nav_state in AUTO_MODES and self._setpoint_type == "land":
+            return LandedState.LANDING
+        return LandedState.IN_AIR
+
+    def snapshot(self) -> VehicleSnapshot:
+        """Everything telemetry needs at the current simulated time."""
+        c, s = self.commander, self._estimate
+        lat, lon, alt = ned_to_global(self.ref, s.pos_ned_m)
+        ctrl = self.parts.control
+        return VehicleSnapshot(
+            time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
+            user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe,
+            landed_state=self.landed_state(), pre_flight_checks_pass=(not c.armed) and c.pre_flight_checks_pass(),
+            position_valid=c.estimator_ready, takeoff_detected=c.have_taken_off,
+            offboard_control=c.offboard_mode, pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s,
+            acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz, rates_frd_rad_s=s.rates_frd_rad_s,
+            euler_rad=_euler(s.q_wxyz), lat_deg=lat, lon_deg=lon, alt_amsl_m=alt, ref_lat_deg=self.ref.lat_deg,
+            ref_lon_deg=self.ref.lon_deg, ref_alt_amsl_m=self.ref.alt_amsl_m, home=c.home,
+            local_setpoint=ctrl.local_setpoint, attitude_setpoint_q_wxyz=ctrl.attitude_setpoint_q_wxyz,
+            rates_setpoint_rad_s=ctrl.rates_setpoint_rad_s, thrust_setpoint=ctrl.thrust_setpoint,
+            motors=self._state.motors, extras={"system_status": float(c.system_status())},
+        )
+
+
+def _yaw(q: Vec4) -> float:
+    w, x, y, z = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _euler(q: Vec4) -> Vec3:
+    """(roll, pitch, yaw) of a w-first quaternion, ZYX (PX4 matrix::Eulerf)."""
+    w, x, y, z = q
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    return roll, pitch, _yaw(q)

@@ -1,0 +1,132 @@
+"""The components Vehicle.step drives, behind small adapters: control cascade, mode executor, land detector.
+
+Each adapter turns the vehicle's state into the component's input type, so vehicle.py stays a readable list of
+steps. If a component module is not installed yet, a null stand-in keeps the vehicle usable (it then stays on the
+ground): motors off, no setpoints, landed while on the ground.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from sitl_emu.flight.commander import Commander, NavCommand
+from sitl_emu.geo import GeoRef
+from sitl_emu.params import ParamRegistry
+from sitl_emu.physics import RigidBodyState
+from sitl_emu.px4 import NavState
+from sitl_emu.types import NAN3, AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, Vec4
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, slots=True)
+class _NullOutput:
+    trajectory: TrajectorySetpoint | None = None
+    attitude: AttitudeSetpoint | None = None
+    setpoint_type: str = "none"
+    task_finished: bool = False
+    messages: tuple = ()
+
+
+class _NullExecutor:
+    task = None
+
+    def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
+                 attitude: AttitudeSetpoint | None) -> None:
+        pass
+
+    def update(self, nav_state: NavState, nav: Any, commands: list[NavCommand], ref: GeoRef,
+               dt_s: float) -> _NullOutput:
+        commands.clear()
+        return _NullOutput()
+
+
+class _NullControl:
+    local_setpoint: TrajectorySetpoint | None = None
+    attitude_setpoint_q_wxyz: Vec4 | None = None
+    rates_setpoint_rad_s: Vec3 = NAN3
+    thrust_setpoint: float = 0.0
+    hover_thrust: float = 0.5
+
+    def update(self, state: RigidBodyState, setpoint: TrajectorySetpoint | None, attitude_sp: AttitudeSetpoint | None,
+               armed: bool, landed: bool, now_us: int, dt_s: float) -> Vec4:
+        return (0.0, 0.0, 0.0, 0.0)
+
+    def reset(self) -> None:
+        pass
+
+
+def _yaw(q: Vec4) -> float:
+    w, x, y, z = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+class Parts:
+    """Control cascade + mode executor + land detector, with the adapters Vehicle.step calls."""
+
+    def __init__(self, params: ParamRegistry) -> None:
+        self.params = params
+        self.control: Any = _make_control(params)
+        self.executor: Any = _make_executor(params)
+        self._detector: Any = _make_land_detector(params)
+
+    def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> Any:
+        try:
+            from sitl_emu.flight.tasks import NavInput
+        except ImportError:
+            return None
+        home = c.home
+        return NavInput(time_us=now_us, pos_ned_m=est.pos_ned_m, vel_ned_m_s=est.vel_ned_m_s,
+                        yaw_rad=_yaw(est.q_wxyz), home_ned_m=home.pos_ned_m if home else (0.0, 0.0, 0.0),
+                        home_yaw_rad=home.yaw_rad if home else 0.0, landed=c.landed, armed=c.armed)
+
+    def land(self, est: RigidBodyState, c: Commander, setpoint_type: str, now_us: int) -> tuple[bool, bool]:
+        """Run the land detector on the new state; (landed, maybe_landed)."""
+        if self._detector is None:
+            landed = est.on_ground or not c.armed
+            return landed, landed
+        from sitl_emu.flight.land_detector import LandDetectorInput
+
+        sp = self.control.local_setpoint
+        sp_vz = sp.velocity_ned_m_s[2] if sp is not None else math.nan
+        f = est.specific_force_frd
+        out = self._detector.update(LandDetectorInput(
+            time_us=now_us, armed=c.armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
+            specific_force_norm_m_s2=math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
+            thrust_setpoint=self.control.thrust_setpoint, hover_thrust=self.control.hover_thrust,
+            setpoint_vz_m_s=sp_vz, in_descent_mode=setpoint_type == "land"))
+        return out.landed, out.maybe_landed
+
+
+def _make_control(params: ParamRegistry) -> Any:
+    try:
+        from sitl_emu.control.cascade import MulticopterControl
+    except ImportError:
+        log.warning("sitl_emu.control.cascade missing: motors stay off")
+        return _NullControl()
+    return MulticopterControl(params)
+
+
+def _make_executor(params: ParamRegistry) -> Any:
+    try:
+        from sitl_emu.flight.mode_executor import ModeExecutor
+    except ImportError:
+        log.warning("sitl_emu.flight.tasks missing: no navigator tasks")
+        return _NullExecutor()
+    return ModeExecutor(params)
+
+
+def _make_land_detector(params: ParamRegistry) -> Any:
+    try:
+        from sitl_emu.flight.land_detector import LandDetector
+    except ImportError:
+        log.warning("sitl_emu.flight.land_detector missing: landed = on the ground")
+        return None
+    return LandDetector(params)
+
+
+def build_parts(params: ParamRegistry) -> Parts:
+    return Parts(params)
