@@ -1,0 +1,121 @@
+"""The MAVLink shell: SERIAL_CONTROL device 10 to the pxh> shell and back (px4-behaviour.md section 8).
+
+Receive (mavlink_receiver.cpp handle_message_serial_control): ignore messages for another system/component, with the
+REPLY flag, or for another device than SHELL (10). The first accepted message opens the shell. 0 < count <= 70 data
+bytes are written to it and the sender becomes the reply target. Without the RESPOND flag the shell is closed after
+the write (a message with flags 0 ends the session).
+Shell (pxh.cpp run_remote_pxh): no prompt on start; every input byte > 3 is echoed; on '\\n' it prints "\\n", runs
+the line, then prints the prompt "pxh> ". Log output (vehicle events) shows up in the session while it is open.
+Output (mavlink_main.cpp handleMavlinkShellOutput): SERIAL_CONTROL {device 10, flags REPLY, timeout 0, baudrate 0,
+count <= 70}. PX4 sends one chunk per 1.5 ms main-loop pass; we send up to CHUNKS_PER_TICK per tick so long outputs
+(`param show`) arrive as quickly.
+The target_system/target_component extension fields are not in pymavlink's dialects: incoming ones read as 0
+(accepted) and outgoing replies carry 0 (clients match on device and the REPLY flag, not on the target).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+from sitl_emu.shell import Shell
+
+SERIAL_CONTROL_DEV_SHELL = 10
+SERIAL_CONTROL_FLAG_REPLY = 1
+SERIAL_CONTROL_FLAG_RESPOND = 2
+MAX_CHUNK = 70
+CHUNKS_PER_TICK = 8
+MAX_PENDING_OUTPUT = 64 * 1024  # a vanished client must not make the buffer grow forever
+PROMPT = b"pxh> "
+
+
+class ShellBridge:
+    """One instance per link: at most one shell session, as PX4 has one MavlinkShell per Mavlink instance."""
+
+    MESSAGES: ClassVar[tuple[str, ...]] = ("SERIAL_CONTROL",)
+
+    def __init__(self, *, on_shutdown: Callable[[], None] | None = None) -> None:
+        self._on_shutdown = on_shutdown
+        self._shell: Shell | None = None
+        self._line = bytearray()
+        self._out = bytearray()
+        self._last_seq = -1
+
+    @property
+    def is_open(self) -> bool:
+        return self._shell is not None
+
+    # --- receive -----------------------------------------------------------------------------------------------
+    def handle(self, msg: Any, ctx: Any) -> None:
+        if not _accepted(msg, ctx):
+            return
+        if self._shell is None:
+            self._open(ctx)
+        if 0 < msg.count <= MAX_CHUNK:
+            self._write(bytes(msg.data[: msg.count]), ctx)
+        if not msg.flags & SERIAL_CONTROL_FLAG_RESPOND:
+            self._close()
+
+    def _open(self, ctx: Any) -> None:
+        self._shell = Shell(ctx.vehicle, self._on_shutdown)
+        self._line.clear()
+        self._out.clear()
+        self._last_seq = _latest_event_seq(ctx.vehicle)  # show log lines from now on, not the boot log
+
+    def _close(self) -> None:
+        self._shell = None
+        self._line.clear()
+        self._out.clear()
+
+    def _write(self, data: bytes, ctx: Any) -> None:
+        for byte in data:
+            if byte == 0x0A:
+                self._run_line(ctx)
+            elif byte > 3:
+                self._out.append(byte)  # echo
+                self._line.append(byte)
+
+    def _run_line(self, ctx: Any) -> None:
+        assert self._shell is not None
+        line = self._line.decode("utf-8", errors="replace")
+        self._line.clear()
+        self._out += b"\n"
+        self._collect_events(ctx)
+        self._out += self._shell.execute(line).encode("utf-8", errors="replace")
+        self._collect_events(ctx)
+        self._out += PROMPT
+
+    # --- transmit ----------------------------------------------------------------------------------------------
+    def tick(self, ctx: Any) -> None:
+        if self._shell is None:
+            return
+        self._collect_events(ctx)
+        for _ in range(CHUNKS_PER_TICK):
+            if not self._out:
+                break
+            chunk = bytes(self._out[:MAX_CHUNK])
+            del self._out[:MAX_CHUNK]
+            data = list(chunk) + [0] * (MAX_CHUNK - len(chunk))
+            ctx.send(ctx.mav.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
+                                                   len(chunk), data))
+
+    def _collect_events(self, ctx: Any) -> None:
+        events = ctx.vehicle.events_after(self._last_seq)
+        if events:
+            self._last_seq = events[-1].seq
+            self._out += "".join(e.console_line + "\n" for e in events).encode("utf-8", errors="replace")
+        if len(self._out) > MAX_PENDING_OUTPUT:
+            del self._out[: len(self._out) - MAX_PENDING_OUTPUT]
+
+
+def _accepted(msg: Any, ctx: Any) -> bool:
+    target_system = getattr(msg, "target_system", 0)
+    target_component = getattr(msg, "target_component", 0)
+    if target_system not in (0, ctx.sysid) or target_component not in (0, ctx.compid):
+        return False
+    return not msg.flags & SERIAL_CONTROL_FLAG_REPLY and msg.device == SERIAL_CONTROL_DEV_SHELL
+
+
+def _latest_event_seq(vehicle: Any) -> int:
+    events = vehicle.events_after(-1)
+    return events[-1].seq if events else -1
