@@ -1,0 +1,158 @@
+"""Raw js axes and buttons -> StickCommand: deadzone with rescale, expo, invert, scale; button hold timing.
+
+Everything here is pure and deterministic: the time comes from JoyState.time_s, hold timers from the previous
+StickCommand. `StickMapper` is the small stateful convenience that keeps the previous command for you.
+
+Per axis (AxisMap): x = raw / 32767, negated when `invert`; then the deadzone, rescaled so the output still reaches
++-1 (|x| <= dz -> 0, else sign(x) * (|x| - dz) / (1 - dz), as ROS joy does); then expo, x' = (1 - e) x + e x^3
+(same end points, softer centre); then times `scale`, clamped to -1..1. A non-centring throttle (throttle_abs)
+maps -32767..32767 to 0..1 (after invert), with the deadzone at the bottom end.
+
+When the source is disconnected, or a deadman button is configured and released, the sticks read neutral
+(0, and up 0.0 when the profile has an up axis) and no action is pressed.
+"""
+
+from __future__ import annotations
+
+from joyfly.joystick import AXIS_MAX
+from joyfly.profiles import AxisMap, Profile
+from joyfly.types import Action, JoyState, StickCommand
+
+
+def normalise(raw: int) -> float:
+    return max(-1.0, min(1.0, raw / AXIS_MAX))
+
+
+def apply_deadzone(x: float, deadzone: float) -> float:
+    """Zero inside +-deadzone, rescaled outside so that +-1 still maps to +-1."""
+    if deadzone <= 0.0:
+        return x
+    if abs(x) <= deadzone:
+        return 0.0
+    return (abs(x) - deadzone) / (1.0 - deadzone) * (1.0 if x > 0 else -1.0)
+
+
+def apply_expo(x: float, expo: float) -> float:
+    """Blend of linear and cubic: same sign and end points, finer control near the centre."""
+    return (1.0 - expo) * x + expo * x * x * x
+
+
+def shape_axis(raw: int, axis: AxisMap) -> float:
+    x = normalise(raw)
+    if axis.invert:
+        x = -x
+    x = apply_expo(apply_deadzone(x, axis.deadzone), axis.expo) * axis.scale
+    return max(-1.0, min(1.0, x))
+
+
+def shape_throttle(raw: int, axis: AxisMap) -> float:
+    x = normalise(raw)
+    if axis.invert:
+        x = -x
+    level = (x + 1.0) / 2.0
+    if axis.deadzone > 0.0:
+        level = 0.0 if level <= axis.deadzone else (level - axis.deadzone) / (1.0 - axis.deadzone)
+    return max(0.0, min(1.0, level * axis.scale))
+
+
+def _raw(values: tuple[int, ...], index: int) -> int | None:
+    return values[index] if 0 <= index < len(values) else None
+
+
+def _stick(profile: Profile, state: JoyState, role: str) -> float | None:
+    """The shaped value of a centred role; None when unmapped, 0.0 when the device lacks that axis."""
+    axis = profile.axis(role)
+    if axis is None:
+        return None
+    raw = _raw(state.axes, axis.index)
+    return 0.0 if raw is None else shape_axis(raw, axis)
+
+
+def _throttle_abs(profile: Profile, state: JoyState) -> float | None:
+    axis = profile.axis("throttle_abs")
+    raw = None if axis is None else _raw(state.axes, axis.index)
+    return None if axis is None or raw is None else shape_throttle(raw, axis)
+
+
+def pressed_actions(profile: Profile, state: JoyState) -> frozenset[Action]:
+    return frozenset(a for a, idx in profile.buttons.items() if _raw(state.buttons, idx) == 1)
+
+
+def _held(pressed: frozenset[Action], state: JoyState, prev: StickCommand | None) -> tuple[tuple[Action, float], ...]:
+    before = dict(prev.held_s) if prev is not None else {}
+    dt = max(0.0, state.time_s - prev.time_s) if prev is not None else 0.0
+    return tuple(
+        (a, before[a] + dt if prev is not None and a in prev.pressed and a in before else 0.0)
+        for a in sorted(pressed, key=lambda a: a.value)
+    )
+
+
+def neutral(profile: Profile, state: JoyState) -> StickCommand:
+    up = None if profile.axis("up") is None else 0.0
+    return StickCommand(up=up, connected=state.connected, time_s=state.time_s,
+                        deadman_ok=None if Action.DEADMAN not in profile.buttons else False)
+
+
+def map_state(profile: Profile, state: JoyState, prev: StickCommand | None = None) -> StickCommand:
+    """One raw JoyState -> StickCommand in the flying convention (see the module docstring)."""
+    if not state.connected:
+        return neutral(profile, state)
+    pressed = pressed_actions(profile, state)
+    deadman_ok = None if Action.DEADMAN not in profile.buttons else Action.DEADMAN in pressed
+    held = _held(pressed, state, prev)
+    if deadman_ok is False:
+        cmd = neutral(profile, state)
+        return StickCommand(up=cmd.up, throttle_abs=_throttle_abs(profile, state), pressed=pressed, held_s=held,
+                            deadman_ok=False, time_s=state.time_s)
+    return StickCommand(
+        forward=_stick(profile, state, "forward") or 0.0,
+        right=_stick(profile, state, "right") or 0.0,
+        up=_stick(profile, state, "up"),
+        yaw=_stick(profile, state, "yaw") or 0.0,
+        throttle_abs=_throttle_abs(profile, state),
+        pressed=pressed,
+        held_s=held,
+        deadman_ok=deadman_ok,
+        connected=True,
+        time_s=state.time_s,
+    )
+
+
+def held_for(cmd: StickCommand, action: Action) -> float | None:
+    """Seconds the action's button has been held, or None when it is not pressed."""
+    return dict(cmd.held_s).get(action)
+
+
+def fired(prev: StickCommand | None, cur: StickCommand, arm_hold_s: float = 1.0) -> frozenset[Action]:
+    """Actions to perform now: ARM once when its hold reaches arm_hold_s; the others on the press edge.
+
+    DEADMAN never fires (read cur.deadman_ok). With prev None (the first state) nothing fires on a press edge, so a
+    button already down when the program starts does nothing until pressed again; ARM still counts its hold.
+    """
+    out: set[Action] = set()
+    for action in cur.pressed:
+        if action is Action.DEADMAN:
+            continue
+        was_pressed = prev is not None and action in prev.pressed
+        if action is Action.ARM:
+            now_s = held_for(cur, action) or 0.0
+            before_s = (held_for(prev, action) or 0.0) if prev is not None and was_pressed else -1.0
+            if before_s < arm_hold_s <= now_s or (arm_hold_s <= 0.0 and not was_pressed and prev is not None):
+                out.add(action)
+        elif prev is not None and not was_pressed:
+            out.add(action)
+    return frozenset(out)
+
+
+class StickMapper:
+    """Keeps the previous command so you can feed states one by one: `cmd, actions = mapper.update(state)`."""
+
+    def __init__(self, profile: Profile) -> None:
+        self.profile = profile
+        self.prev: StickCommand | None = None
+
+    def update(self, state: JoyState) -> tuple[StickCommand, frozenset[Action]]:
+        cmd = map_state(self.profile, state, self.prev)
+        actions = fired(self.prev, cmd, self.profile.arm_hold_s)
+        self.prev = cmd
+        return cmd, actions

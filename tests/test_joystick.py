@@ -1,0 +1,196 @@
+"""The js API reader: event parsing, FIFO and file sources, a pty standing in for a device, errors."""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import tty
+
+import pytest
+
+from joyfly import joystick
+from joyfly.joystick import (
+    EVENT_SIZE,
+    JS_EVENT_AXIS,
+    JS_EVENT_BUTTON,
+    JS_EVENT_INIT,
+    JoystickError,
+    JsDevice,
+    list_devices,
+    open_joystick,
+    pack_event,
+    parse_events,
+)
+
+
+class FakeClock:
+    def __init__(self) -> None:
+        self.t_s = 100.0
+
+    def now(self) -> float:
+        return self.t_s
+
+    def sleep(self, seconds: float) -> None:
+        self.t_s += max(0.0, seconds)
+
+
+def init_burst(axes: list[int], buttons: list[int]) -> bytes:
+    """What the kernel sends on open: buttons first, then axes, all flagged JS_EVENT_INIT."""
+    out = [pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, i, v) for i, v in enumerate(buttons)]
+    out += [pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, i, v) for i, v in enumerate(axes)]
+    return b"".join(out)
+
+
+def test_event_record_is_8_bytes_and_round_trips():
+    data = pack_event(JS_EVENT_AXIS, 4, -32767, time_ms=123456) + pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, 7, 1)
+    assert EVENT_SIZE == 8 and len(data) == 16
+    events, rest = parse_events(data + b"\x01\x02\x03")
+    assert rest == b"\x01\x02\x03"
+    assert (events[0].time_ms, events[0].value, events[0].number, events[0].is_init) == (123456, -32767, 4, False)
+    assert (events[1].type & ~JS_EVENT_INIT, events[1].number, events[1].value, events[1].is_init) == (1, 7, 1, True)
+
+
+def test_fifo_without_writer_opens_at_once_then_reads_events_and_loses_the_writer(tmp_path):
+    path = str(tmp_path / "js-fifo")
+    os.mkfifo(path)
+    clock = FakeClock()
+    src = open_joystick(path, clock)  # must not block although nobody writes yet
+    assert src.name == path and src.path == path
+    assert src.poll(0.0).connected is False  # nothing attached yet
+
+    writer = os.open(path, os.O_WRONLY)
+    os.write(writer, init_burst([0, 0, -32767, 0, 0, -32767], [0] * 11))
+    state = src.poll(0.5)
+    assert state.connected is True
+    assert state.axes == (0, 0, -32767, 0, 0, -32767)  # counts grew with the events
+    assert len(state.buttons) == 11
+
+    os.write(writer, pack_event(JS_EVENT_AXIS, 4, -32767) + pack_event(JS_EVENT_BUTTON, 7, 1))
+    state = src.poll(0.5)
+    assert state.axes[4] == -32767 and state.buttons[7] == 1
+    assert state.time_s == clock.now()
+
+    os.close(writer)
+    state = src.poll(0.5)
+    assert state.connected is False
+    assert "vanished" in str(src.last_error)
+
+    writer = os.open(path, os.O_WRONLY)  # a new writer is picked up again
+    os.write(writer, init_burst([1000], [1]))
+    state = src.poll(0.5)
+    assert state.connected is True and state.axes == (1000,) and state.buttons == (1,)
+    os.close(writer)
+    src.close()
+
+
+def test_fifo_split_record_is_joined(tmp_path):
+    path = str(tmp_path / "js-fifo")
+    os.mkfifo(path)
+    src = open_joystick(path, FakeClock())
+    writer = os.open(path, os.O_WRONLY)
+    record = pack_event(JS_EVENT_AXIS, 1, 12345)
+    os.write(writer, record[:3])
+    src.poll(0.2)
+    os.write(writer, record[3:])
+    assert src.poll(0.2).axes == (0, 12345)
+    os.close(writer)
+    src.close()
+
+
+def test_regular_file_is_read_and_followed(tmp_path):
+    path = tmp_path / "events.bin"
+    path.write_bytes(init_burst([0, 0], [0, 0]) + pack_event(JS_EVENT_AXIS, 1, -20000))
+    clock = FakeClock()
+    src = open_joystick(str(path), clock)
+    state = src.poll(0.1)
+    assert state.axes == (0, -20000) and state.connected
+    with path.open("ab") as fh:
+        fh.write(pack_event(JS_EVENT_BUTTON, 3, 1))
+    state = src.poll(0.1)
+    assert state.buttons == (0, 0, 0, 1) and state.connected
+    before = clock.now()
+    src.poll(0.25)  # nothing new: waits the timeout (on the injected clock), still connected
+    assert clock.now() - before == pytest.approx(0.25)
+    src.close()
+
+
+@pytest.fixture
+def pty_device():
+    """A pty slave is a character device: it stands in for /dev/input/jsN (the js ioctls fail on it)."""
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    path = os.ttyname(slave)
+    yield master, path
+    os.close(slave)
+    with contextlib.suppress(OSError):
+        os.close(master)
+
+
+def test_character_device_without_js_ioctls_falls_back_to_path_name(pty_device):
+    master, path = pty_device
+    src = JsDevice(path, FakeClock())
+    assert src.kind == "device" and src.name == path and src.connected
+    os.write(master, init_burst([0, 0, 0], [0, 0]) + pack_event(JS_EVENT_AXIS, 2, 32767))
+    assert src.poll(0.5).axes == (0, 0, 32767)
+    src.close()
+
+
+def test_device_read_error_disconnects_then_reopens(pty_device, monkeypatch):
+    master, path = pty_device
+    clock = FakeClock()
+    src = JsDevice(path, clock)
+    os.write(master, init_burst([5], [1]))
+    assert src.poll(0.5).axes == (5,)
+
+    real_read = os.read
+
+    def unplugged(fd, n):
+        raise OSError(errno.ENODEV, "No such device")
+
+    monkeypatch.setattr(joystick.os, "read", unplugged)
+    os.write(master, pack_event(JS_EVENT_AXIS, 0, 7))
+    state = src.poll(0.5)
+    assert state.connected is False
+    assert str(src.last_error).startswith(f"The joystick {path} vanished")
+
+    monkeypatch.setattr(joystick.os, "read", real_read)
+    state = src.poll(0.1)  # retries at most every 0.5 s
+    assert state.connected is False
+    clock.sleep(0.5)
+    state = src.poll(0.1)
+    assert state.connected is True
+    assert src.last_error is None
+    src.close()
+
+
+def test_missing_device_names_the_others_or_says_none(tmp_path):
+    with pytest.raises(JoystickError) as info:
+        open_joystick(str(tmp_path / "js0"), FakeClock(), dev_dir=str(tmp_path))
+    assert "none is connected" in str(info.value) and "script:" in str(info.value)
+
+    os.mkfifo(tmp_path / "js1")
+    with pytest.raises(JoystickError) as info:
+        open_joystick(str(tmp_path / "js0"), FakeClock(), dev_dir=str(tmp_path))
+    assert str(tmp_path / "js1") in str(info.value)
+    assert str(info.value).count(".") >= 1 and "\n" not in str(info.value)
+
+
+def test_permission_denied_says_how_to_fix(tmp_path, monkeypatch):
+    def denied(path, flags):
+        raise PermissionError(errno.EACCES, "Permission denied")
+
+    monkeypatch.setattr(joystick.os, "open", denied)
+    with pytest.raises(JoystickError) as info:
+        open_joystick("/dev/input/js0", FakeClock())
+    message = str(info.value)
+    assert "sudo chmod a+rw /dev/input/js0" in message and "input group" in message and "udev" in message
+
+
+def test_list_devices_reports_each_node(tmp_path):
+    os.mkfifo(tmp_path / "js0")
+    os.mkfifo(tmp_path / "js10")
+    os.mkfifo(tmp_path / "js2")
+    found = list_devices(str(tmp_path))
+    assert [d.path for d in found] == [str(tmp_path / n) for n in ("js0", "js2", "js10")]
+    assert all(d.kind == "fifo" and d.axes == 0 for d in found)
