@@ -1,0 +1,168 @@
+"""`sitl-emu serve`: a PX4-protocol quadrotor on UDP, as PX4 SITL opens its links.
+
+The CLI only parses options, builds the Vehicle and its node, prints one line and hands over to a runner.
+Errors a user can cause (port in use, bad --param, bad --home) end in one sentence and exit status 2.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import sys
+import time
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+import click
+
+from sitl_emu.mavlink.link import PortInUseError
+from sitl_emu.runner import RealTimeRunner
+from sitl_emu.server import LinkSettings, VehicleNode
+
+log = logging.getLogger(__name__)
+
+
+class UsageProblem(Exception):
+    """A user mistake; str(err) is one sentence."""
+
+
+def parse_address(text: str, what: str) -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise UsageProblem(f"{what} must look like HOST:PORT (for example 127.0.0.1:14540), not '{text}'.")
+    return host, int(port)
+
+
+def parse_home(text: str) -> tuple[float, float, float]:
+    try:
+        lat, lon, alt = (float(p) for p in text.split(","))
+    except ValueError:
+        raise UsageProblem(f"--home must be LAT,LON,ALT in degrees and metres AMSL, not '{text}'.") from None
+    if not (-90 <= lat <= 90 and -180 <= lon <= 180 and -500 <= alt <= 9000):
+        raise UsageProblem(f"--home {text} is out of range (latitude ±90, longitude ±180, altitude -500..9000 m).")
+    return lat, lon, alt
+
+
+def read_params_file(path: Path) -> list[tuple[str, str]]:
+    """Lines `NAME VALUE`, or QGC .params lines `SYSID COMPID NAME VALUE TYPE`; '#' starts a comment."""
+    try:
+        lines = path.read_text().splitlines()
+    except OSError as err:
+        raise UsageProblem(f"Cannot read the parameter file {path}: {err.strerror}.") from None
+    pairs: list[tuple[str, str]] = []
+    for n, raw in enumerate(lines, 1):
+        parts = raw.split("#", 1)[0].split()
+        if not parts:
+            continue
+        if len(parts) >= 4 and parts[0].isdigit() and parts[1].isdigit():
+            pairs.append((parts[2], parts[3]))
+        elif len(parts) == 2:
+            pairs.append((parts[0], parts[1]))
+        else:
+            raise UsageProblem(f"{path}:{n}: expected 'NAME VALUE' or a QGC .params line, not '{raw.strip()}'.")
+    return pairs
+
+
+def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
+    from sitl_emu.params import ParamError, default_registry
+
+    registry = default_registry()
+    pairs = read_params_file(params_file) if params_file is not None else []
+    for item in assignments:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise UsageProblem(f"--param must look like NAME=VALUE (for example MIS_TAKEOFF_ALT=5), not '{item}'.")
+        pairs.append((name.strip(), value.strip()))
+    for name, value in pairs:
+        try:
+            registry.set(name, float(value))
+        except ValueError as err:
+            if isinstance(err, ParamError):
+                raise UsageProblem(str(err)) from None
+            raise UsageProblem(f"Parameter {name} needs a number, not '{value}'.") from None
+    return registry
+
+
+def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int) -> Any:
+    from sitl_emu.vehicle import Vehicle
+
+    kwargs: dict[str, Any] = {"params": params, "seed": seed, "sysid": sysid}
+    if home is not None:
+        kwargs["home"] = home
+    return Vehicle(**kwargs)
+
+
+def start_console(vehicle: Any, runner: RealTimeRunner, enabled: bool) -> None:
+    if not enabled or not sys.stdin.isatty():
+        return
+    try:
+        from sitl_emu.console import Console
+    except ImportError:
+        log.info("no console module; running headless")
+        return
+    console = Console(vehicle, runner.stop)
+    console.start()
+    runner.hooks.append(console.pump)
+
+
+@click.group()
+@click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
+def main(verbose: int) -> None:
+    """A PX4-protocol quadrotor emulator speaking MAVLink over UDP."""
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+
+
+@main.command()
+@click.option("--port", type=int, default=14557, show_default=True, help="API (onboard) link listen port.")
+@click.option("--remote", default="127.0.0.1:14540", show_default=True, help="API link initial destination.")
+@click.option("--gcs-port", type=int, default=18570, show_default=True, help="GCS link listen port.")
+@click.option("--gcs-remote", default="127.0.0.1:14550", show_default=True, help="GCS link initial destination.")
+@click.option("--bind", "bind_host", default="127.0.0.1", show_default=True, help="Address to listen on.")
+@click.option("--instance", type=click.IntRange(0, 250), default=0, show_default=True,
+              help="Vehicle instance N: sysid N+1 and every port offset by N, as PX4's -i.")
+@click.option("--speed", type=click.FloatRange(min=0.01, max=1000), default=1.0, show_default=True,
+              help="Simulation speed factor.")
+@click.option("--home", default=None, help="Home as LAT,LON,ALT (deg, deg, m AMSL).")
+@click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
+@click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
+              help="Parameter file: lines 'NAME VALUE' or QGC .params format.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed for sensor noise.")
+@click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
+def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
+          home: str | None, assignments: tuple[str, ...], params_file: Path | None, seed: int,
+          no_console: bool) -> None:
+    """Run one emulated PX4 quadrotor with its API and GCS MAVLink links."""
+    try:
+        settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
+                                parse_address(gcs_remote, "--gcs-remote")).for_instance(instance)
+        params = build_params(params_file, assignments)
+        vehicle = build_vehicle(params, parse_home(home) if home else None, seed, instance + 1)
+        node = VehicleNode(vehicle, settings, epoch_unix_us=int(time.time() * 1e6))
+    except (UsageProblem, PortInUseError) as err:
+        click.echo(f"sitl-emu: {err}", err=True)
+        sys.exit(2)
+    runner = RealTimeRunner([node], speed=speed)
+    click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
+    sys.stdout.flush()
+    start_console(vehicle, runner, not no_console)
+    _run_until_signalled(runner)
+    node.close()
+
+
+def _run_until_signalled(runner: RealTimeRunner) -> None:
+    def on_term(signum: int, frame: FrameType | None) -> None:
+        runner.stop()
+
+    previous = signal.signal(signal.SIGTERM, on_term)
+    try:
+        runner.run()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+if __name__ == "__main__":
+    main()

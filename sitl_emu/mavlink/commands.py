@@ -1,0 +1,103 @@
+"""Commands the mavlink module answers itself; everything else goes to the vehicle (commander, navigator...).
+
+Sources: src/modules/mavlink/mavlink_receiver.cpp handle_message_command_both (~l.800-930), set_message_interval,
+get_message_interval; reference 3.9-3.12. PX4 <= v1.17 still answers the legacy REQUEST_AUTOPILOT_CAPABILITIES (520),
+REQUEST_PROTOCOL_VERSION (519) and GET_HOME_POSITION (410) as aliases of REQUEST_MESSAGE; main removed them.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from sitl_emu.px4 import MavResult
+from sitl_emu.types import VehicleCommand
+
+CMD_GET_HOME_POSITION = 410
+CMD_GET_MESSAGE_INTERVAL = 510
+CMD_SET_MESSAGE_INTERVAL = 511
+CMD_REQUEST_MESSAGE = 512
+CMD_REQUEST_PROTOCOL_VERSION = 519
+CMD_REQUEST_AUTOPILOT_CAPABILITIES = 520
+
+MSG_HOME_POSITION = 242
+MSG_MESSAGE_INTERVAL = 244
+MSG_AUTOPILOT_VERSION = 148
+MSG_PROTOCOL_VERSION = 300
+
+# legacy request commands -> the message they ask for (PX4@2024 mavlink_receiver.cpp)
+LEGACY_REQUESTS = {
+    CMD_REQUEST_AUTOPILOT_CAPABILITIES: MSG_AUTOPILOT_VERSION,
+    CMD_REQUEST_PROTOCOL_VERSION: MSG_PROTOCOL_VERSION,
+    CMD_GET_HOME_POSITION: MSG_HOME_POSITION,
+}
+# commands accepted whatever their target_component (PX4@2024 evaluate_target_ok)
+ANY_COMPONENT = frozenset({CMD_REQUEST_AUTOPILOT_CAPABILITIES, CMD_REQUEST_PROTOCOL_VERSION})
+MAVLINK_MODULE_COMMANDS = frozenset({CMD_GET_MESSAGE_INTERVAL, CMD_SET_MESSAGE_INTERVAL, CMD_REQUEST_MESSAGE,
+                                     *LEGACY_REQUESTS})
+
+
+class CommandHandler:
+    """Runs one command on behalf of a link; returns the MAV_RESULT to ACK, or None when the vehicle answers."""
+
+    def execute(self, cmd: VehicleCommand, ctx: Any) -> int | None:
+        """Mavlink-module commands are answered here (ACK on this link); the rest go to the vehicle."""
+        if cmd.command in MAVLINK_MODULE_COMMANDS:
+            result = self._mavlink_command(cmd, ctx)
+            ctx.send(ctx.mav.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
+            return result
+        ack = ctx.vehicle.handle_command(cmd)
+        ctx.node.invalidate_snapshot()
+        if ack is None:
+            return None
+        ctx.node.route_ack(ack.command, int(ack.result), cmd.source_system, cmd.source_component)
+        return int(ack.result)
+
+    def _mavlink_command(self, cmd: VehicleCommand, ctx: Any) -> int:
+        if cmd.command == CMD_SET_MESSAGE_INTERVAL:
+            return self._set_interval(cmd, ctx)
+        if cmd.command == CMD_GET_MESSAGE_INTERVAL:
+            return self._get_interval(_msg_id(cmd.param(1)), ctx)
+        if cmd.command == CMD_REQUEST_MESSAGE:
+            msg_id = _msg_id(cmd.param(1))
+            if msg_id == MSG_MESSAGE_INTERVAL:
+                return self._get_interval(_msg_id(cmd.param(2)), ctx)
+            return self._request(msg_id, ctx)
+        return self._request(LEGACY_REQUESTS[cmd.command], ctx)
+
+    @staticmethod
+    def _set_interval(cmd: VehicleCommand, ctx: Any) -> int:
+        # set_message_interval(): param3, param4 and param7 (response target) must be 0 or NaN
+        for i in (3, 4, 7):
+            p = cmd.param(i)
+            if math.isfinite(p) and int(p + 0.5) != 0:
+                return MavResult.FAILED
+        msg_id = _msg_id(cmd.param(1))
+        interval_us = cmd.param(2)
+        if msg_id is None or math.isnan(interval_us):
+            return MavResult.FAILED
+        return MavResult.ACCEPTED if ctx.streams.set_interval(msg_id, interval_us) else MavResult.FAILED
+
+    @staticmethod
+    def _get_interval(msg_id: int | None, ctx: Any) -> int:
+        if msg_id is None:
+            return MavResult.FAILED
+        ctx.send(ctx.mav.message_interval_encode(msg_id, ctx.streams.get_interval(msg_id)))
+        return MavResult.ACCEPTED
+
+    @staticmethod
+    def _request(msg_id: int | None, ctx: Any) -> int:
+        """REQUEST_MESSAGE: the message goes out on this link before the ACK; DENIED if no stream or no data."""
+        if msg_id is None:
+            return MavResult.DENIED
+        msg = ctx.streams.build(msg_id, ctx, ctx.node.snapshot())
+        if msg is None:
+            return MavResult.DENIED
+        ctx.send(msg)
+        return MavResult.ACCEPTED
+
+
+def _msg_id(value: float) -> int | None:
+    if not math.isfinite(value) or not 0 <= value <= 0xFFFFFF:
+        return None
+    return int(value)

@@ -1,0 +1,191 @@
+"""One MAVLink link of the vehicle (API/onboard or GCS/normal): parse, dispatch, stream. The LinkContext lives here.
+
+PX4 runs one `Mavlink` instance per link (src/modules/mavlink/mavlink_main.cpp), each with its own receiver, its own
+stream list and rates, its own sequence numbers and its own "GCS seen" bookkeeping; so does this class. It holds no
+clock: `poll(now_us)` and `emit(now_us, ...)` are given simulated time by the node.
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
+
+from pymavlink.dialects.v20 import development as dialect
+
+from sitl_emu.mavlink.commands import CommandHandler
+from sitl_emu.mavlink.link import UdpLink
+from sitl_emu.mavlink.receiver import Receiver
+from sitl_emu.mavlink.telemetry import StreamMode, Streams
+
+if TYPE_CHECKING:
+    from sitl_emu.types import VehicleEvent, VehicleSnapshot
+
+log = logging.getLogger(__name__)
+
+COMPID = 1  # MAV_COMP_ID default (mavlink_params.yaml)
+
+# Protocol handlers by other modules, one instance per link (sitl_emu/mavlink/context.py). Missing modules are skipped.
+HANDLER_CLASSES: tuple[tuple[str, str], ...] = (
+    ("sitl_emu.mavlink.params_protocol", "ParamProtocol"),
+    ("sitl_emu.mavlink.mission_protocol", "MissionProtocol"),
+    ("sitl_emu.mavlink.shell_bridge", "ShellBridge"),
+)
+
+
+def load_handler_classes(spec: Iterable[tuple[str, str]] = HANDLER_CLASSES) -> list[type]:
+    classes: list[type] = []
+    for module_name, class_name in spec:
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as err:
+            if err.name != module_name:
+                raise
+            log.debug("handler module %s not present", module_name)
+            continue
+        classes.append(getattr(module, class_name))
+    return classes
+
+
+class NodeServices(Protocol):
+    """What an endpoint needs from the node that owns it."""
+
+    vehicle: Any
+    sysid: int
+    epoch_unix_us: int
+
+    def broadcast(self, msg: Any) -> None: ...
+
+    def route_ack(self, command: int, result: int, target_system: int, target_component: int) -> None: ...
+
+    def snapshot(self) -> VehicleSnapshot: ...
+
+    def invalidate_snapshot(self) -> None: ...
+
+
+@dataclass(slots=True)
+class EndpointStats:
+    rx_messages: int = 0
+    rx_parse_errors: int = 0
+    rx_own_echo: int = 0
+    handler_errors: int = 0
+
+
+class _LinkWriter:
+    """pymavlink's MAVLink.send() writes to a file; this file is the UDP link."""
+
+    def __init__(self, link: UdpLink) -> None:
+        self._link = link
+
+    def write(self, buf: bytes | bytearray) -> None:
+        self._link.send(bytes(buf))
+
+
+class Endpoint:
+    """A link endpoint; also the LinkContext handed to protocol handlers."""
+
+    GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
+
+    def __init__(self, name: str, link: UdpLink, node: NodeServices, mode: StreamMode,
+                 handler_classes: Sequence[type] = ()) -> None:
+        self.link_name = name
+        self.link = link
+        self.node = node
+        self.sysid = node.sysid
+        self.compid = COMPID
+        self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
+        self._parser = _new_parser()
+        self.stats = EndpointStats()
+        self.streams = Streams(mode)
+        self.commands = CommandHandler()
+        self.receiver = Receiver()
+        self.seen_components: set[tuple[int, int]] = set()
+        self.last_gcs_heartbeat_us: int | None = None
+        self._now_us = 0
+        self._handlers = [cls() for cls in handler_classes]
+        self._routes: dict[str, list[Any]] = {}
+        for h in self._handlers:
+            for msg_type in h.MESSAGES:
+                self._routes.setdefault(msg_type, []).append(h)
+
+    # --- LinkContext ---------------------------------------------------------------------------------------------
+    @property
+    def vehicle(self) -> Any:
+        return self.node.vehicle
+
+    @property
+    def now_us(self) -> int:
+        return self._now_us
+
+    def send(self, msg: Any) -> None:
+        self.mav.send(msg)
+
+    def broadcast(self, msg: Any) -> None:
+        self.node.broadcast(msg)
+
+    # --- receive -------------------------------------------------------------------------------------------------
+    def poll(self, now_us: int, max_datagrams: int = 256) -> int:
+        """Read and handle what has arrived; returns the number of datagrams read."""
+        self._now_us = now_us
+        datagrams = self.link.receive(max_datagrams)
+        for data in datagrams:
+            for msg in self._parse(data):
+                self.dispatch(msg)
+        return len(datagrams)
+
+    def dispatch(self, msg: Any) -> None:
+        msg_type = msg.get_type()
+        if msg_type == "BAD_DATA":
+            self.stats.rx_parse_errors += 1
+            return
+        src = (msg.get_srcSystem(), msg.get_srcComponent())
+        if src == (self.sysid, self.compid):  # our own messages looped back (PX4 ignores these)
+            self.stats.rx_own_echo += 1
+            return
+        self.stats.rx_messages += 1
+        self.seen_components.add(src)
+        try:
+            self.receiver.handle(msg, self)
+            for handler in self._routes.get(msg_type, ()):
+                handler.handle(msg, self)
+        except Exception:  # a bad message must never stop the vehicle
+            self.stats.handler_errors += 1
+            log.exception("%s link: error handling %s", self.link_name, msg_type)
+
+    def gcs_connected(self) -> bool:
+        last = self.last_gcs_heartbeat_us
+        return last is not None and self._now_us - last <= self.GCS_TIMEOUT_US
+
+    def _parse(self, data: bytes) -> list[Any]:
+        try:
+            return self._parser.parse_buffer(data) or []
+        except Exception as err:  # pymavlink raises on some malformed input even in robust mode
+            self.stats.rx_parse_errors += 1
+            log.debug("%s link: parse error %s", self.link_name, err)
+            self._parser = _new_parser()
+            return []
+
+    # --- transmit ------------------------------------------------------------------------------------------------
+    def emit(self, now_us: int, snap: VehicleSnapshot, events: Sequence[VehicleEvent]) -> None:
+        """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream."""
+        self._now_us = now_us
+        self.streams.emit_due(self, snap)
+        if events and self.gcs_connected():
+            self.streams.send_statustexts(self, events)
+        for handler in self._handlers:
+            try:
+                handler.tick(self)
+            except Exception:
+                self.stats.handler_errors += 1
+                log.exception("%s link: error in %s.tick", self.link_name, type(handler).__name__)
+
+    def close(self) -> None:
+        self.link.close()
+
+
+def _new_parser() -> Any:
+    parser = dialect.MAVLink(None, srcSystem=0, srcComponent=0)
+    parser.robust_parsing = True
+    return parser

@@ -1,0 +1,163 @@
+"""Messages the mavlink receiver itself handles: commands, modes, offboard setpoints, heartbeat, ping, timesync.
+
+Sources: src/modules/mavlink/mavlink_receiver.cpp (handle_message_command_long/int/both ~l.493-930, set_mode ~l.1061,
+heartbeat, ping ~l.1912), mavlink_timesync.cpp; reference 1.8-1.10, 3.1, 3.4, 4.4, 4.7, 4.8.
+Routing rule (3.1): a command is ours iff target_system is 0 or our sysid and target_component is 0 or our compid;
+anything else is ignored without an ACK.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable
+from typing import Any
+
+from sitl_emu.mavlink import setpoints
+from sitl_emu.mavlink.commands import ANY_COMPONENT
+from sitl_emu.px4 import MavResult, Severity
+from sitl_emu.types import VehicleCommand
+
+log = logging.getLogger(__name__)
+
+MAV_TYPE_GCS = 6
+CMD_DO_SET_MODE = 176
+INT32_MAX_F = float(2**31)  # INT32_MAX as a float32 reads back as 2^31
+COMMAND_INT_NAN_XY = 0x7FF80000  # x == y == this: DENIED (reference 3.1)
+INT32_MAX = 2**31 - 1
+# MAV_CMDs whose COMMAND_INT x/y are a location (mavlink_receiver.cpp handle_message_command_int)
+LOCATION_COMMANDS = frozenset({21, 22, 23, 34, 35, 80, 84, 179, 189, 192, 195, 201, 30001, 43003, 611})
+LOCAL_FRAMES = frozenset({1, 4, 7, 8, 9, 12, 20, 21})
+ERROR_TEXT_INTERVAL_US = 1_000_000  # one copy of the same complaint per second, so a flood cannot flood the log
+
+
+class Receiver:
+    """One per link; `handle(msg, ctx)` for every message (it ignores types it does not know)."""
+
+    def __init__(self) -> None:
+        self._table: dict[str, Callable[[Any, Any], None]] = {
+            "HEARTBEAT": self._heartbeat,
+            "COMMAND_LONG": self._command_long,
+            "COMMAND_INT": self._command_int,
+            "SET_MODE": self._set_mode,
+            "SET_POSITION_TARGET_LOCAL_NED": self._local_ned,
+            "SET_POSITION_TARGET_GLOBAL_INT": self._global_int,
+            "SET_ATTITUDE_TARGET": self._attitude_target,
+            "PING": self._ping,
+            "TIMESYNC": self._timesync,
+        }
+        self._last_error_us: dict[str, int] = {}
+        self.setpoints_accepted = 0
+        self.setpoints_refused = 0
+
+    def handle(self, msg: Any, ctx: Any) -> None:
+        fn = self._table.get(msg.get_type())
+        if fn is not None:
+            fn(msg, ctx)
+
+    # --- bookkeeping -------------------------------------------------------------------------------------------
+    @staticmethod
+    def _heartbeat(msg: Any, ctx: Any) -> None:
+        if msg.type == MAV_TYPE_GCS and msg.get_srcSystem() != ctx.sysid:
+            ctx.last_gcs_heartbeat_us = ctx.now_us
+
+    @staticmethod
+    def _ping(msg: Any, ctx: Any) -> None:
+        """Echo pings addressed to everyone (target 0/0), back to the sender (reference 1.9)."""
+        if msg.target_system == 0 and msg.target_component == 0:
+            ctx.send(ctx.mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(), msg.get_srcComponent()))
+
+    @staticmethod
+    def _timesync(msg: Any, ctx: Any) -> None:
+        """mavlink_timesync.cpp: answer requests (tc1 == 0) with our boot time in ns."""
+        if msg.tc1 == 0:
+            ctx.send(ctx.mav.timesync_encode(ctx.now_us * 1000, msg.ts1))
+
+    # --- commands ----------------------------------------------------------------------------------------------
+    def _command_long(self, msg: Any, ctx: Any) -> None:
+        if not _targets_us(msg, ctx, any_component=msg.command in ANY_COMPONENT):
+            return
+        params = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
+        cmd = _command(msg, params)
+        if _is_int32_max(msg.param5) and _is_int32_max(msg.param6):
+            _ack_here(ctx, cmd, MavResult.DENIED)
+            return
+        ctx.commands.execute(cmd, ctx)
+
+    def _command_int(self, msg: Any, ctx: Any) -> None:
+        if not _targets_us(msg, ctx, any_component=msg.command in ANY_COMPONENT):
+            return
+        x, y = int(msg.x), int(msg.y)
+        if x == COMMAND_INT_NAN_XY and y == COMMAND_INT_NAN_XY:
+            _ack_here(ctx, _command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, 0.0, 0.0, msg.z)),
+                      MavResult.DENIED)
+            return
+        p5, p6 = _command_int_xy(msg.command, int(msg.frame), x, y)
+        ctx.commands.execute(_command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z)), ctx)
+
+    def _set_mode(self, msg: Any, ctx: Any) -> None:
+        """SET_MODE -> DO_SET_MODE(base_mode, main, sub); the ACK is for command 176 (reference 3.4)."""
+        if msg.target_system != ctx.sysid:  # commander only takes DO_SET_MODE meant exactly for this system
+            return
+        main, sub = (msg.custom_mode >> 16) & 0xFF, (msg.custom_mode >> 24) & 0xFF
+        cmd = VehicleCommand(CMD_DO_SET_MODE, (float(msg.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0),
+                             msg.get_srcSystem(), msg.get_srcComponent(), True)
+        ctx.commands.execute(cmd, ctx)
+
+    # --- offboard setpoints ------------------------------------------------------------------------------------
+    def _local_ned(self, msg: Any, ctx: Any) -> None:
+        if _targets_us(msg, ctx):
+            self._apply(setpoints.decode_local_ned(msg, ctx.node.snapshot()), ctx)
+
+    def _global_int(self, msg: Any, ctx: Any) -> None:
+        if _targets_us(msg, ctx):
+            self._apply(setpoints.decode_global_int(msg, ctx.node.snapshot()), ctx)
+
+    def _attitude_target(self, msg: Any, ctx: Any) -> None:
+        if _targets_us(msg, ctx):
+            self._apply(setpoints.decode_attitude_target(msg), ctx)
+
+    def _apply(self, decoded: setpoints.Decoded, ctx: Any) -> None:
+        if decoded.mode is None:
+            self.setpoints_refused += 1
+            if decoded.error is not None:
+                self._complain(decoded.error, ctx)
+            return
+        self.setpoints_accepted += 1
+        ctx.vehicle.offboard_input(decoded.mode, decoded.trajectory, decoded.attitude)
+        ctx.node.invalidate_snapshot()
+
+    def _complain(self, text: str, ctx: Any) -> None:
+        last = self._last_error_us.get(text)
+        if last is not None and ctx.now_us - last < ERROR_TEXT_INTERVAL_US:
+            return
+        self._last_error_us[text] = ctx.now_us
+        ctx.vehicle.report(Severity.CRITICAL, "mavlink", text, is_event=True)
+
+
+def _targets_us(msg: Any, ctx: Any, any_component: bool = False) -> bool:
+    ts, tc = msg.target_system, msg.target_component
+    return ts in (0, ctx.sysid) and (any_component or tc in (0, ctx.compid))
+
+
+def _command(msg: Any, params: tuple[float, ...]) -> VehicleCommand:
+    values = tuple(float(p) for p in params)
+    return VehicleCommand(int(msg.command), values, msg.get_srcSystem(), msg.get_srcComponent(), True)  # type: ignore
+
+
+def _ack_here(ctx: Any, cmd: VehicleCommand, result: int) -> None:
+    ctx.send(ctx.mav.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
+
+
+def _is_int32_max(value: float) -> bool:
+    return math.isfinite(value) and abs(value - INT32_MAX_F) < 1.0
+
+
+def _command_int_xy(command: int, frame: int, x: int, y: int) -> tuple[float, float]:
+    """COMMAND_INT x/y -> param5/6: INT32_MAX means NaN; locations are scaled by 1e4 (local) or 1e7 (global)."""
+    if x == INT32_MAX and y == INT32_MAX:
+        return math.nan, math.nan
+    if command not in LOCATION_COMMANDS:
+        return float(x), float(y)
+    scale = 1e4 if frame in LOCAL_FRAMES else 1e7
+    return x / scale, y / scale

@@ -1,0 +1,153 @@
+"""Telemetry streams per link: which messages, at which rates, scheduled on simulated time.
+
+Default sets from PX4's configure_streams_to_default() (src/modules/mavlink/mavlink_main.cpp, reference 1.5/1.6),
+restricted to messages whose data we have, plus the SITL GCS-link overrides of ROMFS/px4fmu_common/init.d-posix/
+px4-rc.mavlink (50 Hz position/attitude). HEARTBEAT is always 1 Hz and cannot be changed (mavlink_main.cpp ~l.2547).
+A stream whose builder returns None (no data, e.g. HOME_POSITION before home is set) sends nothing.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from typing import Any
+
+from sitl_emu.mavlink import telemetry_msgs as tm
+from sitl_emu.mavlink.version import autopilot_version, protocol_version
+from sitl_emu.types import VehicleEvent, VehicleSnapshot
+
+HEARTBEAT_ID = 0
+HEARTBEAT_INTERVAL_US = 1_000_000
+STATUSTEXT_MAX_AGE_US = 5_000_000  # STATUSTEXT.hpp: don't send stale messages
+STATUSTEXT_CHUNK = 50
+
+
+class StreamMode(enum.Enum):
+    ONBOARD = "onboard"
+    NORMAL = "normal"
+
+
+# message id -> builder (streamable messages)
+BUILDERS: dict[int, tm.Builder] = {
+    0: tm.heartbeat,
+    1: tm.sys_status,
+    2: tm.system_time,
+    24: tm.gps_raw_int,
+    30: tm.attitude,
+    31: tm.attitude_quaternion,
+    32: tm.local_position_ned,
+    33: tm.global_position_int,
+    74: tm.vfr_hud,
+    83: tm.attitude_target,
+    85: tm.position_target_local_ned,
+    111: tm.timesync,
+    141: tm.altitude,
+    147: tm.battery_status,
+    242: tm.home_position,
+    245: tm.extended_sys_state,
+    331: tm.odometry,
+    436: tm.current_mode,
+}
+# messages PX4 sends only on request (REQUEST_MESSAGE), not as periodic streams
+ON_REQUEST: dict[int, tm.Builder] = {
+    148: lambda ctx, snap: autopilot_version(ctx.mav, ctx.sysid),
+    300: lambda ctx, snap: protocol_version(ctx.mav),
+}
+
+# Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
+ONBOARD_RATES_HZ: dict[int, float] = {
+    111: 10, 32: 30, 30: 100, 141: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5, 245: 5, 33: 50, 24: 8,
+    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10,
+}
+# MAVLINK_MODE_NORMAL with the SITL GCS-link overrides (px4-rc.mavlink: 50 Hz for position/attitude streams)
+NORMAL_RATES_HZ: dict[int, float] = {
+    141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 245: 1, 33: 50, 24: 5, 242: 0.5, 32: 50, 85: 50, 1: 1,
+    74: 4,
+}
+
+
+def _interval_us(hz: float) -> int:
+    return round(1e6 / hz)
+
+
+class Streams:
+    """One link's stream table: interval per message id (None = off) and the next due time, in simulated µs."""
+
+    def __init__(self, mode: StreamMode) -> None:
+        self.mode = mode
+        rates = ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else NORMAL_RATES_HZ
+        self._default_us: dict[int, int] = {mid: _interval_us(hz) for mid, hz in rates.items()}
+        self._interval_us: dict[int, int] = dict(self._default_us)
+        self._next_us: dict[int, int] = {}
+        self._next_heartbeat_us = 0
+        self._statustext_id = 0
+
+    # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
+    def known(self, msg_id: int) -> bool:
+        return msg_id in BUILDERS
+
+    def set_interval(self, msg_id: int, interval_us: float) -> bool:
+        """mavlink_receiver.cpp set_message_interval: <0 stop, 0 default rate, >0 that interval. False: no stream."""
+        if msg_id == HEARTBEAT_ID or msg_id not in BUILDERS:
+            return False
+        if interval_us < 0:
+            self._interval_us.pop(msg_id, None)
+        elif interval_us == 0:
+            if msg_id in self._default_us:
+                self._interval_us[msg_id] = self._default_us[msg_id]
+            else:
+                self._interval_us.pop(msg_id, None)
+        else:
+            self._interval_us[msg_id] = max(int(interval_us), 1)
+        self._next_us.pop(msg_id, None)
+        return True
+
+    def get_interval(self, msg_id: int) -> int:
+        """Current interval in µs; -1 if not streaming (MESSAGE_INTERVAL semantics)."""
+        if msg_id == HEARTBEAT_ID:
+            return HEARTBEAT_INTERVAL_US
+        return self._interval_us.get(msg_id, -1)
+
+    # --- sending -----------------------------------------------------------------------------------------------
+    def build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
+        """The message now, for REQUEST_MESSAGE; None if we have no such message or no data for it."""
+        builder = BUILDERS.get(msg_id) or ON_REQUEST.get(msg_id)
+        return builder(ctx, snap) if builder is not None else None
+
+    def emit_due(self, ctx: Any, snap: VehicleSnapshot) -> int:
+        now = ctx.now_us
+        sent = 0
+        if now >= self._next_heartbeat_us:
+            ctx.send(tm.heartbeat(ctx, snap))
+            sent += 1
+            self._next_heartbeat_us = _next_due(self._next_heartbeat_us, HEARTBEAT_INTERVAL_US, now)
+        for msg_id, interval in self._interval_us.items():
+            due = self._next_us.get(msg_id, now)
+            if now < due:
+                continue
+            self._next_us[msg_id] = _next_due(due, interval, now)
+            msg = BUILDERS[msg_id](ctx, snap)
+            if msg is not None:
+                ctx.send(msg)
+                sent += 1
+        return sent
+
+    def send_statustexts(self, ctx: Any, events: Sequence[VehicleEvent]) -> None:
+        """STATUSTEXT.hpp: one id per message, chunks of 50 chars with chunk_seq, nothing older than 5 s."""
+        for ev in events:
+            if not ev.statustext or ctx.now_us - ev.time_us > STATUSTEXT_MAX_AGE_US:
+                continue
+            for chunk_seq, chunk in enumerate(statustext_chunks(ev.statustext_text)):
+                ctx.send(ctx.mav.statustext_encode(int(ev.severity), chunk, self._statustext_id, chunk_seq))
+            self._statustext_id = (self._statustext_id + 1) & 0xFFFF
+
+
+def statustext_chunks(text: str) -> list[bytes]:
+    data = text.encode("utf-8", errors="replace")[:127]  # mavlink_log text is 127 chars + NUL
+    chunks = [data[i:i + STATUSTEXT_CHUNK] for i in range(0, len(data), STATUSTEXT_CHUNK)]
+    return chunks or [b""]
+
+
+def _next_due(due: int, interval: int, now: int) -> int:
+    nxt = due + interval
+    return nxt if nxt > now else now + interval

@@ -1,0 +1,264 @@
+"""Telemetry message builders: VehicleSnapshot -> one MAVLink message, or None when PX4 would have no data to send.
+
+Each builder follows the PX4 stream of the same name (src/modules/mavlink/streams/<NAME>.hpp); the fields we do not
+simulate carry the value PX4 uses for "unknown" (NaN, -1, UINT16_MAX...).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from sitl_emu import px4
+from sitl_emu.px4 import MavState, NavState
+from sitl_emu.types import VehicleSnapshot
+
+NAN = math.nan
+UINT16_MAX = 0xFFFF
+INT16_MAX = 0x7FFF
+
+MAV_TYPE_QUADROTOR = 2
+MAV_AUTOPILOT_PX4 = 12
+MAV_FRAME_LOCAL_NED = 1
+MAV_FRAME_BODY_FRD = 12
+
+# MAV_SYS_STATUS_SENSOR bits (common.xml)
+S_GYRO, S_ACCEL, S_MAG, S_ABS_PRESSURE, S_GPS = 0x01, 0x02, 0x04, 0x08, 0x20
+S_ATTITUDE_STAB, S_XY_POSITION, S_MOTOR_OUTPUTS, S_RC = 0x800, 0x4000, 0x8000, 0x10000
+S_AHRS, S_BATTERY, S_PREARM_CHECK = 0x200000, 0x2000000, 0x10000000
+_PRESENT = (S_GYRO | S_ACCEL | S_MAG | S_ABS_PRESSURE | S_GPS | S_ATTITUDE_STAB | S_XY_POSITION | S_MOTOR_OUTPUTS
+            | S_AHRS | S_BATTERY)
+_POSITION_BITS = S_GPS | S_XY_POSITION | S_AHRS
+
+# Modes whose control mode has flag_control_manual_enabled and attitude (ModeUtil/control_mode.cpp).
+_MANUAL_STABILIZED = frozenset({NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
+                                NavState.ALTITUDE_CRUISE, NavState.STAB})
+
+Builder = Callable[[Any, VehicleSnapshot], Any]
+
+
+def base_mode(snap: VehicleSnapshot) -> int:
+    """HEARTBEAT.base_mode as streams/HEARTBEAT.hpp builds it from the control-mode flags (reference 2.2)."""
+    nav = snap.nav_state
+    flags = px4.MODE_FLAG_CUSTOM_MODE_ENABLED
+    if nav in _MANUAL_STABILIZED:
+        flags |= px4.MODE_FLAG_MANUAL_INPUT_ENABLED | px4.MODE_FLAG_STABILIZE_ENABLED
+    elif nav == NavState.ACRO:
+        flags |= px4.MODE_FLAG_MANUAL_INPUT_ENABLED
+    elif nav in px4.AUTO_MODES:
+        flags |= px4.MODE_FLAG_AUTO_ENABLED | px4.MODE_FLAG_GUIDED_ENABLED | px4.MODE_FLAG_STABILIZE_ENABLED
+    elif nav == NavState.OFFBOARD:
+        ocm = snap.offboard_control
+        if ocm is not None and (ocm.position or ocm.velocity or ocm.acceleration or ocm.attitude):
+            flags |= px4.MODE_FLAG_STABILIZE_ENABLED
+    elif nav == NavState.ORBIT:
+        flags |= px4.MODE_FLAG_STABILIZE_ENABLED
+    if snap.armed:
+        flags |= px4.MODE_FLAG_SAFETY_ARMED
+    return flags
+
+
+def system_status(snap: VehicleSnapshot) -> int:
+    """HEARTBEAT.system_status (reference 2.4)."""
+    if snap.nav_state == NavState.TERMINATION:
+        return MavState.FLIGHT_TERMINATION
+    if snap.armed:
+        return MavState.CRITICAL if snap.failsafe else MavState.ACTIVE
+    return MavState.STANDBY if snap.pre_flight_checks_pass else MavState.UNINIT
+
+
+def heartbeat(ctx: Any, snap: VehicleSnapshot) -> Any:
+    return ctx.mav.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
+                                    px4.custom_mode(snap.nav_state), system_status(snap), 3)
+
+
+def sys_status(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/SYS_STATUS.hpp; MAVSDK reads health from these bits (reference 9a.5)."""
+    health = _PRESENT | S_RC
+    if not snap.position_valid:
+        health &= ~_POSITION_BITS
+    if snap.pre_flight_checks_pass:
+        health |= S_PREARM_CHECK
+    enabled = _PRESENT | (_PRESENT & ~health)
+    voltage_mv = int(min(max(snap.battery_voltage_v * 1000.0, 0.0), UINT16_MAX - 1))
+    remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
+    return ctx.mav.sys_status_encode(_PRESENT | S_PREARM_CHECK, enabled | S_PREARM_CHECK, health, 0, voltage_mv, -1,
+                                     remaining, 0, 0, 0, 0, 0, 0)
+
+
+def extended_sys_state(ctx: Any, snap: VehicleSnapshot) -> Any:
+    return ctx.mav.extended_sys_state_encode(0, int(snap.landed_state))
+
+
+def attitude(ctx: Any, snap: VehicleSnapshot) -> Any:
+    r, p, y = snap.euler_rad
+    wx, wy, wz = snap.rates_frd_rad_s
+    return ctx.mav.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
+
+
+def attitude_quaternion(ctx: Any, snap: VehicleSnapshot) -> Any:
+    w, x, y, z = snap.q_wxyz
+    wx, wy, wz = snap.rates_frd_rad_s
+    return ctx.mav.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
+
+
+def local_position_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
+    x, y, z = snap.pos_ned_m
+    vx, vy, vz = snap.vel_ned_m_s
+    return ctx.mav.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
+
+
+def global_position_int(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/GLOBAL_POSITION_INT.hpp: only with a global position; relative_alt against home (reference 9a.6)."""
+    if not snap.position_valid:
+        return None
+    vx, vy, vz = snap.vel_ned_m_s
+    rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else snap.alt_amsl_m
+    hdg_cdeg = _iround(math.degrees(_wrap_2pi(snap.euler_rad[2])) * 100.0) % 36000
+    return ctx.mav.global_position_int_encode(
+        _ms(snap), _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m), _mm(rel_m),
+        _cm_s(vx), _cm_s(vy), _cm_s(vz), hdg_cdeg)
+
+
+def position_target_local_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/POSITION_TARGET_LOCAL_NED.hpp: the controller's setpoint, a type_mask bit for every NaN (ref 4.9)."""
+    sp = snap.local_setpoint
+    if sp is None:
+        return None
+    values = (*sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2)
+    mask = 0
+    for bit, v in enumerate(values):
+        if not math.isfinite(v):
+            mask |= 1 << bit
+    if not math.isfinite(sp.yaw_rad):
+        mask |= 1024
+    if not math.isfinite(sp.yawspeed_rad_s):
+        mask |= 2048
+    return ctx.mav.position_target_local_ned_encode(_ms(snap), MAV_FRAME_LOCAL_NED, mask, *values, sp.yaw_rad,
+                                                    sp.yawspeed_rad_s)
+
+
+def attitude_target(ctx: Any, snap: VehicleSnapshot) -> Any:
+    q = snap.attitude_setpoint_q_wxyz
+    if q is None:
+        return None
+    wx, wy, wz = snap.rates_setpoint_rad_s
+    return ctx.mav.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
+
+
+def home_position(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/HOME_POSITION.hpp: only while home is valid."""
+    home = snap.home
+    if home is None:
+        return None
+    half = home.yaw_rad / 2.0 if math.isfinite(home.yaw_rad) else NAN
+    q = (math.cos(half), 0.0, 0.0, math.sin(half))
+    x, y, z = home.pos_ned_m
+    return ctx.mav.home_position_encode(_e7(home.lat_deg), _e7(home.lon_deg), _mm(home.alt_amsl_m), x, y, z, q,
+                                        0.0, 0.0, 0.0, snap.time_us)
+
+
+def gps_raw_int(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot."""
+    vn, ve, _ = snap.vel_ned_m_s
+    vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
+    cog = _iround(math.degrees(_wrap_2pi(math.atan2(ve, vn))) * 100.0) % 36000 if vel_cm_s > 0 else 0
+    return ctx.mav.gps_raw_int_encode(snap.time_us, 3, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
+                                      50, 80, vel_cm_s, cog, 10, _mm(snap.alt_amsl_m), 500, 800, 200, 0, 0)
+
+
+def battery_status(ctx: Any, snap: VehicleSnapshot) -> Any:
+    cells = 4  # BAT1_N_CELLS in SITL
+    cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
+    voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
+    remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
+    return ctx.mav.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, 1, [0, 0, 0, 0],
+                                         0, 0)
+
+
+def vfr_hud(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/VFR_HUD.hpp (reference 11.5)."""
+    vn, ve, vd = snap.vel_ned_m_s
+    heading_deg = int(math.degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
+    throttle = _iround(min(max(snap.thrust_setpoint, 0.0), 1.0) * 100.0) if snap.armed else 0
+    return ctx.mav.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
+
+
+def altitude(ctx: Any, snap: VehicleSnapshot) -> Any:
+    rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else NAN
+    local_m = -snap.pos_ned_m[2]
+    return ctx.mav.altitude_encode(snap.time_us, snap.alt_amsl_m, snap.alt_amsl_m, local_m, rel_m, NAN,
+                                   max(local_m, 0.0))
+
+
+def odometry(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
+    v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
+    cov = [NAN] + [0.0] * 20
+    return ctx.mav.odometry_encode(snap.time_us, MAV_FRAME_LOCAL_NED, MAV_FRAME_BODY_FRD, *snap.pos_ned_m,
+                                   snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
+
+
+def timesync(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/TIMESYNC.hpp: PX4's own sync request, tc1=0, ts1=boot time in ns."""
+    return ctx.mav.timesync_encode(0, snap.time_us * 1000)
+
+
+def system_time(ctx: Any, snap: VehicleSnapshot) -> Any:
+    return ctx.mav.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
+
+
+# CURRENT_MODE.standard_mode (src/lib/modes/standard_modes.hpp); everything else NON_STANDARD (0).
+_STANDARD_MODE = {NavState.POSCTL: 1, NavState.ORBIT: 2, NavState.ALTCTL: 4, NavState.AUTO_RTL: 5,
+                  NavState.AUTO_MISSION: 6, NavState.AUTO_LAND: 7, NavState.AUTO_TAKEOFF: 8}
+
+
+def current_mode(ctx: Any, snap: VehicleSnapshot) -> Any:
+    return ctx.mav.current_mode_encode(_STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
+                                       px4.custom_mode(snap.user_intended_nav_state))
+
+
+def rotate_ned_to_body(q_wxyz: tuple[float, float, float, float], v: tuple[float, float, float]
+                       ) -> tuple[float, float, float]:
+    """v expressed in the body frame: R(q)^T v, with q rotating body to NED."""
+    w, x, y, z = q_wxyz
+    return _rotate((w, -x, -y, -z), v)
+
+
+def rotate_body_to_ned(q_wxyz: tuple[float, float, float, float], v: tuple[float, float, float]
+                       ) -> tuple[float, float, float]:
+    return _rotate(q_wxyz, v)
+
+
+def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float]) -> tuple[float, float, float]:
+    w, x, y, z = q
+    vx, vy, vz = v
+    # t = 2 q_vec x v; v' = v + w t + q_vec x t
+    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx))
+
+
+def _iround(x: float) -> int:
+    """round() that never raises: non-finite values (a diverged estimate) become 0."""
+    return round(x) if math.isfinite(x) else 0
+
+
+def _ms(snap: VehicleSnapshot) -> int:
+    return (snap.time_us // 1000) & 0xFFFFFFFF
+
+
+def _e7(deg: float) -> int:
+    return _iround(deg * 1e7)
+
+
+def _mm(m: float) -> int:
+    return _iround(m * 1000.0)
+
+
+def _cm_s(m_s: float) -> int:
+    return max(min(_iround(m_s * 100.0), 32767), -32768)
+
+
+def _wrap_2pi(a: float) -> float:
+    return a % (2.0 * math.pi)

@@ -1,0 +1,120 @@
+"""A vehicle on the wire: one Vehicle and its two MAVLink links (API/onboard and GCS/normal), steppable by any runner.
+
+The node holds no clock and never sleeps. A runner advances the vehicle and calls `step_io(now_us)`, which reads
+what arrived (non-blocking, bounded) and sends what is due at `now_us` of simulated time.
+Ports follow PX4 SITL (ROMFS/px4fmu_common/init.d-posix/px4-rc.mavlink, reference 1.1): for instance i the API link
+listens on 14557+i (the project's default; PX4 today uses 14580+i) and sends to 14540+i, the GCS link listens on
+18570+i and sends to 14550 (not offset, so one QGC sees every vehicle).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
+from sitl_emu.mavlink.link import Address, UdpLink
+from sitl_emu.mavlink.telemetry import StreamMode
+from sitl_emu.types import VehicleSnapshot
+
+log = logging.getLogger(__name__)
+
+IO_BUDGET_DATAGRAMS = 200  # per link per step_io: a flood waits in the socket buffer instead of starving physics
+
+
+@dataclass(frozen=True, slots=True)
+class LinkSettings:
+    bind_host: str = "127.0.0.1"
+    api_port: int = 14557
+    api_remote: Address = ("127.0.0.1", 14540)
+    gcs_port: int = 18570
+    gcs_remote: Address = ("127.0.0.1", 14550)
+
+    def for_instance(self, instance: int) -> LinkSettings:
+        """Offset the ports as PX4's `-i N` does (px4-rc.mavlink); the GCS remote stays 14550."""
+        if instance == 0:
+            return self
+        api_remote_port = self.api_remote[1] + instance if instance <= 9 else 14549
+        return replace(self, api_port=self.api_port + instance, gcs_port=self.gcs_port + instance,
+                       api_remote=(self.api_remote[0], api_remote_port))
+
+
+
+class VehicleNode:
+    """A Vehicle plus its endpoints. `step_io(now_us)` is all a runner calls besides stepping the vehicle."""
+
+    def __init__(self, vehicle: Any, settings: LinkSettings = LinkSettings(), epoch_unix_us: int = 0,
+                 handler_classes: Sequence[type] | None = None) -> None:
+        self.vehicle = vehicle
+        self.settings = settings
+        self.epoch_unix_us = epoch_unix_us
+        classes = load_handler_classes() if handler_classes is None else list(handler_classes)
+        api_link = UdpLink(settings.bind_host, settings.api_port, settings.api_remote, "API")
+        try:
+            gcs_link = UdpLink(settings.bind_host, settings.gcs_port, settings.gcs_remote, "GCS")
+        except OSError:
+            api_link.close()
+            raise
+        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes)
+        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes)
+        self.endpoints: tuple[Endpoint, ...] = (self.api, self.gcs)
+        self._event_seq = -1
+        self._snapshot: VehicleSnapshot | None = None
+        self._snapshot_time_us = -1
+
+    @property
+    def sysid(self) -> int:
+        return int(self.vehicle.sysid)
+
+    def describe(self) -> str:
+        """Where each link listens and sends, e.g. for the CLI's one line."""
+        parts = []
+        for ep, label in ((self.api, "API"), (self.gcs, "GCS")):
+            (lh, lp), (rh, rp) = ep.link.local_address, ep.link.remote
+            parts.append(f"{label} listens on {lh}:{lp}, sends to {rh}:{rp}")
+        return "; ".join(parts)
+
+    def filenos(self) -> list[int]:
+        return [ep.link.fileno() for ep in self.endpoints]
+
+    # --- the one call a runner makes -----------------------------------------------------------------------------
+    def step_io(self, now_us: int) -> int:
+        """Handle what arrived, then send what is due at `now_us`. Returns the number of datagrams read."""
+        received = 0
+        for ep in self.endpoints:
+            received += ep.poll(now_us, IO_BUDGET_DATAGRAMS)
+        snap = self.snapshot()
+        events = self.vehicle.events_after(self._event_seq)
+        if events:
+            self._event_seq = events[-1].seq
+        for ep in self.endpoints:
+            ep.emit(now_us, snap, events)
+        return received
+
+    # --- services for the endpoints ------------------------------------------------------------------------------
+    def snapshot(self) -> VehicleSnapshot:
+        """The vehicle's snapshot, taken at most once per simulated instant unless an input changed it."""
+        t = self.vehicle.time_us
+        if self._snapshot is None or t != self._snapshot_time_us:
+            self._snapshot = self.vehicle.snapshot()
+            self._snapshot_time_us = t
+        return self._snapshot
+
+    def invalidate_snapshot(self) -> None:
+        self._snapshot = None
+
+    def broadcast(self, msg: Any) -> None:
+        for ep in self.endpoints:
+            ep.send(msg)
+
+    def route_ack(self, command: int, result: int, target_system: int, target_component: int) -> None:
+        """COMMAND_ACK on every link where the commanding component has been heard (mavlink_main.cpp ~l.2996)."""
+        for ep in self.endpoints:
+            if (target_system, target_component) in ep.seen_components:
+                ep.send(ep.mav.command_ack_encode(command, result, 0, 0, target_system, target_component))
+
+    def close(self) -> None:
+        for ep in self.endpoints:
+            ep.close()
