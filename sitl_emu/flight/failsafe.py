@@ -76,9 +76,10 @@ def resolve_fallback(user: NavState, s: FallbackSettings, can_run: Callable[[Nav
             return mode
         if mode in _MANUAL_CHAIN:
             idx = _MANUAL_CHAIN.index(mode)
-            mode = _MANUAL_CHAIN[idx + 1] if idx + 1 < len(_MANUAL_CHAIN) else _RCL_ACTIONS.get(s.rcl_act)
-            if mode in _MANUAL_CHAIN:
-                mode = NavState.AUTO_RTL
+            if idx + 1 < len(_MANUAL_CHAIN):
+                mode = _MANUAL_CHAIN[idx + 1]
+            else:  # manual control lost: the RC-loss action
+                mode = _RCL_ACTIONS.get(s.rcl_act, NavState.AUTO_RTL)
         elif mode in _AUTO_CHAIN:
             mode = _AUTO_CHAIN[_AUTO_CHAIN.index(mode) + 1]
         else:
