@@ -100,7 +100,7 @@ class Vehicle:
         out = self.parts.executor.update(c.nav_state, nav, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         armed = c.armed and c.nav_state != NavState.TERMINATION
-        motors = self.parts.control.update(self._estimate, out.trajectory, out.attitude, armed, c.landed, now, dt_s)
+        motors = self.parts.control_update(self._estimate, out, armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
         self._estimate = self._estimate_from(self._state)
         landed, maybe_landed = self.parts.land(self._estimate, c, out.setpoint_type, now)

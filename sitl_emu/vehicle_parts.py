@@ -29,6 +29,7 @@ class _NullOutput:
     setpoint_type: str = "none"
     task_finished: bool = False
     messages: tuple = ()
+    want_takeoff: bool | None = None
 
 
 class _NullExecutor:
@@ -72,6 +73,7 @@ class Parts:
         self.control: Any = _make_control(params)
         self.executor: Any = _make_executor(params)
         self._detector: Any = _make_land_detector(params)
+        self.ground_contact = False
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> Any:
         try:
@@ -81,7 +83,19 @@ class Parts:
         home = c.home
         return NavInput(time_us=now_us, pos_ned_m=est.pos_ned_m, vel_ned_m_s=est.vel_ned_m_s,
                         yaw_rad=_yaw(est.q_wxyz), home_ned_m=home.pos_ned_m if home else (0.0, 0.0, 0.0),
-                        home_yaw_rad=home.yaw_rad if home else 0.0, landed=c.landed, armed=c.armed)
+                        home_yaw_rad=home.yaw_rad if home else 0.0, landed=c.landed, armed=c.armed,
+                        takeoff_state=self.control_takeoff_state(), ref_alt_amsl_m=ref.alt_amsl_m)
+
+    def control_takeoff_state(self) -> str:
+        return str(getattr(self.control, "takeoff_state", "flight"))
+
+    def control_update(self, est: RigidBodyState, out: Any, armed: bool, landed: bool, now_us: int,
+                       dt_s: float) -> Vec4:
+        """The cascade with the task's want_takeoff (auto modes) and the land detector's ground contact."""
+        if isinstance(self.control, _NullControl):
+            return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s)
+        return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
+                                   ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)
 
     def land(self, est: RigidBodyState, c: Commander, setpoint_type: str, now_us: int) -> tuple[bool, bool]:
         """Run the land detector on the new state; (landed, maybe_landed)."""
@@ -98,6 +112,7 @@ class Parts:
             specific_force_norm_m_s2=math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
             thrust_setpoint=self.control.thrust_setpoint, hover_thrust=self.control.hover_thrust,
             setpoint_vz_m_s=sp_vz, in_descent_mode=setpoint_type == "land"))
+        self.ground_contact = bool(out.ground_contact)
         return out.landed, out.maybe_landed
 
 

@@ -32,6 +32,7 @@ class ExecutorOutput:
     setpoint_type: str  # "idle" | "position" | "takeoff" | "land" | "offboard" | "none"
     task_finished: bool
     messages: list[tuple[Severity, str]]
+    want_takeoff: bool | None = None  # the task's vehicle_constraints.want_takeoff; None: from the setpoint
 
 
 class ModeExecutor:
@@ -42,7 +43,6 @@ class ModeExecutor:
         self.task: tasks.Task | None = None
         self._task_mode: NavState | None = None
         self._task_armed = False
-        self._takeoff_target_ned_m: Vec3 | None = None
         self._offboard_kind: OffboardControlMode | None = None
         self._offboard_traj: TrajectorySetpoint | None = None
         self._offboard_att: AttitudeSetpoint | None = None
@@ -63,7 +63,8 @@ class ModeExecutor:
         if self.task is None:
             return ExecutorOutput(None, None, "none", False, [])
         sp = self.task.update(nav, dt_s)
-        return ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages())
+        return ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
+                              self.task.want_takeoff)
 
     def _offboard_output(self) -> ExecutorOutput:
         kind = self._offboard_kind
@@ -80,7 +81,9 @@ class ModeExecutor:
             commands.clear()
             return
         previous = self._task_mode
-        finished_takeoff = previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished
+        takeoff_target: Vec3 | None = None
+        if previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
+            takeoff_target = getattr(self.task, "target_ned_m", None)
         command = commands.pop() if commands else None
         commands.clear()
         changed = nav_state != previous or nav.armed != self._task_armed
@@ -90,7 +93,7 @@ class ModeExecutor:
         if nav_state == NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, command, ref)
         elif nav_state == NavState.AUTO_LOITER:
-            self.task = self._make_loiter(nav, command, ref, finished_takeoff)
+            self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state == NavState.AUTO_RTL:
             self.task = tasks.make_rtl(nav, self.params)
         else:
@@ -99,21 +102,18 @@ class ModeExecutor:
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None
         if command is not None and command.kind == "takeoff" and math.isfinite(command.alt_amsl_m):
-            alt_up = command.alt_amsl_m - ref.alt_amsl_m
-        default_up = -nav.pos_ned_m[2] + float(self.params["MIS_TAKEOFF_ALT"])
-        self._takeoff_target_ned_m = (nav.pos_ned_m[0], nav.pos_ned_m[1], -(alt_up if alt_up is not None
-                                                                          else default_up))
+            alt_up = command.alt_amsl_m - ref.alt_amsl_m  # param7 is AMSL; the local origin is at ref altitude
         return tasks.make_takeoff(nav, self.params, alt_up)
 
     def _make_loiter(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
-                     finished_takeoff: bool) -> tasks.Task:
+                     takeoff_target: Vec3 | None) -> tasks.Task:
         if command is not None and command.kind in ("reposition", "change_altitude") and nav.armed:
             target = _command_target(command, nav, ref)
             speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
             yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else nav.yaw_rad
             return tasks.make_reposition(nav, self.params, target, yaw, speed)
-        if finished_takeoff and self._takeoff_target_ned_m is not None:
-            return tasks.make_loiter(nav, self.params, hold_at_ned_m=self._takeoff_target_ned_m)
+        if takeoff_target is not None:
+            return tasks.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
         return tasks.make_loiter(nav, self.params)
 
 
