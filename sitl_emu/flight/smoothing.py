@@ -1,0 +1,256 @@
+"""Jerk- and acceleration-limited trajectories, after PX4's motion_planning library.
+
+Written from the behaviour of PX4's `src/lib/motion_planning/VelocitySmoothing.cpp` (one axis: constant-jerk
+segments T1 (jerk up), T2 (constant acceleration), T3 (jerk down) that bring the velocity to a target),
+`PositionSmoothing.cpp` (a velocity target per axis derived from the distance to a waypoint, the time stretch that
+waits for a lagging vehicle) and `src/lib/mathlib/math/TrajMath.hpp` (speed from braking distance).
+Only the single-waypoint case the navigator tasks use is implemented (no L1 turns between waypoints).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl_emu.types import Vec3
+
+_EPS = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
+
+
+def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_speed: float) -> float:
+    """Largest speed from which the vehicle can slow to `final_speed` within `distance_m` (TrajMath.hpp)."""
+    b = 4.0 * accel * accel / jerk
+    c = -2.0 * accel * distance_m - final_speed * final_speed
+    return max(0.5 * (-b + math.sqrt(b * b - 4.0 * c)), final_speed)
+
+
+def braking_distance(speed: float, jerk: float, accel: float, accel_delay_max: float) -> float:
+    """Distance to stop from `speed` (TrajMath.hpp computeBrakingDistanceFromVelocity)."""
+    return speed * (speed / (2.0 * accel) + accel_delay_max / jerk)
+
+
+def _sign(x: float) -> int:
+    return (x > 0.0) - (x < 0.0)
+
+
+class AxisSmoother:
+    """One axis of a jerk-limited trajectory (state: jerk, acceleration, velocity, position)."""
+
+    __slots__ = ("_a0", "_dir", "_t1", "_t2", "_t3", "_time", "_v0", "_vel_sp", "_x0",
+                 "a", "j", "max_accel", "max_jerk", "max_vel", "v", "x")
+
+    def __init__(self, accel: float = 0.0, vel: float = 0.0, pos: float = 0.0) -> None:
+        self.max_jerk, self.max_accel, self.max_vel = 4.0, 3.0, 12.0
+        self._t1 = self._t2 = self._t3 = 0.0
+        self._dir = 0
+        self._vel_sp = 0.0
+        self.reset(accel, vel, pos)
+
+    def reset(self, accel: float, vel: float, pos: float) -> None:
+        self.j, self.a, self.v, self.x = 0.0, accel, vel, pos
+        self._a0, self._v0, self._x0 = accel, vel, pos
+        self._time = 0.0
+        self._t1 = self._t2 = self._t3 = 0.0
+
+    def set_position(self, pos: float) -> None:
+        self.x = self._x0 = pos
+
+    @property
+    def total_time(self) -> float:
+        return self._t1 + self._t2 + self._t3
+
+    def update_durations(self, vel_setpoint: float) -> None:
+        """Plan the fastest jerk-limited profile from the current state to `vel_setpoint` (clamped to max_vel)."""
+        self._vel_sp = min(max(vel_setpoint, -self.max_vel), self.max_vel)
+        self._time = 0.0
+        self._a0, self._v0, self._x0 = self.a, self.v, self.x
+        self._dir = self._direction()
+        jerk = self._dir * self.max_jerk
+        if abs(jerk) <= _EPS:
+            self._t1 = self._t2 = self._t3 = 0.0
+            return
+        dv = self._vel_sp - self.v
+        self._t1 = self._t1_min_time(self.a, dv, jerk)
+        self._t3 = max(self.a / jerk + self._t1, 0.0)
+        self._t2 = self._t2_from(self._t1, self._t3, self.a, dv, jerk)
+
+    def update_durations_given_total_time(self, total_s: float) -> None:
+        """Stretch the current plan so that it lasts `total_s` (used to synchronise the axes)."""
+        jerk = self._dir * self.max_jerk
+        if abs(jerk) <= _EPS:
+            self._t1 = self._t2 = self._t3 = 0.0
+            return
+        self._t1 = self._t1_given_total(total_s, self.a, self._vel_sp - self.v, jerk)
+        self._t3 = max(self.a / jerk + self._t1, 0.0)
+        self._t2 = max(total_s - self._t1 - self._t3, 0.0)
+
+    def update_traj(self, dt_s: float, time_stretch: float = 1.0) -> None:
+        """Advance along the planned profile by `dt_s` (scaled by `time_stretch`, 0..1)."""
+        self._time += dt_s * time_stretch
+        rest = self._time
+        j, a, v, x = self._eval(self._dir * self.max_jerk, self._a0, self._v0, self._x0, min(rest, self._t1))
+        rest -= self._t1
+        if rest > 0.0:
+            j, a, v, x = self._eval(0.0, a, v, x, min(rest, self._t2))
+            rest -= self._t2
+        if rest > 0.0:
+            j, a, v, x = self._eval(-self._dir * self.max_jerk, a, v, x, min(rest, self._t3))
+            rest -= self._t3
+        if rest > 0.0:
+            j, a, v, x = self._eval(0.0, 0.0, v, x, rest)
+        self.j, self.a, self.v, self.x = j, a, v, x
+
+    @staticmethod
+    def _eval(j: float, a0: float, v0: float, x0: float, t: float) -> tuple[float, float, float, float]:
+        t = max(t, 0.0)
+        return j, a0 + j * t, v0 + a0 * t + 0.5 * j * t * t, x0 + v0 * t + 0.5 * a0 * t * t + j * t * t * t / 6.0
+
+    def _direction(self) -> int:
+        vel_zero_acc = self.v
+        if abs(self.a) > _EPS:
+            j_zero = -_sign(self.a) * self.max_jerk
+            t_zero = -self.a / j_zero
+            vel_zero_acc = self.v + self.a * t_zero + 0.5 * j_zero * t_zero * t_zero
+        direction = _sign(self._vel_sp - vel_zero_acc)
+        return direction if direction != 0 else _sign(self.a)
+
+    def _saturate_t1(self, a0: float, jerk: float, t1: float) -> float:
+        accel_t1 = a0 + jerk * t1
+        if accel_t1 > self.max_accel:
+            return (self.max_accel - a0) / jerk
+        if accel_t1 < -self.max_accel:
+            return (-self.max_accel - a0) / jerk
+        return t1
+
+    def _t1_min_time(self, a0: float, dv: float, jerk: float) -> float:
+        delta = 2.0 * a0 * a0 + 4.0 * jerk * dv
+        if delta < 0.0:
+            return 0.0
+        root = math.sqrt(delta)
+        t1 = 0.0
+        for cand in ((-a0 + 0.5 * root) / jerk, (-a0 - 0.5 * root) / jerk):
+            if cand >= 0.0 and a0 / jerk + cand >= 0.0:
+                t1 = cand
+                break
+        return max(self._saturate_t1(a0, jerk, t1), 0.0)
+
+    def _t1_given_total(self, total: float, a0: float, dv: float, jerk: float) -> float:
+        qa, qb = -jerk, jerk * total - a0
+        delta = total * total * jerk * jerk + 2.0 * total * a0 * jerk - a0 * a0 - 4.0 * jerk * dv
+        if delta < 0.0:
+            return 0.0
+        root = math.sqrt(delta)
+        t1 = 0.0
+        for cand in (max((-qb + root) / (2.0 * qa), 0.0), max((-qb - root) / (2.0 * qa), 0.0)):
+            t3 = a0 / jerk + cand
+            if t3 >= 0.0 and cand + t3 <= total:
+                t1 = cand
+                break
+        return self._saturate_t1(a0, jerk, t1)
+
+    @staticmethod
+    def _t2_from(t1: float, t3: float, a0: float, dv: float, jerk: float) -> float:
+        den = a0 + jerk * t1
+        if abs(den) <= _EPS:
+            return 0.0
+        t2 = (-0.5 * t1 * t1 * jerk - t1 * t3 * jerk - t1 * a0 + 0.5 * t3 * t3 * jerk - t3 * a0 + dv) / den
+        return max(t2, 0.0)
+
+
+def synchronize(axes: list[AxisSmoother]) -> None:
+    """Make every axis finish its velocity change together with the slowest one (VelocitySmoothing::timeSync)."""
+    longest = max(range(len(axes)), key=lambda i: axes[i].total_time)
+    desired = axes[longest].total_time
+    if desired <= _EPS:
+        return
+    for i, axis in enumerate(axes):
+        if i != longest and axis.total_time < desired:
+            axis.update_durations_given_total_time(desired)
+
+
+@dataclass(frozen=True, slots=True)
+class SmoothedSetpoint:
+    position_ned_m: Vec3
+    velocity_ned_m_s: Vec3
+    acceleration_ned_m_s2: Vec3
+    unsmoothed_velocity_ned_m_s: Vec3
+
+
+class PositionSmoother:
+    """Three jerk-limited axes driven towards one waypoint (PX4 PositionSmoothing, single-waypoint case).
+
+    Limits are public attributes the caller sets before each `generate` (as FlightTaskAuto does every cycle).
+    """
+
+    def __init__(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
+        self.axes = [AxisSmoother(accel[i], vel[i], pos[i]) for i in range(3)]
+        self.cruise_speed_m_s = 5.0
+        self.max_xy_error_m = 2.0
+        self.max_z_error_m = 0.0  # 0 disables the vertical time stretch
+
+    def reset(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
+        for i, axis in enumerate(self.axes):
+            axis.reset(accel[i], vel[i], pos[i])
+
+    def set_limits(self, jerk: float, accel_xy: float, accel_z: float, vel_xy: float, vel_z: float) -> None:
+        for i, axis in enumerate(self.axes):
+            axis.max_jerk = jerk
+            axis.max_accel = accel_xy if i < 2 else accel_z
+            axis.max_vel = vel_xy if i < 2 else vel_z
+
+    @property
+    def position(self) -> Vec3:
+        return (self.axes[0].x, self.axes[1].x, self.axes[2].x)
+
+    @property
+    def velocity(self) -> Vec3:
+        return (self.axes[0].v, self.axes[1].v, self.axes[2].v)
+
+    def generate(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> SmoothedSetpoint:
+        """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis)."""
+        vel_sp = self._velocity_target(target, feedforward_vel)
+        if all(math.isfinite(c) for c in vel_sp):
+            self._advance(vehicle_pos, vel_sp, dt_s)
+        ax = self.axes
+        return SmoothedSetpoint((ax[0].x, ax[1].x, ax[2].x), (ax[0].v, ax[1].v, ax[2].v),
+                                (ax[0].a, ax[1].a, ax[2].a), vel_sp)
+
+    def _velocity_target(self, target: Vec3, ff: Vec3) -> Vec3:
+        out = list(ff)
+        pos = self.position
+        if math.isfinite(target[0]) and math.isfinite(target[1]):
+            dx, dy = target[0] - pos[0], target[1] - pos[1]
+            dist = math.hypot(dx, dy)
+            ax = self.axes[0]
+            speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
+            ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
+            out[0] = ux * speed + (ff[0] if math.isfinite(ff[0]) else 0.0)
+            out[1] = uy * speed + (ff[1] if math.isfinite(ff[1]) else 0.0)
+        if math.isfinite(target[2]):
+            az = self.axes[2]
+            dz = target[2] - pos[2]
+            speed = min(az.max_vel, max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0))
+            out[2] = _sign(dz) * speed + (ff[2] if math.isfinite(ff[2]) else 0.0)
+        return (out[0], out[1], out[2])
+
+    def _advance(self, vehicle_pos: Vec3, vel_sp: Vec3, dt_s: float) -> None:
+        stretch_xy = self._stretch_xy(vehicle_pos)
+        stretch_z = self._stretch_z(vehicle_pos)
+        for i, axis in enumerate(self.axes):
+            axis.update_traj(dt_s, stretch_xy if i < 2 else stretch_z)
+        for i, axis in enumerate(self.axes):
+            axis.update_durations(vel_sp[i])
+        synchronize(self.axes)
+
+    def _stretch_xy(self, vehicle_pos: Vec3) -> float:
+        """Slow the trajectory while the vehicle lags behind it (PositionSmoothing::_generateTrajectory)."""
+        ex, ey = self.axes[0].x - vehicle_pos[0], self.axes[1].x - vehicle_pos[1]
+        if self.max_xy_error_m <= _EPS or ex * self.axes[0].v + ey * self.axes[1].v < 0.0:
+            return 1.0
+        return 1.0 - min(max(math.hypot(ex, ey) / self.max_xy_error_m, 0.0), 1.0)
+
+    def _stretch_z(self, vehicle_pos: Vec3) -> float:
+        ez = self.axes[2].x - vehicle_pos[2]
+        if self.max_z_error_m <= _EPS or ez * self.axes[2].v < 0.0:
+            return 1.0
+        return 1.0 - min(abs(ez) / self.max_z_error_m, 1.0)

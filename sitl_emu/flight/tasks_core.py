@@ -1,0 +1,282 @@
+"""The shared machinery of the navigator tasks: inputs, settings, the base Task and PX4's FlightTaskAuto core.
+
+`AutoCore` turns a waypoint (type + target + yaw) into a smoothed trajectory setpoint the way PX4's
+`src/modules/flight_mode_manager/tasks/Auto/FlightTaskAuto.cpp` does: per-cycle trajectory constraints
+(_updateTrajConstraints: takeoff speed/acceleration near the ground, MPC_ACC_UP_MAX/MPC_Z_V_AUTO_UP upwards,
+MPC_ACC_DOWN_MAX/MPC_Z_V_AUTO_DN downwards), the land speed profile (_prepareLandSetpoints), the idle setpoint,
+heading towards the waypoint (MPC_YAW_MODE 0) and the yaw-rate limit (_limitYawRate, MPC_YAWRAUTO_MAX).
+It also reproduces FlightModeManager's reset of the trajectory while the takeoff ramp has not started
+(`src/modules/flight_mode_manager/FlightModeManager.cpp` generateTrajectorySetpoint -> FlightTaskAuto::reActivate).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl_emu.flight.smoothing import PositionSmoother
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import Severity
+from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
+
+# TakeoffHandling states before the ramp (sitl_emu.control's takeoff_state names, PX4 takeoff_status values).
+PRE_RAMP_STATES = frozenset({"disarmed", "spoolup", "ready_for_takeoff"})
+WANT_TAKEOFF_VZ_M_S = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
+REACTIVATE_VZ_M_S = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
+IDLE_ACC_Z_M_S2 = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
+
+
+@dataclass(frozen=True, slots=True)
+class NavInput:
+    """What the navigator tasks see of the vehicle, in the local NED frame (z = 0 is the ground at home).
+
+    `takeoff_state` is the control cascade's TakeoffHandling state (`MulticopterControl.takeoff_state`): while it is
+    before the ramp ("disarmed", "spoolup", "ready_for_takeoff") the trajectory is held at the vehicle, as PX4's
+    FlightModeManager does; the default "flight" disables that. `ref_alt_amsl_m` is the AMSL altitude of the local
+    origin (only used for the RTL message, which PX4 prints in AMSL).
+    """
+
+    time_us: int
+    pos_ned_m: Vec3
+    vel_ned_m_s: Vec3
+    yaw_rad: float
+    home_ned_m: Vec3
+    home_yaw_rad: float
+    landed: bool
+    armed: bool
+    takeoff_state: str = "flight"
+    ref_alt_amsl_m: float = 488.0
+
+
+@dataclass(frozen=True, slots=True)
+class AutoSettings:
+    """Every parameter the tasks read, fetched by name from the registry (PX4 defaults if a name is missing)."""
+
+    jerk: float
+    acc_hor: float
+    acc_up: float
+    acc_down: float
+    xy_vel_max: float
+    z_v_auto_up: float
+    z_v_auto_dn: float
+    z_vel_max_dn: float
+    tko_speed: float
+    tko_ramp_t: float
+    land_speed: float
+    land_crawl: float
+    land_alt1: float
+    land_alt2: float
+    land_alt3: float
+    xy_cruise: float
+    xy_err_max: float
+    yawrate_max_rad_s: float
+    yaw_mode: int
+    nav_acc_rad: float
+    nav_mc_alt_rad: float
+    takeoff_alt: float
+    rtl_return_alt: float
+    rtl_descend_alt: float
+    rtl_land_delay: float
+    rtl_min_dist: float
+    rtl_cone_ang: float
+
+    @classmethod
+    def from_params(cls, params: ParamRegistry) -> AutoSettings:
+        values = {field: _get(params, name, default) for field, (name, default) in _PARAM_NAMES.items()}
+        values["yawrate_max_rad_s"] = math.radians(values["yawrate_max_rad_s"])
+        values["yaw_mode"] = int(values["yaw_mode"])
+        return cls(**values)
+
+
+_PARAM_NAMES: dict[str, tuple[str, float]] = {
+    "jerk": ("MPC_JERK_AUTO", 4.0), "acc_hor": ("MPC_ACC_HOR", 3.0), "acc_up": ("MPC_ACC_UP_MAX", 4.0),
+    "acc_down": ("MPC_ACC_DOWN_MAX", 3.0), "xy_vel_max": ("MPC_XY_VEL_MAX", 12.0),
+    "z_v_auto_up": ("MPC_Z_V_AUTO_UP", 3.0), "z_v_auto_dn": ("MPC_Z_V_AUTO_DN", 1.5),
+    "z_vel_max_dn": ("MPC_Z_VEL_MAX_DN", 1.5), "tko_speed": ("MPC_TKO_SPEED", 1.5),
+    "tko_ramp_t": ("MPC_TKO_RAMP_T", 3.0), "land_speed": ("MPC_LAND_SPEED", 0.7),
+    "land_crawl": ("MPC_LAND_CRWL", 0.3), "land_alt1": ("MPC_LAND_ALT1", 10.0), "land_alt2": ("MPC_LAND_ALT2", 5.0),
+    "land_alt3": ("MPC_LAND_ALT3", 1.0), "xy_cruise": ("MPC_XY_CRUISE", 5.0), "xy_err_max": ("MPC_XY_ERR_MAX", 2.0),
+    "yawrate_max_rad_s": ("MPC_YAWRAUTO_MAX", 60.0), "yaw_mode": ("MPC_YAW_MODE", 0),
+    "nav_acc_rad": ("NAV_ACC_RAD", 10.0), "nav_mc_alt_rad": ("NAV_MC_ALT_RAD", 0.8),
+    "takeoff_alt": ("MIS_TAKEOFF_ALT", 2.5), "rtl_return_alt": ("RTL_RETURN_ALT", 30.0),
+    "rtl_descend_alt": ("RTL_DESCEND_ALT", 10.0), "rtl_land_delay": ("RTL_LAND_DELAY", 0.0),
+    "rtl_min_dist": ("RTL_MIN_DIST", 10.0), "rtl_cone_ang": ("RTL_CONE_ANG", 45),
+}
+
+
+def _get(params: ParamRegistry, name: str, default: float) -> float:
+    return float(params.get(name)) if name in params else float(default)
+
+
+def wrap_pi(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class Waypoint:
+    """One navigator position setpoint: kind is "idle" | "takeoff" | "position" | "land"; NaN = not given."""
+
+    kind: str
+    target_ned_m: Vec3
+    yaw_rad: float = NAN
+    cruise_m_s: float = NAN
+
+
+class AutoCore:
+    """PX4's FlightTaskAuto for one activation: a smoothed trajectory towards the current waypoint."""
+
+    def __init__(self, nav: NavInput, settings: AutoSettings) -> None:
+        self.s = settings
+        self.smoother = PositionSmoother((0.0, 0.0, 0.0), nav.vel_ned_m_s, nav.pos_ned_m)
+        self._unsmoothed_vz = 0.0
+        self._yaw_sp_prev = nav.yaw_rad
+        self._yaw_lock: float | None = None
+        self._yawspeed_filt = 0.0
+        self._kind_prev = ""
+        self._land_heading = NAN
+        self.want_takeoff = False
+
+    def step(self, nav: NavInput, dt_s: float, wp: Waypoint) -> TrajectorySetpoint:
+        if wp.kind == "idle":
+            return self._idle(nav)
+        self._set_constraints(nav, wp)
+        target, ff = wp.target_ned_m, (NAN, NAN, NAN)
+        if wp.kind == "land":
+            target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
+        sm = self.smoother.generate(nav.pos_ned_m, target, ff, dt_s)
+        self._unsmoothed_vz = sm.unsmoothed_velocity_ned_m_s[2]
+        self.want_takeoff = self._unsmoothed_vz < WANT_TAKEOFF_VZ_M_S
+        yaw, yawspeed = self._yaw(nav, wp, dt_s)
+        self._kind_prev = wp.kind
+        out = TrajectorySetpoint(sm.position_ned_m, sm.velocity_ned_m_s, sm.acceleration_ned_m_s2, yaw, yawspeed)
+        if nav.takeoff_state in PRE_RAMP_STATES:
+            out = self._hold_before_ramp(nav, out)
+        return out
+
+    def _idle(self, nav: NavInput) -> TrajectorySetpoint:
+        self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), nav.pos_ned_m)
+        self._kind_prev, self.want_takeoff, self._yaw_sp_prev = "idle", False, nav.yaw_rad
+        return TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
+
+    def _hold_before_ramp(self, nav: NavInput, out: TrajectorySetpoint) -> TrajectorySetpoint:
+        """FlightModeManager: before the takeoff ramp the task is re-activated every cycle (trajectory reset to the
+        vehicle, 0.7 m/s down). PX4 passes want_takeoff to the controller separately; our controller reads it from
+        the setpoint, so the upward intent is published as the vertical velocity (the controller idles anyway)."""
+        self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, REACTIVATE_VZ_M_S), nav.pos_ned_m)
+        vz = self._unsmoothed_vz if self.want_takeoff else REACTIVATE_VZ_M_S
+        pos = (out.position_ned_m[0], out.position_ned_m[1], nav.pos_ned_m[2])
+        return TrajectorySetpoint(pos, (0.0, 0.0, vz), (NAN, NAN, NAN), out.yaw_rad, out.yawspeed_rad_s)
+
+    def _set_constraints(self, nav: NavInput, wp: Waypoint) -> None:
+        """FlightTaskAuto::_updateTrajConstraints."""
+        s, sm = self.s, self.smoother
+        cruise = wp.cruise_m_s if math.isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
+        sm.cruise_speed_m_s = min(cruise, s.xy_vel_max)
+        sm.max_xy_error_m = s.xy_err_max
+        if self._unsmoothed_vz < 0.0:  # going up
+            acc_z, vel_z = s.acc_up, s.z_v_auto_up
+            if wp.kind == "takeoff" and self._dist_to_ground(nav) < s.land_alt1:
+                vel_z, acc_z = s.tko_speed, min(acc_z, s.tko_speed / s.tko_ramp_t)
+                for axis in sm.axes[2:]:  # keep the altitude setpoint at the vehicle during the ramp
+                    axis.set_position(nav.pos_ned_m[2])
+        else:
+            acc_z, vel_z = s.acc_down, s.z_v_auto_dn
+        sm.set_limits(s.jerk, s.acc_hor, acc_z, s.xy_vel_max, vel_z)
+
+    @staticmethod
+    def _dist_to_ground(nav: NavInput) -> float:
+        return max(-nav.pos_ned_m[2], 0.0)
+
+    def _land_speed(self, nav: NavInput) -> float:
+        """FlightTaskAuto::_prepareLandSetpoints: MPC_LAND_SPEED below ALT2, MPC_Z_VEL_MAX_DN above ALT1, linear in
+        between; MPC_LAND_CRWL below ALT3 (SIH has a distance sensor, so the crawl applies)."""
+        s, d = self.s, self._dist_to_ground(nav)
+        alt1 = max(s.land_alt1, s.land_alt2)
+        if d <= s.land_alt3:
+            return s.land_crawl
+        if d <= s.land_alt2:
+            return s.land_speed
+        if d >= alt1:
+            return s.z_vel_max_dn
+        return s.land_speed + (d - s.land_alt2) / (alt1 - s.land_alt2) * (s.z_vel_max_dn - s.land_speed)
+
+    def _yaw(self, nav: NavInput, wp: Waypoint, dt_s: float) -> tuple[float, float]:
+        yaw_sp = self._yaw_target(nav, wp)
+        return self._limit_yaw_rate(nav, yaw_sp, dt_s)
+
+    def _yaw_target(self, nav: NavInput, wp: Waypoint) -> float:
+        if wp.kind == "land":
+            if self._kind_prev != "land" or not math.isfinite(self._land_heading):
+                self._land_heading = wp.yaw_rad if math.isfinite(wp.yaw_rad) else self._yaw_sp_prev
+            return self._land_heading
+        if math.isfinite(wp.yaw_rad):
+            return wp.yaw_rad
+        # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
+        dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
+        dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
+        if self.s.yaw_mode in (0, 4) and math.isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
+            self._yaw_lock = math.atan2(dy, dx)
+        if self._yaw_lock is None:
+            self._yaw_lock = nav.yaw_rad
+        return self._yaw_lock
+
+    def _limit_yaw_rate(self, nav: NavInput, yaw_sp: float, dt_s: float) -> tuple[float, float]:
+        """FlightTaskAuto::_limitYawRate: rate-limit the heading and feed its filtered rate forward."""
+        prev = self._yaw_sp_prev if math.isfinite(self._yaw_sp_prev) else nav.yaw_rad
+        max_rate = self.s.yawrate_max_rad_s
+        dyaw = min(max(wrap_pi(yaw_sp - prev), -max_rate * dt_s), max_rate * dt_s)
+        yaw_sp = wrap_pi(prev + dyaw)
+        if dt_s > 0.0:
+            alpha = dt_s / (dt_s + 0.2)
+            self._yawspeed_filt += alpha * (dyaw / dt_s - self._yawspeed_filt)
+        self._yaw_sp_prev = yaw_sp
+        return yaw_sp, min(max(self._yawspeed_filt, -max_rate), max_rate)
+
+
+class Task:
+    """One activation of an auto mode. Subclasses set `kind` and implement `_waypoint(nav)`."""
+
+    kind = ""
+
+    def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
+        self._params = params
+        self._version = params.version
+        self._settings = AutoSettings.from_params(params)
+        self._core = AutoCore(nav, self._settings)
+        self._messages: list[tuple[Severity, str]] = []
+        self._type = "position"
+
+    def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
+        """The trajectory setpoint for this cycle (NaN = not controlled)."""
+        if self._params.version != self._version:
+            self._version = self._params.version
+            self._settings = AutoSettings.from_params(self._params)
+            self._core.s = self._settings
+        wp = self._waypoint(nav)
+        self._type = wp.kind
+        return self._core.step(nav, dt_s, wp)
+
+    def _waypoint(self, nav: NavInput) -> Waypoint:
+        raise NotImplementedError
+
+    @property
+    def setpoint_type(self) -> str:
+        """position_setpoint.type: "idle" | "position" | "takeoff" | "land"."""
+        return self._type
+
+    @property
+    def finished(self) -> bool:
+        return False
+
+    @property
+    def want_takeoff(self) -> bool:
+        """PX4's vehicle_constraints.want_takeoff: the unsmoothed trajectory asks to climb (> 0.3 m/s)."""
+        return self._core.want_takeoff
+
+    def _say(self, severity: Severity, text: str) -> None:
+        self._messages.append((severity, text))
+
+    def drain_messages(self) -> list[tuple[Severity, str]]:
+        """Navigator texts since the last call (PX4 also sends them as events; no trailing tab here)."""
+        out, self._messages = self._messages, []
+        return out

@@ -1,0 +1,114 @@
+"""AUTO.RTL for a multicopter returning to home (PX4 navigator rtl.cpp + rtl_direct.cpp, RTL_TYPE 0).
+
+States as RtlDirect: CLIMBING (to the return altitude above the current position) -> MOVE_TO_LOITER (home at the
+return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise LOITER_DOWN (to RTL_DESCEND_ALT) ->
+LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The return altitude follows
+RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
+"""
+
+from __future__ import annotations
+
+import math
+
+from sitl_emu.flight.tasks_core import NavInput, Task, Waypoint
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import Severity
+from sitl_emu.types import NAN, Vec3
+
+
+class RtlTask(Task):
+    kind = "rtl"
+
+    def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
+        super().__init__(nav, params)
+        self._home: Vec3 = nav.home_ned_m
+        self._home_yaw = nav.home_yaw_rad
+        self._rtl_up_m = self._return_altitude_up(nav)
+        self._state = ""
+        self._hold_until_us = 0
+        self._enter("idle" if nav.landed else ("climb" if -nav.pos_ned_m[2] < self._rtl_up_m else "return"), nav)
+        home_up = -self._home[2]
+        amsl = nav.ref_alt_amsl_m + self._rtl_up_m
+        self._say(Severity.INFO, f"RTL: start return at {math.ceil(amsl):d} m "
+                                 f"({math.ceil(self._rtl_up_m - home_up):d} m above destination)")
+
+    @property
+    def state(self) -> str:
+        """"climb" | "return" | "descend" | "hold" | "hover" | "land" | "idle"."""
+        return self._state
+
+    @property
+    def return_alt_up_m(self) -> float:
+        return self._rtl_up_m
+
+    def _return_altitude_up(self, nav: NavInput) -> float:
+        """Return altitude (up, local frame) after the cone rule, never below the current altitude."""
+        s = self._settings
+        home_up, current_up = -self._home[2], -nav.pos_ned_m[2]
+        dist = self._dist_xy(nav)
+        if s.rtl_cone_ang <= 0:
+            return max(current_up, home_up + s.rtl_return_alt)
+        alt = home_up + s.rtl_return_alt
+        if dist <= s.nav_acc_rad:
+            alt = home_up + 2.0 * dist
+        else:
+            if dist <= s.rtl_min_dist:
+                half_angle = math.radians(min(max(s.rtl_cone_ang, 1.0), 89.0))
+                alt = min(dist / math.tan(half_angle) + home_up, alt)
+            alt = max(alt, home_up + 2.0 * s.nav_acc_rad)
+        return max(alt, current_up)
+
+    def _dist_xy(self, nav: NavInput) -> float:
+        return math.hypot(self._home[0] - nav.pos_ned_m[0], self._home[1] - nav.pos_ned_m[1])
+
+    def _enter(self, state: str, nav: NavInput) -> None:
+        self._state = state
+        s = self._settings
+        if state == "climb":
+            self._climb_xy = (nav.pos_ned_m[0], nav.pos_ned_m[1])
+            self._climb_yaw = nav.yaw_rad
+        elif state == "return":
+            self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN
+        elif state == "hold":
+            self._hold_until_us = nav.time_us + int(s.rtl_land_delay * 1e6)
+            if s.rtl_land_delay < 0.0:
+                self._say(Severity.INFO, "RTL: completed, loitering")
+        elif state == "land":
+            self._say(Severity.INFO, "RTL: land at destination")
+
+    def _loiter_up_m(self) -> float:
+        return min(-self._home[2] + self._settings.rtl_descend_alt, self._rtl_up_m)
+
+    def _waypoint(self, nav: NavInput) -> Waypoint:
+        self._advance(nav)
+        return self._current_waypoint()
+
+    def _current_waypoint(self) -> Waypoint:
+        hx, hy = self._home[0], self._home[1]
+        st = self._state
+        if st == "climb":
+            return Waypoint("position", (self._climb_xy[0], self._climb_xy[1], -self._rtl_up_m), self._climb_yaw)
+        if st == "return":
+            return Waypoint("position", (hx, hy, -self._rtl_up_m), self._return_yaw)
+        if st in ("descend", "hold", "hover"):
+            return Waypoint("position", (hx, hy, -self._loiter_up_m()), self._home_yaw)
+        if st == "land":
+            return Waypoint("land", (hx, hy, NAN), self._home_yaw)
+        return Waypoint("idle", self._home)
+
+    def _advance(self, nav: NavInput) -> None:
+        """RtlDirect::_updateRtlState once the current item is reached (mission_block acceptance rules)."""
+        s = self._settings
+        up = -nav.pos_ned_m[2]
+        near_xy = self._dist_xy(nav) <= s.nav_acc_rad
+        st = self._state
+        if st == "climb" and up >= self._rtl_up_m - s.nav_mc_alt_rad:
+            self._enter("return", nav)
+        elif st == "return" and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad:
+            self._enter("land" if s.rtl_land_delay == 0.0 else "descend", nav)
+        elif st == "descend" and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
+            self._enter("hold", nav)
+        elif st == "hold" and s.rtl_land_delay >= 0.0 and nav.time_us >= self._hold_until_us:
+            self._enter("hover", nav)
+        elif st == "hover" and near_xy:
+            self._enter("land", nav)
