@@ -315,7 +315,8 @@ class JsDevice:
                 self._lost(exc)
                 break
             if not data:
-                self._at_eof()
+                if not got:  # else report what arrived first: a FIFO's EOF is still there on the next poll
+                    self._at_eof()
                 break
             got = self._feed(data) or got
         return got

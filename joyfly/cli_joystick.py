@@ -1,0 +1,207 @@
+"""`joyfly joystick list` and `joyfly joystick test`: find joysticks and watch what they send.
+
+`test` is what `rostopic echo /joy` was for, plus the flying commands the matched profile makes of it: a live view
+on a terminal, one plain line per change otherwise (a pipe, a log, a test). It ends on Ctrl-C, after --duration,
+or when a virtual joystick reaches its end.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from typing import Any, TextIO
+
+import click
+
+from joyfly.joystick import (
+    DeviceInfo,
+    JoystickError,
+    JsDevice,
+    MonotonicClock,
+    default_device,
+    list_devices,
+    open_joystick,
+)
+from joyfly.mapping import StickMapper
+from joyfly.profiles import Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
+from joyfly.virtual import TimedSource, record_to
+
+DEV_DIR = "/dev/input"
+
+
+@click.group("joystick")
+def joystick() -> None:
+    """Find joysticks and check what they send (no vehicle needed)."""
+
+
+@joystick.command("list")
+@click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True, help="Where the js* nodes live.")
+def list_cmd(dev_dir: str) -> None:
+    """Every /dev/input/js* with its name, axes, buttons and the profile that matches it."""
+    found = list_devices(dev_dir)
+    if not found:
+        raise click.ClickException(
+            f"No joystick found (no {dev_dir}/js*): plug one in, or fly a virtual one with "
+            "--joy script:examples/joystick_script.txt."
+        )
+    for item in found:
+        click.echo(_device_line(item))
+
+
+def _device_line(item: DeviceInfo | JoystickError) -> str:
+    if isinstance(item, JoystickError):
+        return f"?  {item}"
+    profile = load_profile("auto", item.name, {})
+    counts = f"{item.axes} axes, {item.buttons} buttons" if item.kind == "device" else f"({item.kind})"
+    return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
+
+
+@joystick.command("test")
+@click.option("--joy", "joy", default=None, help="Device, FIFO or file path, script:FILE or replay:FILE "
+              "(default: the first /dev/input/js*).")
+@click.option("--profile", "profile_name", default="auto", show_default=True,
+              help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
+@click.option("--config", "config_path", default=None, help="TOML file whose [profile] table overrides the profile.")
+@click.option("--duration", type=float, default=None, help="Stop after this many seconds.")
+@click.option("--record", "record_path", default=None, help="Also record the session (JSON lines) for replay:FILE.")
+@click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True)
+def test_cmd(joy: str | None, profile_name: str, config_path: str | None, duration: float | None,
+             record_path: str | None, dev_dir: str) -> None:
+    """Show the axes and buttons live, and the flying commands the profile makes of them."""
+    clock = MonotonicClock()
+    try:
+        overrides: dict[str, Any] = read_config(config_path) if config_path else {}
+        source = open_joystick(joy or default_device(dev_dir), clock, dev_dir=dev_dir)
+        profile = load_profile(profile_name, source.name, overrides)
+    except JoystickError as exc:
+        raise click.ClickException(str(exc)) from None
+    if record_path:
+        source = record_to(source, record_path)
+    view = LiveView(sys.stdout) if sys.stdout.isatty() else PlainView(click.echo)
+    try:
+        watch(source, profile, clock, view, duration)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        source.close()
+        view.close()
+
+
+# ---------------------------------------------------------------------------------------------------------- watching
+
+
+def watch(source: JoystickSource, profile: Profile, clock: Clock, view: PlainView | LiveView,
+          duration_s: float | None = None, poll_s: float = 0.05) -> None:
+    """Poll the source and show every change until the duration is over or a virtual source has ended."""
+    view.header(source, profile)
+    mapper = StickMapper(profile)
+    start = clock.now()
+    checked = isinstance(getattr(source, "source", source), TimedSource)  # virtual sticks: no rest check
+    while duration_s is None or clock.now() - start < duration_s:
+        timeout = poll_s if duration_s is None else max(0.0, min(poll_s, duration_s - (clock.now() - start)))
+        state = source.poll(timeout)
+        cmd, _ = mapper.update(state)
+        if not checked and state.connected and state.axes:
+            checked = True
+            for problem in rest_problems(profile, state):
+                view.note(f"warning: {problem}")
+        view.show(state, cmd, start, _error_of(source))
+        if _ended(source):
+            break
+
+
+def _ended(source: JoystickSource) -> bool:
+    inner = getattr(source, "source", source)  # a RecordingSource wraps the real one
+    return isinstance(inner, TimedSource) and inner.ended
+
+
+def _error_of(source: JoystickSource) -> str:
+    inner = getattr(source, "source", source)
+    err = inner.last_error if isinstance(inner, JsDevice) else None
+    return str(err) if err is not None else ""
+
+
+def _sticks(cmd: StickCommand) -> str:
+    up = "  --" if cmd.up is None else f"{cmd.up:+.2f}"
+    text = f"forward={cmd.forward:+.2f} right={cmd.right:+.2f} up={up} yaw={cmd.yaw:+.2f}"
+    if cmd.throttle_abs is not None:
+        text += f" throttle={cmd.throttle_abs:.2f}"
+    return text
+
+
+def _pressed(cmd: StickCommand) -> str:
+    held = dict(cmd.held_s)
+    names = [f"{a.value}({held.get(a, 0.0):.1f}s)" for a in sorted(cmd.pressed, key=lambda a: a.value)]
+    if cmd.deadman_ok is not None:
+        names.append("deadman-ok" if cmd.deadman_ok else "deadman-released")
+    return ",".join(names) or "-"
+
+
+class PlainView:
+    """One line per change (buttons, connection, or an axis), for pipes, logs and tests."""
+
+    def __init__(self, echo: Callable[[str], None]) -> None:
+        self.echo = echo
+        self._last: tuple[Any, ...] | None = None
+
+    def header(self, source: JoystickSource, profile: Profile) -> None:
+        self.echo(f"{source.name} ({source.path}), profile {profile.name}")
+
+    def note(self, text: str) -> None:
+        self.echo(text)
+
+    def show(self, state: JoyState, cmd: StickCommand, start_s: float, error: str) -> None:
+        key = (state.axes, state.buttons, state.connected)
+        if key == self._last:
+            return
+        self._last = key
+        if not state.connected:
+            self.echo(f"t={state.time_s - start_s:.2f} disconnected {error}".rstrip())
+            return
+        self.echo(f"t={state.time_s - start_s:.2f} axes={list(state.axes)} buttons={list(state.buttons)} "
+                  f"{_sticks(cmd)} pressed={_pressed(cmd)}")
+
+    def close(self) -> None:
+        pass
+
+
+class LiveView:
+    """A block of lines redrawn in place on a terminal, at most 20 times a second."""
+
+    def __init__(self, out: TextIO) -> None:
+        self.out = out
+        self._lines = 0
+        self._next_draw_s = 0.0
+
+    def header(self, source: JoystickSource, profile: Profile) -> None:
+        self.out.write(f"{source.name} ({source.path}), profile {profile.name}; Ctrl-C to quit\n")
+
+    def note(self, text: str) -> None:
+        self._erase()
+        self.out.write(text + "\n")
+
+    def show(self, state: JoyState, cmd: StickCommand, start_s: float, error: str) -> None:
+        if state.time_s < self._next_draw_s:
+            return
+        self._next_draw_s = state.time_s + 0.05
+        axes = " ".join(f"{i}:{v / 32767:+.2f}" for i, v in enumerate(state.axes)) or "(none yet)"
+        buttons = " ".join(f"{i}:{v}" for i, v in enumerate(state.buttons)) or "(none yet)"
+        status = "connected" if state.connected else f"DISCONNECTED {error}".rstrip()
+        self._draw([f"t={state.time_s - start_s:7.2f}  {status}", f"axes     {axes}", f"buttons  {buttons}",
+                    f"flying   {_sticks(cmd)}", f"pressed  {_pressed(cmd)}"])
+
+    def close(self) -> None:
+        self.out.write("\n")
+        self.out.flush()
+
+    def _erase(self) -> None:
+        if self._lines:
+            self.out.write(f"\x1b[{self._lines}F\x1b[J")
+            self._lines = 0
+
+    def _draw(self, lines: list[str]) -> None:
+        self._erase()
+        self.out.write("\n".join(lines) + "\n")
+        self.out.flush()
+        self._lines = len(lines)
