@@ -1,0 +1,228 @@
+"""The multicopter control cascade the vehicle calls every physics tick.
+
+trajectory setpoint -> PositionControl (with TakeoffHandling, as MulticopterPositionControl.cpp wraps it)
+-> attitude setpoint -> AttitudeControl -> rate setpoint -> RateControl -> torque -> quad-X mixer -> motors 0..1.
+An offboard attitude/rate setpoint (SET_ATTITUDE_TARGET) bypasses position control (PX4 then skips the takeoff
+ramp: updateTakeoffState(..., skip_takeoff=true)). The estimate is the true state.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from sitl_emu.control.attitude import AttitudeControl, AttitudeControlSettings
+from sitl_emu.control.hover import HoverThrustEstimator
+from sitl_emu.control.mixer import mix
+from sitl_emu.control.position import (
+    PositionControl,
+    PositionControlSettings,
+    PositionLimits,
+    PositionOutput,
+)
+from sitl_emu.control.qmath import yaw_from_q
+from sitl_emu.control.rate import RateControl, RateControlSettings
+from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState
+from sitl_emu.params import ParamRegistry
+from sitl_emu.physics import RigidBodyState
+from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint, Vec3, Vec4
+
+IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, 100.0))  # "no thrust" (not yet taken off)
+TILT_SLEW_RAD_S = 0.2  # MulticopterPositionControl _tilt_limit_slew_rate
+ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class CascadeSettings:
+    position: PositionControlSettings
+    attitude: AttitudeControlSettings
+    rate: RateControlSettings
+    spoolup_time_s: float = 1.0
+    tko_ramp_t_s: float = 3.0
+
+    @classmethod
+    def from_params(cls, reg: ParamRegistry) -> CascadeSettings:
+        spool = reg.get("COM_SPOOLUP_TIME") if "COM_SPOOLUP_TIME" in reg else 1.0
+        return cls(PositionControlSettings.from_params(reg), AttitudeControlSettings.from_params(reg),
+                   RateControlSettings.from_params(reg), spool, reg.get("MPC_TKO_RAMP_T"))
+
+
+class MulticopterControl:
+    """Position/attitude/rate cascade plus mixer, rebuilt from the registry whenever `registry.version` changes."""
+
+    def __init__(self, registry: ParamRegistry) -> None:
+        self._registry = registry
+        self._version = -1
+        self.position = PositionControl()
+        self.attitude = AttitudeControl()
+        self.rate = RateControl()
+        self.takeoff = TakeoffHandling()
+        self.hte = HoverThrustEstimator()
+        self._refresh()
+        self.reset()
+
+    # --- telemetry -------------------------------------------------------------------------------------------
+    @property
+    def local_setpoint(self) -> TrajectorySetpoint | None:
+        return self._local_setpoint
+
+    @property
+    def attitude_setpoint_q_wxyz(self) -> Vec4 | None:
+        return self._q_sp
+
+    @property
+    def rates_setpoint_rad_s(self) -> Vec3:
+        return self._rates_sp
+
+    @property
+    def thrust_setpoint(self) -> float:
+        return self._thrust
+
+    @property
+    def hover_thrust(self) -> float:
+        return self.position.hover_thrust
+
+    @property
+    def takeoff_state(self) -> str:
+        return self.takeoff.state.name.lower()
+
+    @property
+    def tilt_limit_rad(self) -> float:
+        return self._tilt_limit
+
+    @property
+    def in_failsafe(self) -> bool:
+        return self._in_failsafe
+
+    # --- control -----------------------------------------------------------------------------------------------
+    def reset(self, flying: bool = False) -> None:
+        """Forget integrators and filters; `flying=True` starts in the FLIGHT takeoff state (vehicle already up)."""
+        s = self.settings.position
+        self.position.reset()
+        self.position.set_hover_thrust(s.thr_hover)
+        self.hte.reset(s.thr_hover)
+        self.rate.reset()
+        self._local_setpoint: TrajectorySetpoint | None = None
+        self._q_sp: Vec4 | None = None
+        self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
+        self._thrust = 0.0
+        self._in_failsafe = False
+        self._tilt_limit = s.tilt_max_air_rad if flying else s.tilt_max_lnd_rad
+        self._flying_reset = flying
+        self.takeoff.state = TakeoffState.FLIGHT if flying else TakeoffState.DISARMED
+
+    def update(self, state: RigidBodyState, setpoint: TrajectorySetpoint | None, attitude_sp: AttitudeSetpoint | None,
+               armed: bool, landed: bool, now_us: int, dt_s: float, *, ground_contact: bool = False,
+               speed_up_m_s: float = NAN, speed_down_m_s: float = NAN, speed_xy_m_s: float = NAN,
+               want_takeoff: bool | None = None) -> Vec4:
+        """Motor commands (0..1) for this tick.
+
+        Optional constraints (PX4's vehicle_constraints, set by flight tasks such as takeoff): climb/descent/
+        horizontal speed limits and `want_takeoff`; by default want_takeoff is computed from the setpoint as
+        MulticopterPositionControl does in offboard (section 4.6): a setpoint above the vehicle, or climbing.
+        """
+        self._refresh()
+        if not armed:
+            return self._disarmed(now_us)
+        if self._flying_reset:
+            self.takeoff.update_state(True, landed, False, now_us, skip_takeoff=True)
+            self._flying_reset = False
+        if attitude_sp is not None:
+            self.takeoff.update_state(armed, landed, False, now_us, skip_takeoff=True)
+            q_sp, rates_sp, thrust = self._attitude_mode(state, attitude_sp)
+            self._local_setpoint = None
+        elif setpoint is not None:
+            out = self._position_mode(state, setpoint, landed, ground_contact, now_us, dt_s,
+                                      (speed_up_m_s, speed_down_m_s, speed_xy_m_s), want_takeoff)
+            q_sp, thrust = out.q_sp, out.collective
+            rates_sp = self.attitude.update(state.q_wxyz, q_sp, out.yawspeed_sp_rad_s)
+        else:
+            self.takeoff.update_state(armed, landed, False, now_us)
+            self._idle()
+            return ZERO4
+        self._q_sp, self._rates_sp, self._thrust = q_sp, rates_sp, thrust
+        return self._rates_to_motors(state, rates_sp, thrust, landed, dt_s)
+
+    def _rates_to_motors(self, state: RigidBodyState, rates_sp: Vec3, thrust: float, landed: bool,
+                         dt_s: float) -> Vec4:
+        torque = self.rate.update(state.rates_frd_rad_s, rates_sp, dt_s, landed, self._sat_pos, self._sat_neg)
+        motors, self._sat_pos, self._sat_neg = mix(torque, thrust)
+        return motors
+
+    def _disarmed(self, now_us: int) -> Vec4:
+        if self.takeoff.state != TakeoffState.DISARMED or self._thrust != 0.0:
+            self.reset()
+        self.takeoff.update_state(False, True, False, now_us)
+        return ZERO4
+
+    def _idle(self) -> None:
+        self.position.reset_integral()
+        self.rate.reset()
+        self._local_setpoint, self._q_sp, self._rates_sp, self._thrust = None, None, (0.0, 0.0, 0.0), 0.0
+
+    def _attitude_mode(self, state: RigidBodyState, sp: AttitudeSetpoint) -> tuple[Vec4 | None, Vec3, float]:
+        thrust = -sp.thrust_body[2] if math.isfinite(sp.thrust_body[2]) else 0.0
+        thrust = min(1.0, max(0.0, thrust))
+        if sp.q_wxyz is not None:
+            yaw_ff = sp.body_rates_rad_s[2] if math.isfinite(sp.body_rates_rad_s[2]) else 0.0
+            return sp.q_wxyz, self.attitude.update(state.q_wxyz, sp.q_wxyz, yaw_ff), thrust
+        r = sp.body_rates_rad_s
+        rates = (r[0] if math.isfinite(r[0]) else 0.0, r[1] if math.isfinite(r[1]) else 0.0,
+                 r[2] if math.isfinite(r[2]) else 0.0)
+        return None, rates, thrust
+
+    def _position_mode(self, state: RigidBodyState, sp: TrajectorySetpoint, landed: bool, ground_contact: bool,
+                       now_us: int, dt_s: float, speeds: Vec3, want_takeoff: bool | None) -> PositionOutput:
+        s = self.settings.position
+        if want_takeoff is None:
+            want_takeoff = landed and _setpoint_wants_takeoff(sp, state.pos_ned_m[2])
+        tko = self.takeoff.update_state(True, landed, want_takeoff, now_us)
+        flying = tko >= TakeoffState.FLIGHT
+        if not flying:
+            sp = _without_acc_z(sp)
+            self.position.set_hover_thrust(s.thr_hover)
+        if tko < TakeoffState.RAMPUP or (flying and ground_contact):
+            sp = IDLE_SETPOINT
+            self.position.reset_integral()
+        target = s.tilt_max_lnd_rad if tko < TakeoffState.FLIGHT else s.tilt_max_air_rad
+        step = TILT_SLEW_RAD_S * dt_s
+        self._tilt_limit = max(self._tilt_limit - step, min(self._tilt_limit + step, target))
+        up, dn, xy = (v if math.isfinite(v) else d for v, d in zip(speeds, (s.vel_max_up, s.vel_max_dn, s.vel_max_xy),
+                                                                    strict=True))
+        limits = PositionLimits(vel_xy=min(max(xy, 0.0), s.vel_max_xy),
+                                vel_up=min(self.takeoff.update_ramp(dt_s, min(up, s.vel_max_up)), s.vel_max_up),
+                                vel_dn=max(dn, 0.0), tilt_rad=self._tilt_limit,
+                                thr_min=s.thr_min if flying else 0.0, thr_max=s.thr_max)
+        yaw = yaw_from_q(state.q_wxyz)
+        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw, sp, limits, dt_s, now_us)
+        self._in_failsafe = out.in_failsafe
+        self._local_setpoint = out.local_setpoint
+        if flying and not landed and s.use_hte:
+            est = self.hte.update(-out.thrust_ned[2], -state.acc_ned_m_s2[2], state.vel_ned_m_s[2], dt_s)
+            self.position.update_hover_thrust(est, out.local_setpoint.acceleration_ned_m_s2[2])
+        return out
+
+    def _refresh(self) -> None:
+        if self._registry.version == self._version:
+            return
+        self._version = self._registry.version
+        self.settings = CascadeSettings.from_params(self._registry)
+        self.position.settings = self.settings.position
+        self.attitude.settings = self.settings.attitude
+        self.rate.settings = self.settings.rate
+        self.takeoff.configure(self.settings.spoolup_time_s, self.settings.tko_ramp_t_s,
+                               self.settings.position.vel_p[2])
+        self._sat_pos = self._sat_neg = (False, False, False)
+
+
+def _setpoint_wants_takeoff(sp: TrajectorySetpoint, z_m: float) -> bool:
+    """MulticopterPositionControl offboard want_takeoff: setpoint above us, or climbing."""
+    pz, vz, az = sp.position_ned_m[2], sp.velocity_ned_m_s[2], sp.acceleration_ned_m_s2[2]
+    return (math.isfinite(pz) and pz < z_m) or (math.isfinite(vz) and vz < 0.0) or (math.isfinite(az) and az < 0.0)
+
+
+def _without_acc_z(sp: TrajectorySetpoint) -> TrajectorySetpoint:
+    a = sp.acceleration_ned_m_s2
+    if not math.isfinite(a[2]):
+        return sp
+    return TrajectorySetpoint(sp.position_ned_m, sp.velocity_ned_m_s, (a[0], a[1], NAN), sp.yaw_rad, sp.yawspeed_rad_s)

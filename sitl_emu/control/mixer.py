@@ -1,0 +1,81 @@
+"""Quad-X control allocation after PX4's ControlAllocationSequentialDesaturation (MC_AIRMODE 0).
+
+The effectiveness matrix of the 10040_sihsim_quadx airframe, pseudo-inverted and normalised as PX4 does
+(ControlAllocationPseudoInverse::updateControlAllocationMatrixScale), gives for rotors r0 front-right, r1 rear-left,
+r2 front-left, r3 rear-right:
+    u_i = T + R_i * roll + P_i * pitch + Y_i * yaw   with R = 0.707 (-1, +1, +1, -1), P = 0.707 (+1, -1, +1, -1),
+    Y = (+1, +1, -1, -1)
+which matches the SIH moments (physics.py): a positive normalised torque produces a positive body moment.
+Saturation (mixAirmodeDisabled): mix roll/pitch/thrust, only reduce thrust to unsaturate, then reduce roll and pitch;
+then add yaw, reduce yaw (with 15 % headroom above the maximum), and reduce thrust again. Outputs clipped to 0..1.
+"""
+
+from __future__ import annotations
+
+import math
+
+from sitl_emu.types import Vec3, Vec4
+
+_K = 1.0 / math.sqrt(2.0)
+ROLL = (-_K, _K, _K, -_K)
+PITCH = (_K, -_K, _K, -_K)
+YAW = (1.0, 1.0, -1.0, -1.0)
+THRUST = (1.0, 1.0, 1.0, 1.0)
+
+
+def _desat_gain(vec: Vec4, u: list[float], lo: float, hi: float) -> float:
+    """ControlAllocationSequentialDesaturation::computeDesaturationGain."""
+    k_min = k_max = 0.0
+    for i in range(4):
+        d = vec[i]
+        if abs(d) < 1.2e-7:
+            continue
+        if u[i] < lo:
+            k = (lo - u[i]) / d
+            k_min, k_max = min(k_min, k), max(k_max, k)
+        if u[i] > hi:
+            k = (hi - u[i]) / d
+            k_min, k_max = min(k_min, k), max(k_max, k)
+    return k_min + k_max
+
+
+def _desaturate(u: list[float], vec: Vec4, lo: float, hi: float, reduce_only: bool = False) -> None:
+    gain = _desat_gain(vec, u, lo, hi)
+    if reduce_only and gain > 0.0:
+        return
+    for i in range(4):
+        u[i] += gain * vec[i]
+    gain = 0.5 * _desat_gain(vec, u, lo, hi)
+    for i in range(4):
+        u[i] += gain * vec[i]
+
+
+def mix(torque: Vec3, thrust: float) -> tuple[Vec4, tuple[bool, bool, bool], tuple[bool, bool, bool]]:
+    """Motor commands 0..1 for normalised torque (roll, pitch, yaw) and collective thrust 0..1.
+
+    Also returns per-axis positive/negative saturation flags (the torque achieved fell short of the demand), which
+    the rate controller uses to stop integrating into the saturation.
+    """
+    roll, pitch, yaw = (t if math.isfinite(t) else 0.0 for t in torque)
+    thrust = thrust if math.isfinite(thrust) else 0.0
+    u = [thrust + ROLL[i] * roll + PITCH[i] * pitch for i in range(4)]
+    _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
+    _desaturate(u, ROLL, 0.0, 1.0)
+    _desaturate(u, PITCH, 0.0, 1.0)
+    for i in range(4):
+        u[i] += YAW[i] * yaw
+    _desaturate(u, YAW, 0.0, 1.15)
+    _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
+    out = tuple(0.0 if v < 0.0 else (1.0 if v > 1.0 else v) for v in u)
+    achieved = allocated_torque(out)  # type: ignore[arg-type]
+    demand = (roll, pitch, yaw)
+    pos = tuple(achieved[i] < demand[i] - 1e-4 for i in range(3))
+    neg = tuple(achieved[i] > demand[i] + 1e-4 for i in range(3))
+    return out, pos, neg  # type: ignore[return-value]
+
+
+def allocated_torque(u: Vec4) -> Vec3:
+    """Normalised torque that motor commands u produce (inverse of the mix above)."""
+    return (sum(ROLL[i] * u[i] for i in range(4)) / (4 * _K * _K),
+            sum(PITCH[i] * u[i] for i in range(4)) / (4 * _K * _K),
+            sum(YAW[i] * u[i] for i in range(4)) / 4.0)

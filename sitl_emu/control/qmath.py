@@ -1,0 +1,142 @@
+"""Small quaternion and vector helpers on plain float tuples (w-first quaternions, NED/FRD frames).
+
+Semantics follow PX4's matrix library (src/lib/matrix/matrix/Quaternion.hpp): Hamilton product, q rotates body
+vectors into the world frame, `dcm_z` is the body z axis expressed in the world frame.
+"""
+
+from __future__ import annotations
+
+import math
+
+from sitl_emu.types import Vec3, Vec4
+
+
+def q_mul(a: Vec4, b: Vec4) -> Vec4:
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw)
+
+
+def q_inv(q: Vec4) -> Vec4:
+    """Inverse of a unit quaternion (its conjugate)."""
+    return q[0], -q[1], -q[2], -q[3]
+
+
+def q_normalized(q: Vec4) -> Vec4:
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if not n > 0.0:
+        return 1.0, 0.0, 0.0, 0.0
+    return q[0] / n, q[1] / n, q[2] / n, q[3] / n
+
+
+def q_canonical(q: Vec4) -> Vec4:
+    """The same rotation with a non-negative scalar part (PX4 Quaternion::canonical)."""
+    return q if q[0] >= 0.0 else (-q[0], -q[1], -q[2], -q[3])
+
+
+def dcm_z(q: Vec4) -> Vec3:
+    """Third column of the rotation matrix: the body z axis in the world frame."""
+    w, x, y, z = q
+    return 2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)
+
+
+def q_from_two_vectors(src: Vec3, dst: Vec3) -> Vec4:
+    """Shortest rotation taking src onto dst (PX4 Quaternion(src, dst) constructor)."""
+    cx, cy, cz = cross(src, dst)
+    d = dot(src, dst)
+    if math.sqrt(cx * cx + cy * cy + cz * cz) < 1e-5 and d < 0.0:
+        # 180 degrees: rotate about any axis orthogonal to src
+        ax, ay, az = abs(src[0]), abs(src[1]), abs(src[2])
+        if ax < ay:
+            axis = (1.0, 0.0, 0.0) if ax < az else (0.0, 0.0, 1.0)
+        else:
+            axis = (0.0, 1.0, 0.0) if ay < az else (0.0, 0.0, 1.0)
+        cx, cy, cz = cross(src, axis)
+        return q_normalized((0.0, cx, cy, cz))
+    return q_normalized((d + math.sqrt(dot(src, src) * dot(dst, dst)), cx, cy, cz))
+
+
+def q_from_dcm_columns(bx: Vec3, by: Vec3, bz: Vec3) -> Vec4:
+    """Quaternion of the rotation matrix whose columns are bx, by, bz (Shepperd's method, as PX4's Dcm->Quat)."""
+    r00, r11, r22 = bx[0], by[1], bz[2]
+    tr = r00 + r11 + r22
+    if tr > 0.0:
+        s = math.sqrt(tr + 1.0)
+        w = 0.5 * s
+        s = 0.5 / s
+        return q_normalized((w, (by[2] - bz[1]) * s, (bz[0] - bx[2]) * s, (bx[1] - by[0]) * s))
+    if r00 >= r11 and r00 >= r22:
+        s = math.sqrt(1.0 + r00 - r11 - r22)
+        x = 0.5 * s
+        s = 0.5 / s
+        return q_normalized(((by[2] - bz[1]) * s, x, (by[0] + bx[1]) * s, (bx[2] + bz[0]) * s))
+    if r11 >= r22:
+        s = math.sqrt(1.0 + r11 - r00 - r22)
+        y = 0.5 * s
+        s = 0.5 / s
+        return q_normalized(((bz[0] - bx[2]) * s, (by[0] + bx[1]) * s, y, (bz[1] + by[2]) * s))
+    s = math.sqrt(1.0 + r22 - r00 - r11)
+    z = 0.5 * s
+    s = 0.5 / s
+    return q_normalized(((bx[1] - by[0]) * s, (bx[2] + bz[0]) * s, (bz[1] + by[2]) * s, z))
+
+
+def q_from_yaw(yaw_rad: float) -> Vec4:
+    return math.cos(yaw_rad / 2.0), 0.0, 0.0, math.sin(yaw_rad / 2.0)
+
+
+def q_from_euler(roll_rad: float, pitch_rad: float, yaw_rad: float) -> Vec4:
+    cr, sr = math.cos(roll_rad / 2.0), math.sin(roll_rad / 2.0)
+    cp, sp = math.cos(pitch_rad / 2.0), math.sin(pitch_rad / 2.0)
+    cy, sy = math.cos(yaw_rad / 2.0), math.sin(yaw_rad / 2.0)
+    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
+
+
+def euler_from_q(q: Vec4) -> Vec3:
+    """(roll, pitch, yaw) in radians, ZYX convention as PX4's Eulerf."""
+    w, x, y, z = q
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+def yaw_from_q(q: Vec4) -> float:
+    w, x, y, z = q
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def tilt_from_q(q: Vec4) -> float:
+    """Angle between the body z axis and the world down axis, in radians."""
+    return math.acos(max(-1.0, min(1.0, dcm_z(q)[2])))
+
+
+def rotate_world_to_body(q: Vec4, v: Vec3) -> Vec3:
+    """R^T v."""
+    return q_mul(q_mul(q_inv(q), (0.0, *v)), q)[1:]  # type: ignore[return-value]
+
+
+def dot(a: Vec3, b: Vec3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a: Vec3, b: Vec3) -> Vec3:
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+
+
+def norm(a: Vec3) -> float:
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+def normalized(a: Vec3) -> Vec3:
+    n = norm(a)
+    return (a[0] / n, a[1] / n, a[2] / n) if n > 0.0 else (0.0, 0.0, 0.0)
+
+
+def constrain(v: float, lo: float, hi: float) -> float:
+    """Like PX4's math::constrain: NaN passes through."""
+    return lo if v < lo else (hi if v > hi else v)
