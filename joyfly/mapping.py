@@ -1,7 +1,8 @@
 """Raw js axes and buttons -> StickCommand: deadzone with rescale, expo, invert, scale; button hold timing.
 
 Everything here is pure and deterministic: the time comes from JoyState.time_s, hold timers from the previous
-StickCommand. `StickMapper` is the small stateful convenience that keeps the previous command for you.
+StickCommand. `StickMapper` is the small stateful convenience that keeps the previous command for you, and
+`open_sticks()` / `MappedSource` give the flight side a source of StickCommands in one call.
 
 Per axis (AxisMap): x = raw / 32767, negated when `invert`; then the deadzone, rescaled so the output still reaches
 +-1 (|x| <= dz -> 0, else sign(x) * (|x| - dz) / (1 - dz), as ROS joy does); then expo, x' = (1 - e) x + e x^3
@@ -14,9 +15,15 @@ When the source is disconnected, or a deadman button is configured and released,
 
 from __future__ import annotations
 
-from joyfly.joystick import AXIS_MAX
-from joyfly.profiles import AxisMap, Profile
-from joyfly.types import Action, JoyState, StickCommand
+from collections.abc import Mapping
+from typing import Any
+
+from joyfly.joystick import AXIS_MAX, JoystickError, open_joystick
+from joyfly.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
+from joyfly.virtual import record_to
+
+HOLD_EPS_S = 1e-6  # held times are float sums of poll intervals: 10 x 0.1 s must count as 1 s
 
 
 def normalise(raw: int) -> float:
@@ -123,23 +130,28 @@ def held_for(cmd: StickCommand, action: Action) -> float | None:
     return dict(cmd.held_s).get(action)
 
 
+def _hold_reached(prev: StickCommand, cur: StickCommand, action: Action, hold_s: float) -> bool:
+    """True on the one step where the action's hold time reaches hold_s (hold_s <= 0: on the press edge)."""
+    if action not in prev.pressed:
+        return hold_s <= 0.0 or (held_for(cur, action) or 0.0) >= hold_s - HOLD_EPS_S
+    before_s = held_for(prev, action) or 0.0
+    return before_s < hold_s - HOLD_EPS_S <= (held_for(cur, action) or 0.0)
+
+
 def fired(prev: StickCommand | None, cur: StickCommand, arm_hold_s: float = 1.0) -> frozenset[Action]:
     """Actions to perform now: ARM once when its hold reaches arm_hold_s; the others on the press edge.
 
-    DEADMAN never fires (read cur.deadman_ok). With prev None (the first state) nothing fires on a press edge, so a
-    button already down when the program starts does nothing until pressed again; ARM still counts its hold.
+    DEADMAN never fires (read cur.deadman_ok). With prev None (the first state) nothing fires, so a button already
+    down when the program starts does nothing at once (ARM still counts its hold from there).
     """
+    if prev is None:
+        return frozenset()
     out: set[Action] = set()
     for action in cur.pressed:
-        if action is Action.DEADMAN:
-            continue
-        was_pressed = prev is not None and action in prev.pressed
         if action is Action.ARM:
-            now_s = held_for(cur, action) or 0.0
-            before_s = (held_for(prev, action) or 0.0) if prev is not None and was_pressed else -1.0
-            if before_s < arm_hold_s <= now_s or (arm_hold_s <= 0.0 and not was_pressed and prev is not None):
+            if _hold_reached(prev, cur, action, arm_hold_s):
                 out.add(action)
-        elif prev is not None and not was_pressed:
+        elif action is not Action.DEADMAN and action not in prev.pressed:
             out.add(action)
     return frozenset(out)
 
@@ -156,3 +168,50 @@ class StickMapper:
         actions = fired(self.prev, cmd, self.profile.arm_hold_s)
         self.prev = cmd
         return cmd, actions
+
+
+class MappedSource:
+    """A joystick source seen through a profile: poll() returns StickCommands (the flight side's stick source).
+
+    `last_state` is the raw JoyState behind the last command and `last_actions` the actions that fired on it
+    (ARM after its hold, the others on their press edge), for callers that do not track edges themselves.
+    """
+
+    def __init__(self, source: JoystickSource, profile: Profile) -> None:
+        self.source = source
+        self.profile = profile
+        self.name = source.name
+        self.path = source.path
+        self._mapper = StickMapper(profile)
+        self.last_state: JoyState | None = None
+        self.last_actions: frozenset[Action] = frozenset()
+
+    def poll(self, timeout_s: float) -> StickCommand:
+        state = self.source.poll(timeout_s)
+        cmd, self.last_actions = self._mapper.update(state)
+        self.last_state = state
+        return cmd
+
+    def rest_problems(self) -> list[str]:
+        """Stick roles off centre in the last state (see profiles.rest_problems); [] before any data."""
+        state = self.last_state
+        return [] if state is None or not state.axes else rest_problems(self.profile, state)
+
+    def close(self) -> None:
+        self.source.close()
+
+
+def open_sticks(spec: str, clock: Clock | None = None, profile: str = "auto",
+                overrides: Mapping[str, Any] | None = None, record: str | None = None,
+                dev_dir: str = "/dev/input") -> MappedSource:
+    """One call for `joyfly fly`: open `--joy` (path, script:, replay:), pick the profile (`--profile`, the config's
+    `[profile]` table), optionally `--record`, and map. Raises JoystickError (one sentence) on any problem."""
+    source = open_joystick(spec, clock, dev_dir=dev_dir)
+    try:
+        chosen = load_profile(profile, source.name, overrides)
+    except JoystickError:
+        source.close()
+        raise
+    if record:
+        source = record_to(source, record)
+    return MappedSource(source, chosen)

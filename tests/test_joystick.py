@@ -194,3 +194,17 @@ def test_list_devices_reports_each_node(tmp_path):
     found = list_devices(str(tmp_path))
     assert [d.path for d in found] == [str(tmp_path / n) for n in ("js0", "js2", "js10")]
     assert all(d.kind == "fifo" and d.axes == 0 for d in found)
+
+
+def test_init_burst_after_a_queue_overflow_replaces_the_state(tmp_path):
+    path = tmp_path / "events.bin"
+    # button 0 pressed and axis 1 pushed; then the queue overflows while they are released: the kernel re-sends
+    # the whole state as INIT events, which must win over the stale values.
+    path.write_bytes(
+        init_burst([0, 0], [0])
+        + pack_event(JS_EVENT_BUTTON, 0, 1)
+        + pack_event(JS_EVENT_AXIS, 1, -32767)
+        + init_burst([0, 0], [0])
+    )
+    state = open_joystick(str(path), FakeClock()).poll(0.0)
+    assert state.axes == (0, 0) and state.buttons == (0,)

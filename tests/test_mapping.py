@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import pytest
 
-from joyfly.mapping import StickMapper, apply_deadzone, apply_expo, fired, map_state, shape_axis
+from joyfly.joystick import JoystickError
+from joyfly.mapping import StickMapper, apply_deadzone, apply_expo, fired, map_state, open_sticks, shape_axis
 from joyfly.profiles import AxisMap, get_profile, load_profile
 from joyfly.types import Action, JoyState, StickCommand
 
@@ -213,3 +214,40 @@ def test_deadman_released_neutralises_the_sticks():
     held = map_state(profile, JoyState(0.0, tuple(axes), tuple(lb)))
     assert held.deadman_ok is True and held.forward == 1.0
     assert map_state(get_profile("xbox"), JoyState(0.0, tuple(axes), (0,) * 11)).deadman_ok is None
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.t_s = 0.0
+
+    def now(self) -> float:
+        return self.t_s
+
+    def sleep(self, seconds: float) -> None:
+        self.t_s += max(0.0, seconds)
+
+
+def test_open_sticks_gives_stick_commands_with_fired_actions(tmp_path):
+    script = tmp_path / "s.txt"
+    script.write_text("0 forward=1 arm=1\n1.2 arm=0\n2 end\n")
+    clock = _Clock()
+    sticks = open_sticks(f"script:{script}", clock, overrides={"forward": {"scale": 0.5}}, record=str(tmp_path / "r"))
+    assert sticks.profile.name == "script+config" and sticks.name == "joyfly script"
+    fired_at = []
+    for _ in range(25):
+        cmd = sticks.poll(0.0)
+        if sticks.last_actions:
+            fired_at.append((round(clock.now(), 1), set(sticks.last_actions)))
+        clock.sleep(0.1)
+    assert cmd.connected is False
+    assert fired_at == [(1.0, {Action.ARM})]
+    sticks.close()
+    assert (tmp_path / "r").read_text().count("\n") >= 4  # header, states, end
+
+
+def test_open_sticks_bad_profile_is_one_sentence(tmp_path):
+    script = tmp_path / "s.txt"
+    script.write_text("0 end\n")
+    with pytest.raises(JoystickError) as info:
+        open_sticks(f"script:{script}", _Clock(), profile="nope")
+    assert str(info.value).startswith("Unknown profile 'nope'")
