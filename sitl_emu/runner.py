@@ -51,6 +51,8 @@ class RealTimeRunner:
         start_wall = time.monotonic()
         fds = [fd for node in self.nodes for fd in node.filenos()]
         while not self._stop.is_set():
+            if lead.time_us < start_sim_us:  # rebooted: simulated time restarted at 0
+                start_sim_us, start_wall = int(lead.time_us), time.monotonic()
             target_us = start_sim_us + int((time.monotonic() - start_wall) * 1e6 * self.speed)
             if end_us is not None:
                 target_us = min(target_us, end_us)

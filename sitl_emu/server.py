@@ -63,6 +63,7 @@ class VehicleNode:
         self._event_seq = -1
         self._snapshot: VehicleSnapshot | None = None
         self._snapshot_time_us = -1
+        self._last_now_us = -1
 
     @property
     def sysid(self) -> int:
@@ -82,6 +83,10 @@ class VehicleNode:
     # --- the one call a runner makes -----------------------------------------------------------------------------
     def step_io(self, now_us: int) -> int:
         """Handle what arrived, then send what is due at `now_us`. Returns the number of datagrams read."""
+        if now_us < self._last_now_us:  # the vehicle rebooted (time starts again at 0): restart the schedules
+            for ep in self.endpoints:
+                ep.restart()
+        self._last_now_us = now_us
         received = 0
         for ep in self.endpoints:
             received += ep.poll(now_us, IO_BUDGET_DATAGRAMS)

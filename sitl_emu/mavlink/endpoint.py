@@ -181,6 +181,11 @@ class Endpoint:
                 self.stats.handler_errors += 1
                 log.exception("%s link: error in %s.tick", self.link_name, type(handler).__name__)
 
+    def restart(self) -> None:
+        """After a vehicle reboot: streams restart from time 0 at their current rates; the GCS must be heard again."""
+        self.streams.restart()
+        self.last_gcs_heartbeat_us = None
+
     def close(self) -> None:
         self.link.close()
 

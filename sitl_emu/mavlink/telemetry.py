@@ -9,12 +9,15 @@ A stream whose builder returns None (no data, e.g. HOME_POSITION before home is 
 from __future__ import annotations
 
 import enum
+import logging
 from collections.abc import Sequence
 from typing import Any
 
 from sitl_emu.mavlink import telemetry_msgs as tm
 from sitl_emu.mavlink.version import autopilot_version, protocol_version
 from sitl_emu.types import VehicleEvent, VehicleSnapshot
+
+log = logging.getLogger(__name__)
 
 HEARTBEAT_ID = 0
 HEARTBEAT_INTERVAL_US = 1_000_000
@@ -81,6 +84,11 @@ class Streams:
         self._next_us: dict[int, int] = {}
         self._next_heartbeat_us = 0
         self._statustext_id = 0
+        self.build_errors = 0
+
+    def restart(self) -> None:
+        self._next_us.clear()
+        self._next_heartbeat_us = 0
 
     # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
     def known(self, msg_id: int) -> bool:
@@ -126,11 +134,20 @@ class Streams:
             if now < due:
                 continue
             self._next_us[msg_id] = _next_due(due, interval, now)
-            msg = BUILDERS[msg_id](ctx, snap)
+            msg = self._safe_build(msg_id, ctx, snap)
             if msg is not None:
                 ctx.send(msg)
                 sent += 1
         return sent
+
+    def _safe_build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
+        try:
+            return BUILDERS[msg_id](ctx, snap)
+        except Exception:  # a bad snapshot value must cost one message, not the link
+            self.build_errors += 1
+            if self.build_errors == 1:
+                log.exception("cannot build message %d", msg_id)
+            return None
 
     def send_statustexts(self, ctx: Any, events: Sequence[VehicleEvent]) -> None:
         """STATUSTEXT.hpp: one id per message, chunks of 50 chars with chunk_seq, nothing older than 5 s."""
