@@ -30,6 +30,9 @@ from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint, Vec3, Vec4
 IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, 100.0))  # "no thrust" (not yet taken off)
 TILT_SLEW_RAD_S = 0.2  # MulticopterPositionControl _tilt_limit_slew_rate
 ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
+# mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
+# Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
+POSITION_PERIOD_US = 8000
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,6 +110,8 @@ class MulticopterControl:
         self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
         self._thrust = 0.0
         self._in_failsafe = False
+        self._pos_out: PositionOutput | None = None
+        self._pos_last_us = 0
         self._tilt_limit = s.tilt_max_air_rad if flying else s.tilt_max_lnd_rad
         self._flying_reset = flying
         self.takeoff.state = TakeoffState.FLIGHT if flying else TakeoffState.DISARMED
@@ -127,13 +132,19 @@ class MulticopterControl:
         if self._flying_reset:
             self.takeoff.update_state(True, landed, False, now_us, skip_takeoff=True)
             self._flying_reset = False
+        if setpoint is None:
+            self._pos_out = None
         if attitude_sp is not None:
             self.takeoff.update_state(armed, landed, False, now_us, skip_takeoff=True)
             q_sp, rates_sp, thrust = self._attitude_mode(state, attitude_sp)
             self._local_setpoint = None
         elif setpoint is not None:
-            out = self._position_mode(state, setpoint, landed, ground_contact, now_us, dt_s,
-                                      (speed_up_m_s, speed_down_m_s, speed_xy_m_s), want_takeoff)
+            out = self._pos_out
+            if out is None or now_us - self._pos_last_us >= POSITION_PERIOD_US - dt_s * 0.5e6:
+                pos_dt = dt_s if out is None else min(0.04, max(0.002, (now_us - self._pos_last_us) * 1e-6))
+                out = self._position_mode(state, setpoint, landed, ground_contact, now_us, pos_dt,
+                                          (speed_up_m_s, speed_down_m_s, speed_xy_m_s), want_takeoff)
+                self._pos_out, self._pos_last_us = out, now_us
             q_sp, thrust = out.q_sp, out.collective
             rates_sp = self.attitude.update(state.q_wxyz, q_sp, out.yawspeed_sp_rad_s)
         else:

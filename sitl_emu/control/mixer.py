@@ -21,6 +21,7 @@ ROLL = (-_K, _K, _K, -_K)
 PITCH = (_K, -_K, _K, -_K)
 YAW = (1.0, 1.0, -1.0, -1.0)
 THRUST = (1.0, 1.0, 1.0, 1.0)
+_NO_SAT = (False, False, False)
 
 
 def _desat_gain(vec: Vec4, u: list[float], lo: float, hi: float) -> float:
@@ -58,6 +59,10 @@ def mix(torque: Vec3, thrust: float) -> tuple[Vec4, tuple[bool, bool, bool], tup
     """
     roll, pitch, yaw = (t if math.isfinite(t) else 0.0 for t in torque)
     thrust = thrust if math.isfinite(thrust) else 0.0
+    r, p = _K * roll, _K * pitch
+    fast = (thrust - r + p + yaw, thrust + r - p + yaw, thrust + r + p - yaw, thrust - r - p - yaw)
+    if min(fast) >= 0.0 and max(fast) <= 1.0:  # nothing saturates: the plain mix
+        return fast, _NO_SAT, _NO_SAT
     u = [thrust + ROLL[i] * roll + PITCH[i] * pitch for i in range(4)]
     _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
     _desaturate(u, ROLL, 0.0, 1.0)
