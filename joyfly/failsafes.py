@@ -1,0 +1,129 @@
+"""Small state machines the flight session runs on its clock: the joystick and link watchdogs, and bounded
+command retries that explain a refusal with the vehicle's own words (COMMAND_ACK result + STATUSTEXT)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from joyfly.link import CommandHandle, VehicleLink
+
+# PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
+# (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
+REASON_GRACE_S = 0.25
+WARNING = 4  # MAV_SEVERITY_WARNING: CRITICAL "Arming denied: ..." and friends are below it
+
+
+class LinkWatch:
+    """Reports "lost" once the heartbeat watchdog fails and "back" when it recovers."""
+
+    def __init__(self) -> None:
+        self.ok = False
+
+    def update(self, ok: bool) -> str | None:
+        if ok == self.ok:
+            return None
+        self.ok = ok
+        return "back" if ok else "lost"
+
+
+class JoystickWatch:
+    """Tracks a lost joystick: "lost"/"back" on changes, `expired()` once after `timeout_s` lost."""
+
+    def __init__(self, timeout_s: float) -> None:
+        self.timeout_s = timeout_s
+        self.lost_since: float | None = None
+        self._fired = False
+
+    @property
+    def holding(self) -> bool:
+        return self.lost_since is not None
+
+    def update(self, connected: bool, now_s: float) -> str | None:
+        if connected and self.lost_since is not None:
+            self.lost_since = None
+            self._fired = False
+            return "back"
+        if not connected and self.lost_since is None:
+            self.lost_since = now_s
+            return "lost"
+        return None
+
+    def expired(self, now_s: float) -> bool:
+        if self.lost_since is None or self._fired or now_s - self.lost_since < self.timeout_s:
+            return False
+        self._fired = True
+        return True
+
+
+class Retry:
+    """Send a command until the vehicle's state shows it worked, at most `attempts` times.
+
+    `update()` returns None while in progress, "refused" after a refusal that will be retried, "failed" when the
+    attempts are used up. An ACCEPTED whose effect does not show within `settle_s` counts as a new attempt.
+    """
+
+    def __init__(self, what: str, attempts: int, now_s: float, settle_s: float = 2.0, pause_s: float = 1.0) -> None:
+        self.what = what
+        self.attempts = attempts
+        self.settle_s = settle_s
+        self.pause_s = pause_s
+        self.attempt = 0
+        self.handle: CommandHandle | None = None
+        self.sent_s = now_s
+        self.next_try_s = now_s
+        self.accepted_s: float | None = None
+        self.refused_s: float | None = None
+        self.last_refusal = ""
+
+    def update(self, now_s: float, link: VehicleLink, send: Callable[[], CommandHandle],
+               done: Callable[[], bool]) -> str | None:
+        if done():
+            return None
+        if self.handle is None:
+            return self._maybe_send(now_s, send)
+        if not self.handle.done:
+            return None
+        if self.handle.accepted:
+            return self._after_accept(now_s)
+        return self._after_refusal(now_s, link)
+
+    def _maybe_send(self, now_s: float, send: Callable[[], CommandHandle]) -> str | None:
+        if now_s < self.next_try_s:
+            return None
+        if self.attempt >= self.attempts:
+            return "failed"
+        self.attempt += 1
+        self.handle = send()
+        self.sent_s = now_s
+        return None
+
+    def _after_accept(self, now_s: float) -> str | None:
+        if self.accepted_s is None:
+            self.accepted_s = now_s
+        if now_s - self.accepted_s > self.settle_s:
+            self.handle, self.accepted_s = None, None
+            self.last_refusal = f"{self.what}: the vehicle accepted but its state did not change"
+            return "refused" if self.attempt < self.attempts else "failed"
+        return None
+
+    def _after_refusal(self, now_s: float, link: VehicleLink) -> str | None:
+        if self.refused_s is None:
+            self.refused_s = now_s
+        if now_s - self.refused_s < REASON_GRACE_S:
+            return None
+        assert self.handle is not None
+        self.last_refusal = f"{self.what} refused by the vehicle ({self.handle.describe()}): {self._reason(link)}."
+        if self.handle.timed_out:
+            self.last_refusal = f"{self.what}: no answer from the vehicle."
+        self.handle, self.refused_s = None, None
+        self.next_try_s = now_s + self.pause_s
+        return "refused" if self.attempt < self.attempts else "failed"
+
+    def _reason(self, link: VehicleLink) -> str:
+        texts = [t for t in link.statustexts if t.time_s >= self.sent_s - 0.05]
+        serious = [t.text for t in texts if t.severity <= WARNING]
+        chosen = serious or [t.text for t in texts]
+        return "; ".join(dict.fromkeys(chosen)) if chosen else "the vehicle gave no reason"
+
+    def failure_message(self) -> str:
+        return f"{self.what} failed after {self.attempt} attempt(s). {self.last_refusal}"
