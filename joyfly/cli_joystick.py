@@ -23,7 +23,7 @@ from joyfly.joystick import (
     open_joystick,
 )
 from joyfly.mapping import StickMapper
-from joyfly.profiles import Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
 from joyfly.virtual import TimedSource, record_to
 
@@ -55,6 +55,17 @@ def _device_line(item: DeviceInfo | JoystickError) -> str:
     profile = load_profile("auto", item.name, {})
     counts = f"{item.axes} axes, {item.buttons} buttons" if item.kind == "device" else f"({item.kind})"
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
+
+
+@joystick.command("profiles")
+def profiles_cmd() -> None:
+    """The built-in controller profiles, the device names they match, and their layout."""
+    for profile in BUILTIN:
+        axes = ", ".join(f"{role}={ax.index}{' inverted' if ax.invert else ''}" for role, ax in profile.axes.items())
+        buttons = ", ".join(f"{a.value}={i}" for a, i in profile.buttons.items())
+        click.echo(f"{profile.name}: {profile.description}")
+        click.echo(f"    matches {' | '.join(profile.match)}")
+        click.echo(f"    axes {axes}; buttons {buttons}" + (f"; {profile.notes}" if profile.notes else ""))
 
 
 @joystick.command("test")

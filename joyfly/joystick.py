@@ -60,25 +60,37 @@ class JoystickError(Exception):
     """A joystick problem a user can fix; str() is one sentence saying what happened and what to do."""
 
 
+class NoDeviceError(JoystickError):
+    """Nothing at the path (lists the js devices that do exist, or says there are none)."""
+
+
+class PermissionDeniedError(JoystickError):
+    """The device exists but we may not read it."""
+
+
+class DeviceVanishedError(JoystickError):
+    """The device went away while in use (unplugged, out of radio range)."""
+
+
 def no_such_device_error(path: str, dev_dir: str = "/dev/input") -> JoystickError:
     others = [p for p in find_device_paths(dev_dir) if p != path]
     if others:
-        return JoystickError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
-    return JoystickError(
+        return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
+    return NoDeviceError(
         f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a virtual one with "
         "--joy script:examples/joystick_script.txt."
     )
 
 
 def permission_error(path: str) -> JoystickError:
-    return JoystickError(
+    return PermissionDeniedError(
         f"Permission denied opening {path}: run `sudo chmod a+rw {path}` for now, or add yourself to the input group "
         "(`sudo usermod -aG input $USER`, then log in again) or write a udev rule."
     )
 
 
 def vanished_error(path: str) -> JoystickError:
-    return JoystickError(f"The joystick {path} vanished (unplugged?): plug it back in and joyfly reopens it.")
+    return DeviceVanishedError(f"The joystick {path} vanished (unplugged?): plug it back in and joyfly reopens it.")
 
 
 # ---------------------------------------------------------------------------------------------------------- events
@@ -273,7 +285,8 @@ class JsDevice:
         try:
             self._fd = _open_fd(self.path, self.dev_dir)
         except JoystickError as exc:
-            self.last_error = exc
+            if not (isinstance(exc, NoDeviceError) and isinstance(self.last_error, DeviceVanishedError)):
+                self.last_error = exc  # "vanished" stays the news until something else goes wrong
             return False
         info = probe_fd(self._fd, self.path)
         self.info, self.name = info, info.name

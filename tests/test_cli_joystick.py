@@ -112,3 +112,11 @@ def test_live_view_redraws_in_place():
     assert "axes     0:+0.00 1:-1.00" in text and "forward=+1.00" in text
     assert "\x1b[5F" in text  # the second frame moved the cursor back over the first
     assert get_profile("xbox").name == "xbox"
+
+
+def test_profiles_lists_every_builtin_layout():
+    result = run("profiles")
+    assert result.exit_code == 0
+    xbox = result.output.split("xbox: ", 1)[1].splitlines()
+    assert "forward=4 inverted, right=3, up=1 inverted, yaw=0" in xbox[2] and "arm=7" in xbox[2]
+    assert "radio: " in result.output and "generic: " in result.output

@@ -15,6 +15,7 @@ from joyfly.joystick import (
     JS_EVENT_AXIS,
     JS_EVENT_BUTTON,
     JS_EVENT_INIT,
+    DeviceVanishedError,
     JoystickError,
     JsDevice,
     list_devices,
@@ -155,6 +156,17 @@ def test_device_read_error_disconnects_then_reopens(pty_device, monkeypatch):
     assert str(src.last_error).startswith(f"The joystick {path} vanished")
 
     monkeypatch.setattr(joystick.os, "read", real_read)
+    real_open = os.open
+
+    def gone(p, flags):
+        raise FileNotFoundError(errno.ENOENT, "No such file")
+
+    monkeypatch.setattr(joystick.os, "open", gone)
+    clock.sleep(0.5)
+    assert src.poll(0.1).connected is False  # the node is gone: still "vanished", not "no such device"
+    assert isinstance(src.last_error, DeviceVanishedError)
+
+    monkeypatch.setattr(joystick.os, "open", real_open)
     state = src.poll(0.1)  # retries at most every 0.5 s
     assert state.connected is False
     clock.sleep(0.5)
