@@ -160,12 +160,10 @@ class AutoCore:
 
     def _hold_before_ramp(self, nav: NavInput, out: TrajectorySetpoint) -> TrajectorySetpoint:
         """FlightModeManager: before the takeoff ramp the task is re-activated every cycle (trajectory reset to the
-        vehicle, 0.7 m/s down). PX4 passes want_takeoff to the controller separately; our controller reads it from
-        the setpoint, so the upward intent is published as the vertical velocity (the controller idles anyway)."""
+        vehicle, 0.7 m/s down) after publishing. The upward intent reaches the controller only through
+        `want_takeoff` (PX4's vehicle_constraints), which the caller must pass on."""
         self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, REACTIVATE_VZ_M_S), nav.pos_ned_m)
-        vz = self._unsmoothed_vz if self.want_takeoff else REACTIVATE_VZ_M_S
-        pos = (out.position_ned_m[0], out.position_ned_m[1], nav.pos_ned_m[2])
-        return TrajectorySetpoint(pos, (0.0, 0.0, vz), (NAN, NAN, NAN), out.yaw_rad, out.yawspeed_rad_s)
+        return out
 
     def _set_constraints(self, nav: NavInput, wp: Waypoint) -> None:
         """FlightTaskAuto::_updateTrajConstraints."""
