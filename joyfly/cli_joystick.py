@@ -129,8 +129,13 @@ def _ended(source: JoystickSource) -> bool:
 
 def _error_of(source: JoystickSource) -> str:
     inner = getattr(source, "source", source)
-    err = inner.last_error if isinstance(inner, JsDevice) else None
-    return str(err) if err is not None else ""
+    if isinstance(inner, TimedSource) and inner.ended:
+        return "(the virtual joystick reached its end)"
+    if not isinstance(inner, JsDevice):
+        return ""
+    if inner.last_error is None and inner.kind == "fifo":
+        return "(waiting for a writer on the FIFO)"
+    return str(inner.last_error or "")
 
 
 def _sticks(cmd: StickCommand) -> str:
@@ -184,6 +189,7 @@ class LiveView:
         self.out = out
         self._lines = 0
         self._next_draw_s = 0.0
+        self._connected = True
 
     def header(self, source: JoystickSource, profile: Profile) -> None:
         self.out.write(f"{source.name} ({source.path}), profile {profile.name}; Ctrl-C to quit\n")
@@ -193,8 +199,9 @@ class LiveView:
         self.out.write(text + "\n")
 
     def show(self, state: JoyState, cmd: StickCommand, start_s: float, error: str) -> None:
-        if state.time_s < self._next_draw_s:
+        if state.time_s < self._next_draw_s and state.connected == self._connected:
             return
+        self._connected = state.connected
         self._next_draw_s = state.time_s + 0.05
         axes = " ".join(f"{i}:{v / 32767:+.2f}" for i, v in enumerate(state.axes)) or "(none yet)"
         buttons = " ".join(f"{i}:{v}" for i, v in enumerate(state.buttons)) or "(none yet)"

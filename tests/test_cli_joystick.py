@@ -45,7 +45,7 @@ def test_test_prints_plain_lines_and_stops_at_the_script_end(tmp_path):
     assert lines[0] == f"joyfly script ({script}), profile script"
     assert "forward=+0.50" in lines[1] and "pressed=-" in lines[1]
     assert any("pressed=arm(" in ln for ln in lines)
-    assert lines[-1].endswith("disconnected")
+    assert lines[-1].endswith("disconnected (the virtual joystick reached its end)")
 
 
 def test_test_reads_a_fifo_until_the_duration(tmp_path):
