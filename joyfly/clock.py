@@ -46,3 +46,19 @@ class SimClock:
             self._now_s = min(target, self._now_s + self._max_step_s)
             for hook in self._hooks:
                 hook(self._now_s)
+
+
+class ScaledClock:
+    """Wall time running `speed` times faster: pairs with an emulator running at the same speed factor, so every
+    joyfly timeout and rate (and a script joystick's timing) follows the vehicle's simulated time."""
+
+    def __init__(self, speed: float = 1.0) -> None:
+        self.speed = speed
+        self._t0 = time.monotonic()
+
+    def now(self) -> float:
+        return (time.monotonic() - self._t0) * self.speed
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            time.sleep(seconds / self.speed)

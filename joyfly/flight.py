@@ -11,98 +11,31 @@ setpoints resume (failsafe.cpp: the fallback clears when the condition clears), 
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
-from enum import Enum
-from typing import Protocol
+from dataclasses import replace
 
 from joyfly.failsafes import JoystickWatch, LinkWatch, Retry
+from joyfly.flight_session import (
+    STREAMING_PHASES,
+    FlightStats,
+    Note,
+    Phase,
+    SessionSettings,
+    SessionView,
+    StickSource,
+    update_stats,
+)
 from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, VehicleLink
-from joyfly.setpoints import Fence, Limits, Setpoint, hold_setpoint, initial_setpoint, next_setpoint
+from joyfly.mapping import fired
+from joyfly.setpoints import Fence, Setpoint, hold_setpoint, initial_setpoint, next_setpoint
 from joyfly.types import Action, Clock, StickCommand
 
+__all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "SessionView", "StickSource"]
+
+MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
+READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
+
 log = logging.getLogger(__name__)
-
-
-class Phase(Enum):
-    CONNECTING = "connecting"
-    PRESTREAM = "pre-streaming setpoints"
-    ARMING = "arming"
-    ENTERING = "entering OFFBOARD"
-    RESUMING = "resuming the setpoint stream"
-    FLYING = "flying in OFFBOARD"
-    PAUSED = "not commanding"
-    LANDING = "landing"
-    GROUNDED = "landed"
-    EXITING = "exiting"
-    DONE = "done"
-    FAILED = "failed"
-
-
-STREAMING_PHASES = (Phase.PRESTREAM, Phase.ARMING, Phase.ENTERING, Phase.RESUMING, Phase.FLYING)
-
-
-class StickSource(Protocol):
-    """Normalised stick commands (the joystick side's mapping output), read without blocking longer than asked."""
-
-    def poll(self, timeout_s: float) -> StickCommand: ...
-
-    def close(self) -> None: ...
-
-
-@dataclass(frozen=True, slots=True)
-class SessionSettings:
-    alt_m: float = 3.0
-    rate_hz: float = 20.0
-    on_exit: str = "land"  # land | hold | rtl
-    joy_timeout_s: float = 5.0
-    connect_timeout_s: float = 15.0
-    prestream_count: int = 10  # setpoints sent before arming (the seed node sends its first ones the same way)
-    arm_attempts: int = 3
-    exit_timeout_s: float = 60.0
-    exit_when_landed: bool = False  # `joyfly demo`: finish once the vehicle has landed and disarmed
-    fence_m: float = 5.0
-    min_alt_m: float = 0.5
-    max_alt_m: float = 10.0
-    limits: Limits = field(default_factory=Limits)
-
-
-@dataclass(frozen=True, slots=True)
-class Note:
-    time_s: float
-    level: str  # info | warn | error
-    text: str
-
-
-@dataclass(frozen=True, slots=True)
-class FlightStats:
-    distance_m: float = 0.0
-    min_fence_margin_m: float = math.inf
-    offboard_time_s: float = 0.0
-    max_alt_m: float = 0.0
-
-
-@dataclass(frozen=True, slots=True)
-class SessionView:
-    """Everything the live view shows, one consistent snapshot."""
-
-    time_s: float
-    phase: Phase
-    link_ok: bool
-    mode: str
-    armed: bool
-    landed_state: int
-    pos_ned_m: tuple[float, float, float] | None
-    setpoint: Setpoint | None
-    streaming: bool
-    stick: StickCommand
-    joystick_ok: bool
-    fence: Fence
-    stats: FlightStats
-    statustexts: tuple[str, ...]
-    notes: tuple[Note, ...]
-    link_description: str
 
 
 class FlightSession:
@@ -129,8 +62,9 @@ class FlightSession:
         self._retry: Retry | None = None
         self._joy = JoystickWatch(settings.joy_timeout_s)
         self._linkw = LinkWatch()
-        self._prev_pressed: frozenset[Action] = frozenset()
-        self._arm_fired = False
+        self._fired: frozenset[Action] = frozenset()
+        self._arm_hold_s = float(getattr(getattr(sticks, "profile", None), "arm_hold_s", 1.0))
+        self._ready_noted = False
         self._last_pos: tuple[float, float, float] | None = None
         self.setpoints_sent = 0
         self.on_setpoint: list[Callable[[Setpoint], None]] = []
@@ -157,6 +91,7 @@ class FlightSession:
         remaining = next_tick - self.clock.now()
         cmd = self.sticks.poll(max(0.0, remaining))
         changed = replace(cmd, time_s=0.0) != replace(self.cmd, time_s=0.0)
+        self._fired |= fired(self.cmd, cmd, self._arm_hold_s)
         self.cmd = cmd
         if changed and self.phase is Phase.FLYING and self._streaming_allowed():
             self._send_flight_setpoint()
@@ -274,31 +209,13 @@ class FlightSession:
 
     def _update_stats(self, now: float) -> None:
         st = self.link.state
-        dt = now - self._last_tick_s
-        pos = st.pos_ned_m
-        if pos is None or not st.armed:
-            self._last_pos = pos
-            return
-        s = self.stats
-        dist = s.distance_m
-        if self._last_pos is not None:
-            dist += math.dist(pos, self._last_pos)
-        self._last_pos = pos
-        margin = min(s.min_fence_margin_m, self.fence.margin_m(pos)) if st.landed_state != 1 else s.min_fence_margin_m
-        self.stats = FlightStats(dist, margin, s.offboard_time_s + (dt if st.offboard else 0.0),
-                                 max(s.max_alt_m, self.fence.alt_m(pos)))
+        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s)
+        self._last_pos = st.pos_ned_m
 
     # --- buttons -----------------------------------------------------------------------------------------------
     def _handle_buttons(self) -> None:
-        pressed = self.cmd.pressed
-        new = pressed - self._prev_pressed
-        self._prev_pressed = pressed
-        held = dict(self.cmd.held_s)
-        if Action.ARM not in pressed:
-            self._arm_fired = False
-        elif held.get(Action.ARM, 0.0) >= 1.0 and not self._arm_fired:
-            self._arm_fired = True
-            new = new | {Action.ARM}
+        """Act on the buttons that fired since the last tick (ARM after its hold, the others on the press)."""
+        new, self._fired = self._fired, frozenset()
         for action in (Action.LAND, Action.RETURN, Action.HOLD, Action.OFFBOARD, Action.TAKEOFF, Action.ARM):
             if action in new:
                 self._on_button(action)
@@ -317,7 +234,7 @@ class FlightSession:
             self._note("info", "HOLD pressed: the vehicle holds in AUTO.LOITER; press OFFBOARD to fly again.")
             self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
             self._set_phase(Phase.PAUSED)
-        elif action is Action.ARM and st.armed and st.on_ground:
+        elif action is Action.ARM and st.armed and st.on_ground and self.phase in (Phase.PAUSED, Phase.GROUNDED):
             self._note("info", "ARM held: disarming.")
             self.link.arm(False)
         elif action in (Action.OFFBOARD, Action.TAKEOFF, Action.ARM) and self.phase in (
@@ -379,8 +296,18 @@ class FlightSession:
         assert self.sp is not None
         self._send(self.sp)
         self._prestreamed += 1
-        if self._prestreamed >= self.s.prestream_count:
+        if self._prestreamed >= self.s.prestream_count and self._vehicle_ready(now):
             self._set_phase(Phase.ENTERING if self.link.state.armed else Phase.ARMING)
+
+    def _vehicle_ready(self, now: float) -> bool:
+        """Armed already, or its heartbeat says STANDBY (checks pass), or we waited long enough to ask anyway."""
+        st = self.link.state
+        if st.armed or st.system_status == MAV_STATE_STANDBY or now - self._phase_s > READY_WAIT_S:
+            return True
+        if not self._ready_noted:
+            self._ready_noted = True
+            self._note("info", "Waiting for the vehicle to be ready to arm (its HEARTBEAT does not say STANDBY yet).")
+        return False
 
     def _arming(self, now: float) -> None:
         assert self.sp is not None
