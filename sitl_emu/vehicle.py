@@ -103,7 +103,8 @@ class Vehicle:
         motors = self.parts.control_update(self._estimate, out, armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
         self._estimate = self._estimate_from(self._state)
-        landed, maybe_landed = self.parts.land(self._estimate, c, out.setpoint_type, now)
+        climb_rate_controlled = out.attitude is None and out.setpoint_type != "none"
+        landed, maybe_landed = self.parts.land(self._estimate, c, climb_rate_controlled, now)
         c.on_land_detector(landed, maybe_landed)
         for severity, text in out.messages:
             self._emit(severity, "navigator", text, True, True)

@@ -21,6 +21,8 @@ from sitl_emu.types import NAN3, AttitudeSetpoint, OffboardControlMode, Trajecto
 
 log = logging.getLogger(__name__)
 
+LAND_DETECTOR_PERIOD_US = 20_000  # land_detector runs at 50 Hz (LandDetector.h LAND_DETECTOR_UPDATE_INTERVAL)
+
 
 @dataclass(frozen=True, slots=True)
 class _NullOutput:
@@ -74,6 +76,9 @@ class Parts:
         self.executor: Any = _make_executor(params)
         self._detector: Any = _make_land_detector(params)
         self.ground_contact = False
+        self._ld_last_us: int | None = None
+        self._ld_armed = False
+        self._ld_out = (True, True)
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> Any:
         try:
@@ -97,23 +102,46 @@ class Parts:
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)
 
-    def land(self, est: RigidBodyState, c: Commander, setpoint_type: str, now_us: int) -> tuple[bool, bool]:
-        """Run the land detector on the new state; (landed, maybe_landed)."""
+    def land(self, est: RigidBodyState, c: Commander, climb_rate_controlled: bool,
+             now_us: int) -> tuple[bool, bool]:
+        """Run the land detector on the new state; (landed, maybe_landed).
+
+        `climb_rate_controlled` is PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard
+        position/velocity/acceleration (not offboard attitude/rates, not manual modes)."""
         if self._detector is None:
             landed = est.on_ground or not c.armed
             return landed, landed
+        if self._ld_last_us is not None and now_us - self._ld_last_us < LAND_DETECTOR_PERIOD_US \
+                and c.armed == self._ld_armed:
+            return self._ld_out
+        self._ld_last_us, self._ld_armed = now_us, c.armed
         from sitl_emu.flight.land_detector import LandDetectorInput
 
-        sp = self.control.local_setpoint
-        sp_vz = sp.velocity_ned_m_s[2] if sp is not None else math.nan
+        sp_vz = _descent_vz(self.control.local_setpoint)
         f = est.specific_force_frd
         out = self._detector.update(LandDetectorInput(
             time_us=now_us, armed=c.armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
             specific_force_norm_m_s2=math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
             thrust_setpoint=self.control.thrust_setpoint, hover_thrust=self.control.hover_thrust,
-            setpoint_vz_m_s=sp_vz, in_descent_mode=setpoint_type == "land"))
+            setpoint_vz_m_s=sp_vz, in_descent_mode=climb_rate_controlled))
         self.ground_contact = bool(out.ground_contact)
-        return out.landed, out.maybe_landed
+        self._ld_out = (out.landed, out.maybe_landed)
+        return self._ld_out
+
+
+def _descent_vz(sp: TrajectorySetpoint | None) -> float:
+    """The vertical velocity setpoint the land detector judges "descending" by.
+
+    MulticopterLandDetector.cpp _get_ground_contact_state also counts the idle setpoint (acceleration z >= 100,
+    which the controller commands once it has ground contact) as descending; LandDetectorInput only carries vz,
+    so an idle setpoint is passed as a large downward velocity.
+    """
+    if sp is None:
+        return math.nan
+    acc_z = sp.acceleration_ned_m_s2[2]
+    if math.isfinite(acc_z) and acc_z >= 100.0:
+        return 1e3
+    return sp.velocity_ned_m_s[2]
 
 
 def _make_control(params: ParamRegistry) -> Any:

@@ -10,28 +10,27 @@ Pure functions of a `CheckInputs` snapshot. Sources:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Flag, auto
 
 from sitl_emu.px4 import NavState
 
 
-class Req(Flag):
-    """One bit per mode requirement (failsafe_flags.mode_req_*)."""
+class Req:
+    """One bit per mode requirement (failsafe_flags.mode_req_*); plain ints, as enum.Flag is slow per step."""
 
     NONE = 0
-    ATTITUDE = auto()  # angular velocity + attitude
-    POSITION = auto()  # local (relaxed or not), global position and local altitude
-    HOME = auto()
-    MISSION = auto()
-    OFFBOARD = auto()
-    MANUAL = auto()
-    PREVENT_ARMING = auto()
+    ATTITUDE = 1  # angular velocity + attitude
+    POSITION = 2  # local (relaxed or not), global position and local altitude
+    HOME = 4
+    MISSION = 8
+    OFFBOARD = 16
+    MANUAL = 32
+    PREVENT_ARMING = 64
 
 
 _A, _P, _M = Req.ATTITUDE, Req.POSITION, Req.MANUAL
 
 # mode_requirements.cpp, multicopter (ROTARY_WING) branch
-_REQUIREMENTS: dict[NavState, Req] = {
+_REQUIREMENTS: dict[NavState, int] = {
     NavState.MANUAL: _M,
     NavState.ALTCTL: _A | _P | _M,
     NavState.ALTITUDE_CRUISE: _A | _P | _M,
@@ -55,7 +54,7 @@ _REQUIREMENTS: dict[NavState, Req] = {
 }
 
 # The reasons modeCheck.cpp reports (as events) for each failed requirement, in its order.
-_REASONS: tuple[tuple[Req, str], ...] = (
+_REASONS: tuple[tuple[int, str], ...] = (
     (Req.ATTITUDE, "No valid attitude estimate"),
     (Req.POSITION, "Navigation error: No valid position estimate"),
     (Req.MISSION, "No valid mission available"),
@@ -75,35 +74,36 @@ class CheckInputs:
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # sitl_emu has no mission storage
 
+    def available(self) -> int:
+        """The requirement bits these inputs satisfy."""
+        have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else 0
+        if self.home_valid:
+            have |= Req.HOME
+        if self.mission_valid:
+            have |= Req.MISSION
+        if self.offboard_signal:
+            have |= Req.OFFBOARD
+        if self.manual_control:
+            have |= Req.MANUAL
+        return have
 
-def requirements(nav_state: NavState) -> Req:
+
+def requirements(nav_state: NavState) -> int:
     return _REQUIREMENTS.get(nav_state, Req.NONE)
 
 
 def mode_prevents_arming(nav_state: NavState) -> bool:
-    return Req.PREVENT_ARMING in requirements(nav_state)
+    return bool(requirements(nav_state) & Req.PREVENT_ARMING)
 
 
-def missing(nav_state: NavState, c: CheckInputs) -> Req:
+def missing(nav_state: NavState, c: CheckInputs) -> int:
     """The requirements of nav_state that are not met now (PREVENT_ARMING excluded)."""
-    have = Req.NONE
-    if c.estimator_ready:
-        have |= Req.ATTITUDE | Req.POSITION
-    if c.home_valid:
-        have |= Req.HOME
-    if c.mission_valid:
-        have |= Req.MISSION
-    if c.offboard_signal:
-        have |= Req.OFFBOARD
-    if c.manual_control:
-        have |= Req.MANUAL
-    need = requirements(nav_state) & ~Req.PREVENT_ARMING
-    return need & ~have
+    return requirements(nav_state) & ~(c.available() | Req.PREVENT_ARMING)
 
 
 def can_run(nav_state: NavState, c: CheckInputs) -> bool:
     """True if nav_state's requirements are met (HealthAndArmingChecks::canRun)."""
-    return missing(nav_state, c) == Req.NONE
+    return not missing(nav_state, c)
 
 
 def arming_failure(nav_state: NavState, c: CheckInputs) -> str | None:
@@ -115,7 +115,7 @@ def arming_failure(nav_state: NavState, c: CheckInputs) -> str | None:
         return "Mode not suitable for arming"
     gaps = missing(nav_state, c)
     for req, text in _REASONS:
-        if req in gaps:
+        if req & gaps:
             return text
     return None
 

@@ -21,6 +21,8 @@ from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
+# flight_mode_manager runs the task on each estimator update; sitl_emu runs it with the position controller (125 Hz)
+TASK_PERIOD_US = 8000
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
                          NavState.AUTO_RTL})
 
@@ -46,6 +48,8 @@ class ModeExecutor:
         self._offboard_kind: OffboardControlMode | None = None
         self._offboard_traj: TrajectorySetpoint | None = None
         self._offboard_att: AttitudeSetpoint | None = None
+        self._held: ExecutorOutput | None = None  # the last task output, reused until TASK_PERIOD_US has passed
+        self._last_us = 0
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -57,14 +61,20 @@ class ModeExecutor:
 
     def update(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand], ref: GeoRef,
                dt_s: float) -> ExecutorOutput:
-        self._select_task(nav_state, nav, commands, ref)
+        new_task = self._select_task(nav_state, nav, commands, ref)
         if nav_state == NavState.OFFBOARD:
             return self._offboard_output()
         if self.task is None:
             return ExecutorOutput(None, None, "none", False, [])
-        sp = self.task.update(nav, dt_s)
-        return ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
-                              self.task.want_takeoff)
+        if not new_task and self._held is not None and nav.time_us - self._last_us < TASK_PERIOD_US:
+            return self._held
+        dt = dt_s if new_task or self._held is None else (nav.time_us - self._last_us) * 1e-6
+        sp = self.task.update(nav, dt)
+        out = ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
+                             self.task.want_takeoff)
+        self._held = ExecutorOutput(sp, None, out.setpoint_type, out.task_finished, [], out.want_takeoff)
+        self._last_us = nav.time_us
+        return out
 
     def _offboard_output(self) -> ExecutorOutput:
         kind = self._offboard_kind
@@ -75,11 +85,12 @@ class ModeExecutor:
 
     # ---- task selection -----------------------------------------------------------------------------------------
     def _select_task(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand],
-                     ref: GeoRef) -> None:
+                     ref: GeoRef) -> bool:
+        """Start the task the mode (or a command) asks for; True if a new task started."""
         if nav_state not in _TASK_MODES:
-            self.task, self._task_mode = None, None
+            self.task, self._task_mode, self._held = None, None, None
             commands.clear()
-            return
+            return False
         previous = self._task_mode
         takeoff_target: Vec3 | None = None
         if previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
@@ -88,7 +99,7 @@ class ModeExecutor:
         commands.clear()
         changed = nav_state != previous or nav.armed != self._task_armed
         if not changed and command is None:
-            return
+            return False
         self._task_mode, self._task_armed = nav_state, nav.armed
         if nav_state == NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, command, ref)
@@ -98,6 +109,7 @@ class ModeExecutor:
             self.task = tasks.make_rtl(nav, self.params)
         else:
             self.task = tasks.make_land(nav, self.params)
+        return True
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None
