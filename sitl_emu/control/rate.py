@@ -3,7 +3,8 @@
 torque = P e + I + FF sp - D d(omega)/dt, with MC_*RATE_K scaling P, I and D (mc_rate_control). The integrator
 is frozen while landed, does not grow in the direction of an allocation saturation, shrinks its gain for large errors
 (i_factor, 400 deg/s) and is clamped to MC_*_INT_LIM. The angular acceleration is the gyro derivative through a
-30 Hz low-pass (IMU_DGYRO_CUTOFF).
+30 Hz low-pass (IMU_DGYRO_CUTOFF). The yaw torque goes through a low-pass MC_YAW_TQ_CUTOFF
+(MulticopterRateControl.cpp _output_lpf_yaw).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ class RateControlSettings:
     gain_d: Vec3 = (0.003, 0.003, 0.0)
     gain_ff: Vec3 = (0.0, 0.0, 0.0)
     int_lim: Vec3 = (0.3, 0.3, 0.3)
+    yaw_tq_cutoff_hz: float = 2.0
 
     @classmethod
     def from_params(cls, reg: ParamRegistry) -> RateControlSettings:
@@ -37,6 +39,7 @@ class RateControlSettings:
             gain_d=tuple(k[i] * g(f"MC_{a}RATE_D") for i, a in enumerate(axes)),  # type: ignore[arg-type]
             gain_ff=tuple(g(f"MC_{a}RATE_FF") for a in axes),  # type: ignore[arg-type]
             int_lim=(g("MC_RR_INT_LIM"), g("MC_PR_INT_LIM"), g("MC_YR_INT_LIM")),
+            yaw_tq_cutoff_hz=g("MC_YAW_TQ_CUTOFF"),
         )
 
 
@@ -46,11 +49,13 @@ class RateControl:
         self._int = [0.0, 0.0, 0.0]
         self._prev_rates: Vec3 | None = None
         self._accel: list[float] = [0.0, 0.0, 0.0]
+        self._yaw_torque = 0.0
 
     def reset(self) -> None:
         self._int = [0.0, 0.0, 0.0]
         self._prev_rates = None
         self._accel = [0.0, 0.0, 0.0]
+        self._yaw_torque = 0.0
 
     @property
     def integrator(self) -> Vec3:
@@ -63,11 +68,15 @@ class RateControl:
         s = self.settings
         accel = self._angular_accel(rates, dt_s)
         err = [rates_sp[i] - rates[i] for i in range(3)]
-        torque = tuple(s.gain_p[i] * err[i] + self._int[i] - s.gain_d[i] * accel[i] + s.gain_ff[i] * rates_sp[i]
-                       for i in range(3))
+        tr, tp, ty = (s.gain_p[i] * err[i] + self._int[i] - s.gain_d[i] * accel[i] + s.gain_ff[i] * rates_sp[i]
+                      for i in range(3))
         if not landed:
             self._update_integral(err, dt_s, sat_pos, sat_neg)
-        return torque  # type: ignore[return-value]
+        if s.yaw_tq_cutoff_hz > 0.0 and dt_s > 0.0:  # AlphaFilter: alpha = dt / (dt + 1 / (2 pi fc))
+            alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * s.yaw_tq_cutoff_hz))
+            self._yaw_torque += alpha * (ty - self._yaw_torque)
+            ty = self._yaw_torque
+        return tr, tp, ty
 
     def _angular_accel(self, rates: Vec3, dt_s: float) -> list[float]:
         prev, self._prev_rates = self._prev_rates, rates

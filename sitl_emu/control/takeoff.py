@@ -34,7 +34,7 @@ class TakeoffHandling:
     def configure(self, spoolup_time_s: float, ramp_time_s: float, vel_p_acc_z: float) -> None:
         self.spoolup_time_s = spoolup_time_s
         self.ramp_time_s = ramp_time_s
-        self.ramp_vz_init = -G / vel_p_acc_z  # generateInitialRampValue
+        self.ramp_vz_init = -G / max(vel_p_acc_z, 0.01)  # generateInitialRampValue
 
     def update_state(self, armed: bool, landed: bool, want_takeoff: bool, now_us: int,
                      skip_takeoff: bool = False) -> TakeoffState:

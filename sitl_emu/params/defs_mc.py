@@ -36,4 +36,5 @@ PARAMS: list[ParamDef] = [
     *_rate_axis("PITCH", "PR", 0.15, 0.2, 0.003, "Pitch"),
     *_rate_axis("YAW", "YR", 0.2, 0.1, 0.0, "Yaw"),
     integer("MC_AIRMODE", 0, 0, 2, "", "Air mode: 0 disabled (the only mode emulated)."),
+    real("MC_YAW_TQ_CUTOFF", 2.0, 0.0, 10.0, "Hz", "Low-pass cutoff of the yaw torque setpoint (0 disables)."),
 ]
