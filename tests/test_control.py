@@ -226,3 +226,19 @@ def test_starting_in_the_air_as_flying_holds_position():
     sp = TrajectorySetpoint(position_ned_m=(0.0, 0.0, -10.0))
     loop.run(5.0, lambda t: sp)
     assert loop.state.pos_ned_m == pytest.approx((0.0, 0.0, -10.0), abs=0.05)
+
+
+def test_hover_thrust_estimator_learns_the_true_hover_thrust_and_becomes_valid():
+    from sitl_emu.control.hover import HoverThrustEstimator
+
+    hte = HoverThrustEstimator()
+    true_hover, g = 0.42, 9.80665
+    valid_at = None
+    for k in range(1000):  # 10 s at 100 Hz, thrust wandering around hover
+        thrust = true_hover * (1.0 + 0.1 * math.sin(k * 0.05))
+        acc_up = g * thrust / true_hover - g
+        if hte.update(thrust, acc_up, (0.0, 0.0, 0.0), 0.01, k * 10_000) and valid_at is None:
+            valid_at = k * 0.01
+    assert hte.estimate == pytest.approx(true_hover, abs=0.005)
+    assert valid_at is not None and valid_at >= 2.0  # variance small for 2 s first
+    assert HoverThrustEstimator().bounds == pytest.approx((0.3, 0.7))  # MPC_THR_HOVER +- HTE_THR_RANGE

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 
 from sitl_emu.control.attitude import AttitudeControl, AttitudeControlSettings
-from sitl_emu.control.hover import HoverThrustEstimator
+from sitl_emu.control.hover import HoverThrustEstimator, HoverThrustSettings
 from sitl_emu.control.mixer import mix
 from sitl_emu.control.position import (
     PositionControl,
@@ -56,6 +56,8 @@ class MulticopterControl:
     def __init__(self, registry: ParamRegistry) -> None:
         self._registry = registry
         self._version = -1
+        self._sat_pos: tuple[bool, bool, bool] = (False, False, False)
+        self._sat_neg: tuple[bool, bool, bool] = (False, False, False)
         self.position = PositionControl()
         self.attitude = AttitudeControl()
         self.rate = RateControl()
@@ -103,7 +105,8 @@ class MulticopterControl:
         s = self.settings.position
         self.position.reset()
         self.position.set_hover_thrust(s.thr_hover)
-        self.hte.reset(s.thr_hover)
+        self.hte.reset()
+        self._hte_in_air = False
         self.rate.reset()
         self._local_setpoint: TrajectorySetpoint | None = None
         self._q_sp: Vec4 | None = None
@@ -208,10 +211,22 @@ class MulticopterControl:
         out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw, sp, limits, dt_s, now_us)
         self._in_failsafe = out.in_failsafe
         self._local_setpoint = out.local_setpoint
-        if flying and not landed and s.use_hte:
-            est = self.hte.update(-out.thrust_ned[2], -state.acc_ned_m_s2[2], state.vel_ned_m_s[2], dt_s)
-            self.position.update_hover_thrust(est, out.local_setpoint.acceleration_ned_m_s2[2])
+        self._update_hover_thrust(state, out, landed, dt_s, now_us)
         return out
+
+    def _update_hover_thrust(self, state: RigidBodyState, out: PositionOutput, landed: bool, dt_s: float,
+                             now_us: int) -> None:
+        """MulticopterHoverThrustEstimator: in the air (not landed, > 1 m up) feed the EKF; use it once valid."""
+        if landed:
+            self._hte_in_air = False
+        elif -state.pos_ned_m[2] > 1.0:
+            self._hte_in_air = True
+        if not self._hte_in_air:
+            self.hte.valid = False
+            return
+        valid = self.hte.update(-out.thrust_ned[2], -state.acc_ned_m_s2[2], state.vel_ned_m_s, dt_s, now_us)
+        if valid and self.settings.position.use_hte:
+            self.position.update_hover_thrust(self.hte.estimate, out.local_setpoint.acceleration_ned_m_s2[2])
 
     def _refresh(self) -> None:
         if self._registry.version == self._version:
@@ -221,6 +236,7 @@ class MulticopterControl:
         self.position.settings = self.settings.position
         self.attitude.settings = self.settings.attitude
         self.rate.settings = self.settings.rate
+        self.hte.settings = HoverThrustSettings.from_params(self._registry)
         self.takeoff.configure(self.settings.spoolup_time_s, self.settings.tko_ramp_t_s,
                                self.settings.position.vel_p[2])
         self._sat_pos = self._sat_neg = (False, False, False)

@@ -1,29 +1,102 @@
-"""Hover thrust estimate, in the spirit of PX4's mc_hover_thrust_estimator (MPC_USE_HTE).
+"""Hover thrust estimate after PX4's mc_hover_thrust_estimator (MPC_USE_HTE).
 
-PX4 runs a one-state Kalman filter on the vertical acceleration; here a first-order filter on the same measurement
-(hover = T_up g / (g + a_up)) gives the estimate the position controller and the land detector need. It only learns
-while flying and slow vertically (|vz| < 2 m/s, HTE_VZ_THR), and starts from MPC_THR_HOVER.
+A one-state EKF (zero_order_hover_thrust_ekf.cpp): the state is the hover thrust, the measurement the upward
+acceleration a = g T / h - g for the upward thrust setpoint T. Innovation gate, measurement-noise learning and the
+large-offset recovery follow PX4; so does the gating of MulticopterHoverThrustEstimator.cpp: it runs only armed,
+in the air (not landed and more than 1 m above the ground), it trusts measurements less at speed (HTE_VZ_THR,
+HTE_VXY_THR), and the estimate is "valid" once its variance stayed below 0.001 for 2 s.
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
+from sitl_emu.params import ParamRegistry
+
 G = 9.80665
-VZ_THRESHOLD_M_S = 2.0  # HTE_VZ_THR
-TIME_CONSTANT_S = 2.0
+NOISE_LEARNING_TAU_S = 2.0
+LPF_TAU_S = 1.0
+VALID_VAR = 0.001
+VALID_HYSTERESIS_US = 2_000_000
+
+
+@dataclass(frozen=True, slots=True)
+class HoverThrustSettings:
+    initial: float = 0.5  # MPC_THR_HOVER
+    process_noise: float = 0.0036  # HTE_HT_NOISE
+    gate: float = 3.0  # HTE_ACC_GATE
+    err_init: float = 0.1  # HTE_HT_ERR_INIT
+    vz_thr: float = 2.0  # HTE_VZ_THR
+    vxy_thr: float = 10.0  # HTE_VXY_THR
+    thr_range: float = 0.2  # HTE_THR_RANGE
+
+    @classmethod
+    def from_params(cls, reg: ParamRegistry) -> HoverThrustSettings:
+        g = reg.get
+        return cls(g("MPC_THR_HOVER"), g("HTE_HT_NOISE"), g("HTE_ACC_GATE"), g("HTE_HT_ERR_INIT"), g("HTE_VZ_THR"),
+                   g("HTE_VXY_THR"), g("HTE_THR_RANGE"))
 
 
 class HoverThrustEstimator:
-    def __init__(self, initial: float = 0.5, lo: float = 0.1, hi: float = 0.9) -> None:
-        self.lo, self.hi = lo, hi
-        self.reset(initial)
+    def __init__(self, settings: HoverThrustSettings | None = None) -> None:
+        self.settings = settings or HoverThrustSettings()
+        self.reset()
 
-    def reset(self, initial: float) -> None:
-        self.estimate = min(self.hi, max(self.lo, initial))
+    def reset(self) -> None:
+        s = self.settings
+        self.estimate = min(0.9, max(0.1, s.initial))
+        self.var = s.err_init * s.err_init
+        self.valid = False
+        self._acc_var = 5.0
+        self._residual_lpf = 0.0
+        self._ratio_lpf = 0.0
+        self._valid_since_us: int | None = None
 
-    def update(self, thrust_up: float, acc_up_m_s2: float, vz_m_s: float, dt_s: float) -> float:
-        """Feed the vertical thrust setpoint (0..1, positive up) and the measured upward acceleration."""
-        if abs(vz_m_s) < VZ_THRESHOLD_M_S and thrust_up > 0.0 and G + acc_up_m_s2 > 1.0:
-            meas = thrust_up * G / (G + acc_up_m_s2)
-            k = min(1.0, dt_s / TIME_CONSTANT_S)
-            self.estimate = min(self.hi, max(self.lo, self.estimate + k * (meas - self.estimate)))
-        return self.estimate
+    @property
+    def bounds(self) -> tuple[float, float]:
+        s = self.settings
+        return min(max(s.initial - s.thr_range, 0.0), 0.8), min(max(s.initial + s.thr_range, 0.2), 0.9)
+
+    def update(self, thrust_up: float, acc_up_m_s2: float, vel_ned_m_s: tuple[float, float, float], dt_s: float,
+               now_us: int) -> bool:
+        """One in-air cycle; returns whether the estimate is valid (then the controller should use it)."""
+        if not (0.001 < dt_s < 1.0) or not math.isfinite(thrust_up):
+            return self.valid
+        s = self.settings
+        self.var += s.process_noise * s.process_noise * dt_s * dt_s  # predict (as PX4: var += q dt^2)
+        vz_coeff = max(abs(vel_ned_m_s[2]) - s.vz_thr + 1.0, 1.0)
+        vxy_coeff = max(math.hypot(vel_ned_m_s[0], vel_ned_m_s[1]) - s.vxy_thr + 1.0, 1.0)
+        scale = max(vz_coeff, vxy_coeff) ** 2
+        self._fuse(acc_up_m_s2, thrust_up, scale, dt_s)
+        ok = self.var < VALID_VAR
+        if ok and self._valid_since_us is None:
+            self._valid_since_us = now_us
+        elif not ok:
+            self._valid_since_us = None
+        self.valid = self._valid_since_us is not None and now_us - self._valid_since_us >= VALID_HYSTERESIS_US
+        return self.valid
+
+    def _fuse(self, acc_z: float, thrust: float, scale: float, dt_s: float) -> None:
+        h = self.estimate
+        jac = -G * thrust / (h * h)
+        r = self._acc_var * scale
+        innov_var = max(jac * self.var * jac + r, r)
+        innov = acc_z - (G * thrust / h - G)
+        ratio = innov * innov / (self.settings.gate ** 2 * innov_var)
+        residual = innov
+        if ratio < 1.0:
+            k = self.var * jac / innov_var
+            lo, hi = self.bounds
+            self.estimate = min(hi, max(lo, h + k * innov))
+            self.var = min(1.0, max(1e-10, (1.0 - k * jac) * self.var))
+            residual = acc_z - (G * thrust / self.estimate - G)
+        elif abs(self._ratio_lpf) > 0.2:  # large offset: bump the variance to recover
+            self.var += 1e3 * self.settings.process_noise ** 2 * dt_s
+        alpha = dt_s / (LPF_TAU_S + dt_s)
+        self._residual_lpf += alpha * (residual - self._residual_lpf)
+        self._ratio_lpf += alpha * (math.copysign(min(ratio, 1.0), innov) - self._ratio_lpf)
+        alpha_n = dt_s / (NOISE_LEARNING_TAU_S + dt_s)
+        res = residual - self._residual_lpf
+        self._acc_var = min(400.0, max(1.0, (1.0 - alpha_n) * self._acc_var + alpha_n * (res * res + jac * self.var
+                                                                                         * jac)))

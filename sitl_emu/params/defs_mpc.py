@@ -64,4 +64,15 @@ _TAKEOFF_LAND: list[ParamDef] = [
     real("MPC_LAND_ALT3", 1.0, 0.0, 122.0, "m", "Altitude below which MPC_LAND_CRWL applies."),
 ]
 
-PARAMS: list[ParamDef] = [*_LIMITS, *_AUTO, *_MANUAL, *_CONTROL, *_TAKEOFF_LAND]
+# Hover thrust estimator (src/modules/mc_hover_thrust_estimator/hover_thrust_estimator_params.yaml); it feeds
+# MPC_THR_HOVER's online refinement, so it lives with the position controller's parameters.
+_HTE: list[ParamDef] = [
+    real("HTE_HT_NOISE", 0.0036, 0.0001, 1.0, "", "Hover thrust process noise (standard deviation)."),
+    real("HTE_ACC_GATE", 3.0, 1.0, 10.0, "SD", "Gate size for the acceleration fusion."),
+    real("HTE_HT_ERR_INIT", 0.1, 0.0, 1.0, "", "Initial hover thrust uncertainty (standard deviation)."),
+    real("HTE_VXY_THR", 10.0, 1.0, 20.0, "m/s", "Horizontal speed above which measurements are trusted less."),
+    real("HTE_VZ_THR", 2.0, 1.0, 10.0, "m/s", "Vertical speed above which measurements are trusted less."),
+    real("HTE_THR_RANGE", 0.2, 0.01, 0.4, "", "Maximum deviation of the estimate from MPC_THR_HOVER."),
+]
+
+PARAMS: list[ParamDef] = [*_LIMITS, *_AUTO, *_MANUAL, *_CONTROL, *_TAKEOFF_LAND, *_HTE]
