@@ -96,8 +96,10 @@ class Vehicle:
         c = self.commander
         c.observe(Observation(now, now >= self._ready_delay_us, self._here(), self._task_finished))
         c.update(now)
-        nav = self.parts.nav_input(now, self._estimate, c, self.ref)
-        out = self.parts.executor.update(c.nav_state, nav, c.nav_commands, self.ref, dt_s)
+        est = self._estimate
+        out = self.parts.executor.update(c.nav_state, c.armed, now,
+                                         lambda: self.parts.nav_input(now, est, c, self.ref),
+                                         c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         armed = c.armed and c.nav_state != NavState.TERMINATION
         motors = self.parts.control_update(self._estimate, out, armed, c.landed, now, dt_s)
@@ -193,7 +195,7 @@ class Vehicle:
         return VehicleSnapshot(
             time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
             user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe,
-            landed_state=self.landed_state(), pre_flight_checks_pass=(not c.armed) and c.pre_flight_checks_pass(),
+            landed_state=self.landed_state(), pre_flight_checks_pass=c.pre_flight_checks_pass(),
             position_valid=c.estimator_ready, takeoff_detected=c.have_taken_off,
             offboard_control=c.offboard_mode, pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s,
             acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz, rates_frd_rad_s=s.rates_frd_rad_s,

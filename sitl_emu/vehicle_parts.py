@@ -41,8 +41,8 @@ class _NullExecutor:
                  attitude: AttitudeSetpoint | None) -> None:
         pass
 
-    def update(self, nav_state: NavState, nav: Any, commands: list[NavCommand], ref: GeoRef,
-               dt_s: float) -> _NullOutput:
+    def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Any, commands: list[NavCommand],
+               ref: GeoRef, dt_s: float) -> _NullOutput:
         commands.clear()
         return _NullOutput()
 

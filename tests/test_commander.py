@@ -324,3 +324,10 @@ def test_termination_holds_until_disarm() -> None:
     h.run(0.01)
     assert h.c.nav_state == NavState.TERMINATION and h.c.system_status() == MavState.FLIGHT_TERMINATION
     assert h.set_mode(NavState.AUTO_LOITER).result == MavResult.TEMPORARILY_REJECTED
+
+
+def test_pre_flight_checks_pass_while_flying_in_return() -> None:
+    h = Harness()
+    h.arm_and_fly()
+    h.cmd(20)
+    assert h.c.nav_state == NavState.AUTO_RTL and h.c.pre_flight_checks_pass()

@@ -106,12 +106,15 @@ def can_run(nav_state: NavState, c: CheckInputs) -> bool:
     return not missing(nav_state, c)
 
 
-def arming_failure(nav_state: NavState, c: CheckInputs) -> str | None:
-    """None if arming is allowed in nav_state, else the first failing check's text (canArm is False)."""
+def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> str | None:
+    """None if arming is allowed in nav_state, else the first failing check's text (canArm is False).
+
+    While armed the "mode prevents arming" check is skipped (modeCheck.cpp), so vehicle_status.pre_flight_checks_pass
+    stays true when flying in Return or Land."""
     if not c.estimator_ready:
         # Every arming check needs the estimator (ekf2 not ready: attitude/position invalid).
         return "No valid attitude estimate"
-    if mode_prevents_arming(nav_state):
+    if not armed and mode_prevents_arming(nav_state):
         return "Mode not suitable for arming"
     gaps = missing(nav_state, c)
     for req, text in _REASONS:
@@ -120,5 +123,5 @@ def arming_failure(nav_state: NavState, c: CheckInputs) -> str | None:
     return None
 
 
-def can_arm(nav_state: NavState, c: CheckInputs) -> bool:
-    return arming_failure(nav_state, c) is None
+def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
+    return arming_failure(nav_state, c, armed) is None

@@ -37,6 +37,28 @@ class Observation:
 
 
 @dataclass(frozen=True, slots=True)
+class CommanderSettings:
+    """The commander's parameters, read once per parameter change (commander_params.yaml names)."""
+
+    of_loss_us: int  # COM_OF_LOSS_T
+    disarm_land_us: int  # COM_DISARM_LAND (<= 0: off)
+    preflight_disarm_us: int  # COM_SPOOLUP_TIME + COM_DISARM_PRFLT (COM_DISARM_PRFLT <= 0: off)
+    home_enabled: bool  # COM_HOME_EN
+    fallback: FallbackSettings  # COM_OBL_RC_ACT, NAV_RCL_ACT
+
+    @classmethod
+    def from_params(cls, p: ParamRegistry) -> CommanderSettings:
+        prflt_s = float(p["COM_DISARM_PRFLT"])
+        return cls(
+            of_loss_us=int(float(p["COM_OF_LOSS_T"]) * 1e6),
+            disarm_land_us=int(float(p["COM_DISARM_LAND"]) * 1e6),
+            preflight_disarm_us=int((float(p["COM_SPOOLUP_TIME"]) + prflt_s) * 1e6) if prflt_s > 0 else 0,
+            home_enabled=bool(p["COM_HOME_EN"]),
+            fallback=FallbackSettings(obl_rc_act=int(p["COM_OBL_RC_ACT"]), rcl_act=int(p["NAV_RCL_ACT"])),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class NavCommand:
     """A request for the navigator that comes with a command (global coordinates, NaN = keep current)."""
 
@@ -53,6 +75,8 @@ class Commander:
 
     def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None) -> None:
         self.params = params
+        self._settings = CommanderSettings.from_params(params)
+        self._settings_version = params.version
         self._emit = emit
         self._ned_of = ned_of
         self.intention = ModeIntention(NavState.AUTO_LOITER)
@@ -75,6 +99,13 @@ class Commander:
         self._offboard_mode: OffboardControlMode | None = None
         self._last_reject_text_us: int | None = None
 
+    @property
+    def settings(self) -> CommanderSettings:
+        if self.params.version != self._settings_version:
+            self._settings = CommanderSettings.from_params(self.params)
+            self._settings_version = self.params.version
+        return self._settings
+
     # ---- inputs -------------------------------------------------------------------------------------------------
     def observe(self, obs: Observation) -> None:
         self._obs = obs
@@ -96,7 +127,7 @@ class Commander:
         """offboardCheck.cpp: a setpoint kind is set and now < timestamp + COM_OF_LOSS_T."""
         if self._offboard_last_us is None or self._offboard_mode is None or not self._offboard_mode.any():
             return False
-        return now_us < self._offboard_last_us + int(self.params["COM_OF_LOSS_T"] * 1e6)
+        return now_us < self._offboard_last_us + self.settings.of_loss_us
 
     @property
     def offboard_mode(self) -> OffboardControlMode | None:
@@ -113,8 +144,8 @@ class Commander:
         return arming.can_run(nav_state, self.check_inputs())
 
     def pre_flight_checks_pass(self) -> bool:
-        """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT)."""
-        return arming.can_arm(self.nav_state, self.check_inputs())
+        """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed)."""
+        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed)
 
     def system_status(self) -> MavState:
         """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
@@ -153,7 +184,7 @@ class Commander:
         self._armed_at_us = now_us
         self._landed_since_us = None
         self._failsafe.reset()
-        if self.params["COM_HOME_EN"] and self._obs.here is not None:
+        if self.settings.home_enabled and self._obs.here is not None:
             self.home = self._obs.here
         self.say(Severity.INFO, f"Armed by {'external' if external else 'internal'} command")
         return True
@@ -184,15 +215,11 @@ class Commander:
             self._apply_mode(self.now_us)
         return ok
 
-    def _fallback_settings(self) -> FallbackSettings:
-        return FallbackSettings(obl_rc_act=int(self.params["COM_OBL_RC_ACT"]),
-                                rcl_act=int(self.params["NAV_RCL_ACT"]))
-
     def _apply_mode(self, now_us: int) -> None:
         inputs = self.check_inputs(now_us)
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
                                          can_run=lambda m: arming.can_run(m, inputs),
-                                         settings=self._fallback_settings(), terminated=self.terminated)
+                                         settings=self.settings.fallback, terminated=self.terminated)
         if self.nav_state == NavState.TERMINATION and self.armed:
             decision_nav = NavState.TERMINATION  # never leave termination while armed
         else:
@@ -215,7 +242,7 @@ class Commander:
     def _update_ready(self) -> None:
         if not self.estimator_ready:
             return
-        if self.home is None and not self.armed and self.params["COM_HOME_EN"] and self._obs.here is not None:
+        if self.home is None and not self.armed and self.settings.home_enabled and self._obs.here is not None:
             self.home = self._obs.here  # HomePosition::update: first valid global position on the ground
         if not self._ready_announced:
             self._ready_announced = True
@@ -225,20 +252,17 @@ class Commander:
         """handleAutoDisarm: COM_DISARM_LAND after landing, COM_SPOOLUP_TIME + COM_DISARM_PRFLT if never airborne."""
         if not self.armed:
             return
-        disarm_land_s = float(self.params["COM_DISARM_LAND"])
-        prflt_s = float(self.params["COM_DISARM_PRFLT"])
+        st = self.settings
         if self.have_taken_off:
-            if disarm_land_s <= 0 or not self.landed:
+            if st.disarm_land_us <= 0 or not self.landed:
                 self._landed_since_us = None
                 return
             if self._landed_since_us is None:
                 self._landed_since_us = now_us
-            if now_us - self._landed_since_us >= int(disarm_land_s * 1e6):
+            if now_us - self._landed_since_us >= st.disarm_land_us:
                 self.disarm("landing", forced=True)
-        elif prflt_s > 0:
-            limit_us = int((float(self.params["COM_SPOOLUP_TIME"]) + prflt_s) * 1e6)
-            if now_us - self._armed_at_us >= limit_us:
-                self.disarm("auto preflight disarming", forced=True)
+        elif st.preflight_disarm_us > 0 and now_us - self._armed_at_us >= st.preflight_disarm_us:
+            self.disarm("auto preflight disarming", forced=True)
 
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""

@@ -12,6 +12,7 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from sitl_emu.flight import tasks
@@ -59,21 +60,22 @@ class ModeExecutor:
         if attitude is not None:
             self._offboard_att = attitude
 
-    def update(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand], ref: GeoRef,
-               dt_s: float) -> ExecutorOutput:
-        new_task = self._select_task(nav_state, nav, commands, ref)
+    def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
+               commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
+        """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
+        new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
         if nav_state == NavState.OFFBOARD:
             return self._offboard_output()
         if self.task is None:
             return ExecutorOutput(None, None, "none", False, [])
-        if not new_task and self._held is not None and nav.time_us - self._last_us < TASK_PERIOD_US:
+        if not new_task and self._held is not None and now_us - self._last_us < TASK_PERIOD_US:
             return self._held
-        dt = dt_s if new_task or self._held is None else (nav.time_us - self._last_us) * 1e-6
-        sp = self.task.update(nav, dt)
+        dt = dt_s if new_task or self._held is None else (now_us - self._last_us) * 1e-6
+        sp = self.task.update(nav_fn(), dt)
         out = ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
                              self.task.want_takeoff)
         self._held = ExecutorOutput(sp, None, out.setpoint_type, out.task_finished, [], out.want_takeoff)
-        self._last_us = nav.time_us
+        self._last_us = now_us
         return out
 
     def _offboard_output(self) -> ExecutorOutput:
@@ -84,8 +86,8 @@ class ModeExecutor:
         return ExecutorOutput(None, self._offboard_att, "offboard", False, [])
 
     # ---- task selection -----------------------------------------------------------------------------------------
-    def _select_task(self, nav_state: NavState, nav: tasks.NavInput, commands: list[NavCommand],
-                     ref: GeoRef) -> bool:
+    def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], tasks.NavInput],
+                     commands: list[NavCommand], ref: GeoRef) -> bool:
         """Start the task the mode (or a command) asks for; True if a new task started."""
         if nav_state not in _TASK_MODES:
             self.task, self._task_mode, self._held = None, None, None
@@ -97,10 +99,11 @@ class ModeExecutor:
             takeoff_target = getattr(self.task, "target_ned_m", None)
         command = commands.pop() if commands else None
         commands.clear()
-        changed = nav_state != previous or nav.armed != self._task_armed
+        changed = nav_state != previous or armed != self._task_armed
         if not changed and command is None:
             return False
-        self._task_mode, self._task_armed = nav_state, nav.armed
+        nav = nav_fn()
+        self._task_mode, self._task_armed = nav_state, armed
         if nav_state == NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, command, ref)
         elif nav_state == NavState.AUTO_LOITER:
