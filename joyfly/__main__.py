@@ -1,0 +1,5 @@
+"""`python -m joyfly`: the same as the `joyfly` command."""
+
+from joyfly.cli import main
+
+main()

@@ -1,0 +1,157 @@
+"""`joyfly fly`, `joyfly demo` and `joyfly joystick ...`: parse options, build the pieces, run, report.
+
+Errors a user can hit (no joystick, port in use, no vehicle, arming refused) end in one sentence and a non-zero exit
+status; Ctrl-C / SIGTERM perform --on-exit and exit 0; a second Ctrl-C quits at once.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from types import FrameType
+from typing import Any
+
+import click
+
+from joyfly.cli_joystick import joystick
+from joyfly.clock import WallClock
+from joyfly.config import ConfigError, FlyOptions, build_options, load_file
+from joyfly.dashboard import make_view, summary_lines
+from joyfly.flight import FlightSession, Phase
+from joyfly.joystick import JoystickError
+from joyfly.link import VehicleLink
+from joyfly.mapping import open_sticks
+from joyfly.transport import TransportError, open_transport
+
+D = FlyOptions()
+
+
+@click.group()
+@click.option("-v", "--verbose", count=True, help="More log output on stderr (-v info, -vv debug).")
+def main(verbose: int) -> None:
+    """Fly a PX4 quadrotor (PX4 SITL or `sitl-emu serve`) with a joystick over MAVLink."""
+    level = logging.WARNING - 10 * min(verbose, 2)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    if verbose == 0:
+        logging.getLogger("joyfly").setLevel(logging.ERROR + 10)  # the live view already says it all
+
+
+main.add_command(joystick)
+
+
+def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any]:
+    default = getattr(D, name.lstrip("-").replace("-", "_"))
+    return click.option(name, type=kind, default=None, help=f"{help_text} [default: {default}]", **kw)
+
+
+@main.command()
+@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO or file of js_event records, script:FILE, replay:FILE.")
+@_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
+@_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
+@_opt("--control", click.Choice(["velocity", "step"]), "Sticks command a velocity, or a position step (the seed).")
+@_opt("--step", float, "Step control: metres per full stick.")
+@_opt("--alt", float, "Take-off altitude, metres above home.")
+@_opt("--max-climb", float, "Climb/descent rate at full throttle stick, m/s.")
+@_opt("--max-speed", float, "Horizontal speed at full stick, m/s.")
+@_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick, deg/s.")
+@_opt("--fence", float, "Half-width of the square fence around home, metres; 0 disables.")
+@_opt("--min-alt", float, "Lowest setpoint, metres above home.")
+@_opt("--max-alt", float, "Highest setpoint, metres above home.")
+@_opt("--rate", float, "Setpoint stream rate, Hz (at least 10).")
+@_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
+@_opt("--record", str, "Record the joystick's events with timestamps to this file (replay with --joy replay:FILE).")
+@_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
+@click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
+def fly(config_path: str | None, **cli_options: Any) -> None:
+    """Connect, take off to --alt in OFFBOARD and fly with the joystick; Ctrl-C lands (see --on-exit)."""
+    try:
+        file_options, profile_table = load_file(config_path) if config_path else ({}, {})
+        opts = build_options(file_options, cli_options)
+    except (ConfigError, JoystickError) as err:
+        _die(str(err), 2)
+    sys.exit(run_fly(opts, profile_table))
+
+
+def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) -> int:
+    """Open the joystick and the link, fly until done; returns the exit status."""
+    out = out or sys.stdout
+    clock = WallClock()
+    try:
+        sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
+    except JoystickError as err:
+        _die(str(err), 2)
+    try:
+        transport = open_transport(opts.url)
+    except TransportError as err:
+        sticks.close()
+        _die(str(err), 2)
+    view = make_view(out)
+    out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
+              f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
+    session = FlightSession(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
+    return fly_session(session, view, out)
+
+
+def fly_session(session: FlightSession, view: Any, out: Any) -> int:
+    """Run the session with Ctrl-C/SIGTERM handling, print the summary, close everything."""
+    try:
+        with exit_signals(session):
+            session.run(on_view=view.show)
+    except KeyboardInterrupt:
+        out.write("\njoyfly: interrupted twice, quitting at once (the vehicle keeps its last mode).\n")
+        return 130
+    finally:
+        view.close()
+        session.link.close()
+        session.sticks.close()
+    for line in summary_lines(session.stats):
+        out.write(line + "\n")
+    if session.phase is Phase.FAILED:
+        click.echo(f"joyfly: {session.error}", err=True)
+        return 1
+    return 0
+
+
+@contextmanager
+def exit_signals(session: FlightSession) -> Iterator[None]:
+    """First SIGINT/SIGTERM: ask the session to perform --on-exit; the second: KeyboardInterrupt, at once."""
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        if session.exit_requested:
+            raise KeyboardInterrupt
+        session.request_exit()
+
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+@main.command()
+@click.option("--url", default=None, help="Fly a vehicle already listening there instead of the built-in emulator.")
+@click.option("--speed", type=click.FloatRange(min=0.1, max=20), default=1.0, show_default=True,
+              help="Run the built-in emulator (and the script) this many times faster than real time.")
+@click.option("--script", "script_path", default=None, help="Joystick script (default: the built-in demo flight).")
+@click.option("--live/--plain", default=None, help="Force the live terminal view or plain log lines.")
+def demo(url: str | None, speed: float, script_path: str | None, live: bool | None) -> None:
+    """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
+    from joyfly.demo import DemoError, run_demo
+
+    try:
+        sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live))
+    except (DemoError, TransportError, JoystickError) as err:
+        _die(str(err), 2)
+
+
+def _die(message: str, status: int) -> Any:
+    click.echo(f"joyfly: {message}", err=True)
+    sys.exit(status)
+
+
+if __name__ == "__main__":
+    main()

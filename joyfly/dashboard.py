@@ -1,0 +1,153 @@
+"""The live view of a flight: a block redrawn in place ~10 times a second on a terminal (link, mode, armed,
+position, setpoint, stick bars, fence margin, the vehicle's last STATUSTEXTs), with joyfly's messages scrolling
+above it. Without a terminal (a pipe, CI, a log file): plain lines, one per state change and at most one a second.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TextIO
+
+from joyfly.flight_session import FlightStats, Note, SessionView
+from joyfly.types import StickCommand
+
+LIVE_PERIOD_S = 0.1
+PLAIN_PERIOD_S = 1.0
+_LANDED = {0: "?", 1: "on ground", 2: "in air", 3: "taking off", 4: "landing"}
+
+
+def bar(value: float, half_width: int = 5) -> str:
+    """A centred bar for -1..1: `[   |##  ]`."""
+    n = round(max(-1.0, min(1.0, value)) * half_width)
+    left = " " * (half_width + min(n, 0)) + "#" * -min(n, 0)
+    right = "#" * max(n, 0) + " " * (half_width - max(n, 0))
+    return f"[{left}|{right}]"
+
+
+def fmt_vec(v: tuple[float, float, float] | None) -> str:
+    return "(   -   ,    -   ,    -   )" if v is None else f"({v[0]:+7.2f}, {v[1]:+7.2f}, {v[2]:+7.2f})"
+
+
+def fmt_margin(margin_m: float) -> str:
+    if math.isinf(margin_m):
+        return "off"
+    return f"{margin_m:+.2f} m" + ("  OUTSIDE" if margin_m < 0 else "")
+
+
+def stick_line(cmd: StickCommand) -> str:
+    up = cmd.up if cmd.up is not None else (2 * cmd.throttle_abs - 1 if cmd.throttle_abs is not None else 0.0)
+    pressed = ",".join(sorted(a.value for a in cmd.pressed)) or "-"
+    return (f"fwd {bar(cmd.forward)} right {bar(cmd.right)} up {bar(up)} yaw {bar(cmd.yaw)}  buttons {pressed}")
+
+
+def render(view: SessionView) -> list[str]:
+    """The live block for one view snapshot."""
+    link = "OK" if view.link_ok else "LOST"
+    pos = view.pos_ned_m
+    margin = view.fence.margin_m(pos) if pos is not None else math.inf
+    sp = view.setpoint
+    stream = "streaming" if view.streaming else "not streaming"
+    joy = "ok" if view.joystick_ok else "LOST (holding)"
+    lines = [
+        f"t {view.time_s:7.1f} s  {view.phase.value:<28} link {link:<4} ({view.link_description})",
+        f"mode {view.mode:<14} {'ARMED' if view.armed else 'disarmed':<9} {_LANDED.get(view.landed_state, '?'):<10}"
+        f" setpoints {stream}",
+        f"position NED {fmt_vec(pos)} m   alt {view.fence.alt_m(pos) if pos else 0.0:5.2f} m",
+        f"setpoint NED {fmt_vec(sp.pos_ned_m if sp else None)} m   yaw {math.degrees(sp.yaw_rad) if sp else 0:+6.1f}",
+        f"fence margin {fmt_margin(margin)}   closest {fmt_margin(view.stats.min_fence_margin_m)}   joystick {joy}",
+        stick_line(view.stick),
+    ]
+    lines += [f"vehicle: {text}" for text in view.statustexts[-3:]]
+    return lines
+
+
+def summary_lines(stats: FlightStats) -> list[str]:
+    closest = "n/a" if math.isinf(stats.min_fence_margin_m) else f"{stats.min_fence_margin_m:.2f} m inside"
+    if stats.min_fence_margin_m < 0:
+        closest = f"{-stats.min_fence_margin_m:.2f} m OUTSIDE"
+    return [
+        f"distance flown        {stats.distance_m:6.1f} m",
+        f"closest to the fence  {closest}",
+        f"time in OFFBOARD      {stats.offboard_time_s:6.1f} s",
+        f"highest               {stats.max_alt_m:6.1f} m above home",
+    ]
+
+
+class LiveDashboard:
+    """For a terminal: notes scroll, the status block stays at the bottom, redrawn at most 10 times a second."""
+
+    def __init__(self, out: TextIO) -> None:
+        self.out = out
+        self._lines = 0
+        self._next_s = -math.inf
+        self._last: SessionView | None = None
+
+    def note(self, note: Note) -> None:
+        self._erase()
+        mark = {"warn": "! ", "error": "!! "}.get(note.level, "")
+        self.out.write(f"{mark}{note.text}\n")
+        if self._last is not None:
+            self._draw(render(self._last))
+
+    def show(self, view: SessionView) -> None:
+        self._last = view
+        if view.time_s < self._next_s:
+            return
+        self._next_s = view.time_s + LIVE_PERIOD_S
+        self._draw(render(view))
+
+    def close(self) -> None:
+        if self._last is not None:
+            self._draw(render(self._last))
+        self.out.flush()
+
+    def _erase(self) -> None:
+        if self._lines:
+            self.out.write(f"\x1b[{self._lines}F\x1b[J")
+            self._lines = 0
+
+    def _draw(self, lines: list[str]) -> None:
+        self._erase()
+        self.out.write("\n".join(lines) + "\n")
+        self.out.flush()
+        self._lines = len(lines)
+
+
+class PlainLog:
+    """For pipes and logs: every note, a status line on each state change, and at most one a second."""
+
+    def __init__(self, out: TextIO) -> None:
+        self.out = out
+        self._key: tuple[object, ...] | None = None
+        self._next_s = -math.inf
+        self._t_s = 0.0
+
+    def note(self, note: Note) -> None:
+        level = {"warn": "WARNING ", "error": "ERROR "}.get(note.level, "")
+        self.out.write(f"[{self._t_s:7.2f}] {level}{note.text}\n")
+        self.out.flush()
+
+    def show(self, view: SessionView) -> None:
+        self._t_s = view.time_s
+        key = (view.phase, view.mode, view.armed, view.link_ok, view.joystick_ok, view.landed_state)
+        flying = view.streaming and view.time_s >= self._next_s
+        if key == self._key and not flying:
+            return
+        self._key = key
+        self._next_s = view.time_s + PLAIN_PERIOD_S
+        pos = view.pos_ned_m
+        margin = view.fence.margin_m(pos) if pos is not None else math.inf
+        sp = view.setpoint.pos_ned_m if view.setpoint is not None else None
+        self.out.write(f"[{view.time_s:7.2f}] {view.phase.value}; {view.mode} {'armed' if view.armed else 'disarmed'}"
+                       f"; link {'ok' if view.link_ok else 'LOST'}; pos {fmt_vec(pos)} sp {fmt_vec(sp)}"
+                       f"; fence margin {fmt_margin(margin)}\n")
+        self.out.flush()
+
+    def close(self) -> None:
+        self.out.flush()
+
+
+def make_view(out: TextIO, live: bool | None = None) -> LiveDashboard | PlainLog:
+    """The live block on a terminal, plain lines otherwise (`live` forces one or the other)."""
+    is_tty = out.isatty() if live is None else live
+    return LiveDashboard(out) if is_tty else PlainLog(out)

@@ -1,0 +1,126 @@
+"""`joyfly demo`: a whole joystick flight with no hardware and no second terminal.
+
+It starts the bundled emulator in-process (sitl_emu's vehicle node on free loopback ports, run by its real-time
+runner in a background thread), or uses a vehicle already listening at `--url`; flies a scripted joystick (take off,
+a square inside the fence, a push against the fence, land) through the same session `joyfly fly` uses, with the
+live view; and ends with a summary: distance flown, closest approach to the fence, time in OFFBOARD.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from pathlib import Path
+from typing import Any, TextIO
+
+from joyfly.clock import ScaledClock
+from joyfly.config import FlyOptions
+from joyfly.dashboard import make_view
+from joyfly.flight import FlightSession
+from joyfly.link import VehicleLink
+from joyfly.mapping import MappedSource
+from joyfly.profiles import load_profile
+from joyfly.transport import UdpTransport, open_transport
+from joyfly.virtual import ScriptSource
+
+# The demo flight (joyfly takes off by itself at the start; the sticks then fly a square and push the fence).
+# Format: joyfly/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.
+DEMO_SCRIPT = """\
+8      forward=0.5               # north, 2.5 m/s
++1.6   forward=0
++1.5   right=0.5                 # east
++1.6   right=0
++1.5   forward=-0.5              # south
++1.6   forward=0
++1.5   right=-0.5                # west, back over home
++1.6   right=0
++1.5   up=0.5 yaw=0.5            # climb a little, turn clockwise
++2     up=0 yaw=0
++1     forward=1                 # full stick north for 4 s: 20 m of demand, the fence stops it at 5 m
++4     forward=0
++1     forward=-0.5              # back towards home
++2     forward=0
++2     land=1
++0.3   land=0
++30    end
+"""
+DEMO_TIMEOUT_S = 120.0  # simulated seconds; the scripted flight needs about 50
+
+
+class DemoError(Exception):
+    """The demo cannot start; the message says why and what to do."""
+
+
+class EmbeddedVehicle:
+    """sitl_emu's vehicle node on free loopback ports, run in real time (x speed) in a daemon thread."""
+
+    def __init__(self, joyfly_port: int, speed: float) -> None:
+        try:
+            from sitl_emu.cli import build_params, build_vehicle
+            from sitl_emu.runner import RealTimeRunner
+            from sitl_emu.server import LinkSettings, VehicleNode
+        except ImportError as exc:
+            raise DemoError(f"The bundled emulator cannot be imported ({exc}): reinstall with `make demo`.") from None
+        settings = LinkSettings(bind_host="127.0.0.1", api_port=0, api_remote=("127.0.0.1", joyfly_port),
+                                gcs_port=0, gcs_remote=("127.0.0.1", 14550))
+        self.node: Any = VehicleNode(build_vehicle(build_params(None, ()), None, 0, 1), settings)
+        self.runner = RealTimeRunner([self.node], speed=speed)
+        self._thread = threading.Thread(target=self.runner.run, name="sitl-emu", daemon=True)
+
+    @property
+    def api_address(self) -> tuple[str, int]:
+        host, port = self.node.api.link.local_address
+        return ("127.0.0.1" if host in ("0.0.0.0", "") else host, port)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        self.runner.stop()
+        self._thread.join(2.0)
+        self.node.close()
+
+
+def script_source(script_path: str | None, clock: Any) -> MappedSource:
+    """The scripted joystick, mapped through the built-in `script` profile."""
+    source = ScriptSource.from_file(script_path, clock) if script_path else ScriptSource.from_text(
+        DEMO_SCRIPT, clock, "<built-in demo script>")
+    return MappedSource(source, load_profile("auto", source.name))
+
+
+def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
+             out: TextIO | None = None, options: FlyOptions | None = None) -> int:
+    """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed)."""
+    from joyfly.cli import fly_session
+
+    out = out or sys.stdout
+    opts = options or FlyOptions()
+    transport: Any = open_transport(url) if url else UdpTransport(("127.0.0.1", 0), None)
+    emulator = None
+    if url is None:
+        emulator = EmbeddedVehicle(transport.local_port, speed)
+        transport.remote = emulator.api_address
+        transport.description = f"the built-in emulator (UDP {emulator.api_address[1]})"
+        emulator.start()
+    clock = ScaledClock(speed if emulator is not None else 1.0)
+    sticks = script_source(script_path, clock)
+    view = make_view(out, live)
+    out.write(f"joyfly demo: {transport.description}, scripted joystick "
+              f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}\n")
+    settings = opts.session_settings(exit_when_landed=True)
+    session = FlightSession(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
+    watchdog = threading.Timer(DEMO_TIMEOUT_S / clock.speed, session.request_exit)
+    watchdog.daemon = True
+    watchdog.start()
+    try:
+        status = fly_session(session, view, out)
+    finally:
+        watchdog.cancel()
+        if emulator is not None:
+            emulator.stop()
+    return status
+
+
+def default_script() -> Path:
+    """The repository's example script, for users who want to edit a copy."""
+    return Path(__file__).resolve().parent.parent / "examples" / "joystick_script.txt"
