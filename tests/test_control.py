@@ -242,3 +242,18 @@ def test_hover_thrust_estimator_learns_the_true_hover_thrust_and_becomes_valid()
     assert hte.estimate == pytest.approx(true_hover, abs=0.005)
     assert valid_at is not None and valid_at >= 2.0  # variance small for 2 s first
     assert HoverThrustEstimator().bounds == pytest.approx((0.3, 0.7))  # MPC_THR_HOVER +- HTE_THR_RANGE
+
+
+def test_horizontal_velocity_limit_keeps_the_position_term_first():
+    from sitl_emu.control.position import constrain_xy
+
+    vx, vy = constrain_xy(3.0, 0.0, 0.0, 5.0, 4.0)  # P-term 3 m/s north, feed-forward 5 m/s east, limit 4
+    assert vx == pytest.approx(3.0) and math.hypot(vx, vy) == pytest.approx(4.0)
+    assert constrain_xy(0.0, 0.0, 3.0, 4.0, 0.0) == (0.0, 0.0)  # a zero limit stops, never divides by zero
+
+
+def test_attitude_setpoint_with_nan_quaternion_never_reaches_the_motors(hovering):
+    loop = fresh(hovering)
+    att = AttitudeSetpoint(q_wxyz=(NAN, 0.0, 0.0, 0.0), thrust_body=(0.0, 0.0, -0.49))
+    tr = loop.run(0.5, lambda t: None, attitude=lambda t: att)
+    assert all(math.isfinite(m) for ms in tr.motors for m in ms)

@@ -20,7 +20,7 @@ from sitl_emu.control.position import (
     PositionLimits,
     PositionOutput,
 )
-from sitl_emu.control.qmath import yaw_from_q
+from sitl_emu.control.qmath import q_normalized, yaw_from_q
 from sitl_emu.control.rate import RateControl, RateControlSettings
 from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState
 from sitl_emu.params import ParamRegistry
@@ -177,9 +177,10 @@ class MulticopterControl:
     def _attitude_mode(self, state: RigidBodyState, sp: AttitudeSetpoint) -> tuple[Vec4 | None, Vec3, float]:
         thrust = -sp.thrust_body[2] if math.isfinite(sp.thrust_body[2]) else 0.0
         thrust = min(1.0, max(0.0, thrust))
-        if sp.q_wxyz is not None:
+        if sp.q_wxyz is not None and all(math.isfinite(c) for c in sp.q_wxyz):
+            q_sp = q_normalized(sp.q_wxyz)
             yaw_ff = sp.body_rates_rad_s[2] if math.isfinite(sp.body_rates_rad_s[2]) else 0.0
-            return sp.q_wxyz, self.attitude.update(state.q_wxyz, sp.q_wxyz, yaw_ff), thrust
+            return q_sp, self.attitude.update(state.q_wxyz, q_sp, yaw_ff), thrust
         r = sp.body_rates_rad_s
         rates = (r[0] if math.isfinite(r[0]) else 0.0, r[1] if math.isfinite(r[1]) else 0.0,
                  r[2] if math.isfinite(r[2]) else 0.0)

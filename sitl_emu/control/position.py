@@ -110,7 +110,7 @@ def constrain_xy(v0x: float, v0y: float, v1x: float, v1y: float, vmax: float) ->
         return sx, sy
     n0 = math.hypot(v0x, v0y)
     if n0 >= vmax:
-        return v0x / n0 * vmax, v0y / n0 * vmax
+        return (v0x / n0 * vmax, v0y / n0 * vmax) if n0 > 0.0 else (0.0, 0.0)
     if math.hypot(v1x - v0x, v1y - v0y) < 0.001:
         return v0x / n0 * vmax, v0y / n0 * vmax
     n1 = math.hypot(v1x, v1y)
