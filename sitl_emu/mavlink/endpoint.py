@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 import logging
+import struct
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
@@ -71,6 +72,7 @@ class EndpointStats:
     rx_parse_errors: int = 0
     rx_own_echo: int = 0
     handler_errors: int = 0
+    tx_pack_errors: int = 0
 
 
 class _LinkWriter:
@@ -120,7 +122,12 @@ class Endpoint:
         return self._now_us
 
     def send(self, msg: Any) -> None:
-        self.mav.send(msg)
+        try:
+            self.mav.send(msg)
+        except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
+            self.stats.tx_pack_errors += 1
+            if self.stats.tx_pack_errors == 1:
+                log.error("%s link: cannot send %s: %s", self.link_name, msg.get_type(), err)
 
     def broadcast(self, msg: Any) -> None:
         self.node.broadcast(msg)
@@ -159,13 +166,19 @@ class Endpoint:
         return last is not None and self._now_us - last <= self.GCS_TIMEOUT_US
 
     def _parse(self, data: bytes) -> list[Any]:
+        """Frames in one datagram. A frame cut short at the datagram's end is dropped, so it cannot swallow the
+        start of the next datagram (senders put whole frames in each datagram)."""
         try:
-            return self._parser.parse_buffer(data) or []
+            msgs = self._parser.parse_buffer(data) or []
         except Exception as err:  # pymavlink raises on some malformed input even in robust mode
             self.stats.rx_parse_errors += 1
             log.debug("%s link: parse error %s", self.link_name, err)
             self._parser = _new_parser()
             return []
+        if self._parser.buf_len() > 0:
+            self.stats.rx_parse_errors += 1
+            self._parser = _new_parser()
+        return msgs
 
     # --- transmit ------------------------------------------------------------------------------------------------
     def emit(self, now_us: int, snap: VehicleSnapshot, events: Sequence[VehicleEvent]) -> None:

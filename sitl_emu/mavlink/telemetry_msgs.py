@@ -249,11 +249,15 @@ def _ms(snap: VehicleSnapshot) -> int:
 
 
 def _e7(deg: float) -> int:
-    return _iround(deg * 1e7)
+    return _int32(deg * 1e7)
 
 
 def _mm(m: float) -> int:
-    return _iround(m * 1000.0)
+    return _int32(m * 1000.0)
+
+
+def _int32(x: float) -> int:
+    return max(min(_iround(x), 2**31 - 1), -(2**31))
 
 
 def _cm_s(m_s: float) -> int:
