@@ -34,11 +34,20 @@ class AttitudeControl:
     def __init__(self, settings: AttitudeControlSettings | None = None) -> None:
         self.settings = settings or AttitudeControlSettings()
 
+    @property
+    def settings(self) -> AttitudeControlSettings:
+        return self._settings
+
+    @settings.setter
+    def settings(self, s: AttitudeControlSettings) -> None:
+        self._settings = s
+        self._yaw_w = constrain(s.yaw_weight, 0.0, 1.0)
+        # setProportionalGain: compensate the yaw weight's rescaling of the output
+        self._kp = s.gain_p if self._yaw_w <= 1e-4 else (s.gain_p[0], s.gain_p[1], s.gain_p[2] / self._yaw_w)
+
     def update(self, q: Vec4, q_sp: Vec4, yawspeed_ff_rad_s: float = 0.0) -> Vec3:
         """Body rate setpoint (rad/s, FRD) driving attitude q towards q_sp."""
-        s = self.settings
-        yaw_w = constrain(s.yaw_weight, 0.0, 1.0)
-        kp = s.gain_p if yaw_w <= 1e-4 else (s.gain_p[0], s.gain_p[1], s.gain_p[2] / yaw_w)
+        yaw_w, kp = self._yaw_w, self._kp
         # reduced attitude: only tilt the thrust axis, neglecting yaw
         qd_red = q_from_two_vectors(dcm_z(q), dcm_z(q_sp))
         if abs(qd_red[1]) > 1.0 - 1e-5 or abs(qd_red[2]) > 1.0 - 1e-5:
@@ -51,10 +60,12 @@ class AttitudeControl:
         z = constrain(q_mix[3], -1.0, 1.0)
         qd = q_mul(qd_red, (math.cos(yaw_w * math.acos(w)), 0.0, 0.0, math.sin(yaw_w * math.asin(z))))
         qe = q_canonical(q_mul(q_inv(q), qd))
-        rates = [2.0 * qe[i + 1] * kp[i] for i in range(3)]
-        if math.isfinite(yawspeed_ff_rad_s):
-            wz = dcm_z(q_inv(q))  # world z axis in the body frame
-            rates = [rates[i] + wz[i] * yawspeed_ff_rad_s for i in range(3)]
-        lim = s.rate_max_rad_s
-        return (constrain(rates[0], -lim[0], lim[0]), constrain(rates[1], -lim[1], lim[1]),
-                constrain(rates[2], -lim[2], lim[2]))
+        r0, r1, r2 = 2.0 * qe[1] * kp[0], 2.0 * qe[2] * kp[1], 2.0 * qe[3] * kp[2]
+        if yawspeed_ff_rad_s != 0.0 and math.isfinite(yawspeed_ff_rad_s):
+            # world z axis in the body frame: third row of R
+            qw, qx, qy, qz = q
+            r0 += 2.0 * (qx * qz - qw * qy) * yawspeed_ff_rad_s
+            r1 += 2.0 * (qy * qz + qw * qx) * yawspeed_ff_rad_s
+            r2 += (1.0 - 2.0 * (qx * qx + qy * qy)) * yawspeed_ff_rad_s
+        lim = self._settings.rate_max_rad_s
+        return constrain(r0, -lim[0], lim[0]), constrain(r1, -lim[1], lim[1]), constrain(r2, -lim[2], lim[2])

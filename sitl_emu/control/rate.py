@@ -66,12 +66,14 @@ class RateControl:
                sat_neg: tuple[bool, bool, bool] = (False, False, False)) -> Vec3:
         """Normalised torque (roll, pitch, yaw) for the mixer."""
         s = self.settings
-        accel = self._angular_accel(rates, dt_s)
-        err = [rates_sp[i] - rates[i] for i in range(3)]
-        tr, tp, ty = (s.gain_p[i] * err[i] + self._int[i] - s.gain_d[i] * accel[i] + s.gain_ff[i] * rates_sp[i]
-                      for i in range(3))
+        a0, a1, a2 = self._angular_accel(rates, dt_s)
+        p, i, d, ff = s.gain_p, self._int, s.gain_d, s.gain_ff
+        e0, e1, e2 = rates_sp[0] - rates[0], rates_sp[1] - rates[1], rates_sp[2] - rates[2]
+        tr = p[0] * e0 + i[0] - d[0] * a0 + ff[0] * rates_sp[0]
+        tp = p[1] * e1 + i[1] - d[1] * a1 + ff[1] * rates_sp[1]
+        ty = p[2] * e2 + i[2] - d[2] * a2 + ff[2] * rates_sp[2]
         if not landed:
-            self._update_integral(err, dt_s, sat_pos, sat_neg)
+            self._update_integral([e0, e1, e2], dt_s, sat_pos, sat_neg)
         if s.yaw_tq_cutoff_hz > 0.0 and dt_s > 0.0:  # AlphaFilter: alpha = dt / (dt + 1 / (2 pi fc))
             alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * s.yaw_tq_cutoff_hz))
             self._yaw_torque += alpha * (ty - self._yaw_torque)
