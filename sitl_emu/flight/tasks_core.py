@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.params import ParamRegistry
@@ -82,7 +83,7 @@ class AutoSettings:
 
     @classmethod
     def from_params(cls, params: ParamRegistry) -> AutoSettings:
-        values = {field: _get(params, name, default) for field, (name, default) in _PARAM_NAMES.items()}
+        values: dict[str, Any] = {f: _get(params, name, default) for f, (name, default) in _PARAM_NAMES.items()}
         values["yawrate_max_rad_s"] = math.radians(values["yawrate_max_rad_s"])
         values["yaw_mode"] = int(values["yaw_mode"])
         return cls(**values)
