@@ -168,7 +168,8 @@ class FlightSession:
             sp = replace(self.sp, vel_ned_m_s=(0.0, 0.0, 0.0) if self.sp.vel_ned_m_s is not None else None)
         else:
             dt = min(max(now - self._last_sp_s, 0.0), 0.2)
-            sp = next_setpoint(self.sp, self.cmd, self._vehicle_pos(), dt, self.s.limits, self.fence)
+            sp = next_setpoint(self.sp, self.cmd, self._vehicle_pos(), dt, self.s.limits, self.fence,
+                               self.link.state.vel_ned_m_s)
         self._send(sp)
 
     # --- watchdogs -------------------------------------------------------------------------------------------

@@ -79,6 +79,7 @@ class Limits:
     max_yaw_rate_rad_s: float = math.radians(45.0)
     leash_m: float = 1.0  # velocity mode: how far the setpoint may run ahead of the vehicle
     brake_acc_m_s2: float = 2.0  # velocity mode: planned deceleration towards the fence
+    lag_s: float = 0.5  # velocity mode: how far ahead to predict the vehicle (its velocity lags the demand)
 
 
 @dataclass(frozen=True, slots=True)
@@ -128,14 +129,19 @@ def _stick_xy(cmd: StickCommand) -> tuple[float, float]:
 
 
 def next_setpoint(
-    prev: Setpoint, cmd: StickCommand, vehicle_ned_m: Vec3, dt_s: float, limits: Limits, fence: Fence
+    prev: Setpoint, cmd: StickCommand, vehicle_ned_m: Vec3, dt_s: float, limits: Limits, fence: Fence,
+    vehicle_vel_ned_m_s: Vec3 = (0.0, 0.0, 0.0),
 ) -> Setpoint:
-    """The setpoint after `dt_s` of stick `cmd`, starting from `prev`, clamped by the fence."""
+    """The setpoint after `dt_s` of stick `cmd`, starting from `prev`, clamped by the fence.
+
+    Velocity mode brakes towards a fence side from where the vehicle will be `lag_s` from now (its position plus
+    velocity x lag), so a vehicle that lags its demand still stops at the side, not beyond it."""
     yaw = wrap_pi(prev.yaw_rad + cmd.yaw * limits.max_yaw_rate_rad_s * dt_s)
     z = _next_z(prev.pos_ned_m[2], climb_demand(cmd), vehicle_ned_m[2], dt_s, limits)
     if limits.control == "step":
         return _step_xy(prev, cmd, vehicle_ned_m, z, yaw, limits, fence)
-    sp = _velocity_xy(prev, cmd, vehicle_ned_m, z, yaw, dt_s, limits, fence)
+    ahead = tuple(p + v * limits.lag_s for p, v in zip(vehicle_ned_m, vehicle_vel_ned_m_s, strict=True))
+    sp = _velocity_xy(prev, cmd, vehicle_ned_m, (ahead[0], ahead[1]), z, yaw, dt_s, limits, fence)
     return _with_climb_feedforward(sp, z, fence.clamp(sp.pos_ned_m)[2], climb_demand(cmd) * limits.max_climb_m_s)
 
 
@@ -179,6 +185,7 @@ def _velocity_xy(
     prev: Setpoint,
     cmd: StickCommand,
     vehicle: Vec3,
+    ahead: tuple[float, float],
     z: float,
     yaw: float,
     dt_s: float,
@@ -191,11 +198,13 @@ def _velocity_xy(
         return Setpoint(pos, yaw, (0.0, 0.0, 0.0))
     px, py = prev.pos_ned_m[0], prev.pos_ned_m[1]
     hx, hy = fence.home_ned_m[0], fence.home_ned_m[1]
-    vx = _brake_limit(limits.max_speed_m_s * f, max(px, vehicle[0]) if f > 0 else min(px, vehicle[0]), hx, fence,
-                      limits.brake_acc_m_s2)
-    vy = _brake_limit(limits.max_speed_m_s * r, max(py, vehicle[1]) if r > 0 else min(py, vehicle[1]), hy, fence,
-                      limits.brake_acc_m_s2)
-    x, y = _leash(px + vx * dt_s - vehicle[0], py + vy * dt_s - vehicle[1], limits.leash_m)
+    acc = limits.brake_acc_m_s2
+    vx = _brake_limit(limits.max_speed_m_s * f, max(ahead[0], vehicle[0]) if f > 0 else min(ahead[0], vehicle[0]),
+                      hx, fence, acc)
+    vy = _brake_limit(limits.max_speed_m_s * r, max(ahead[1], vehicle[1]) if r > 0 else min(ahead[1], vehicle[1]),
+                      hy, fence, acc)
+    leash = min(limits.leash_m, 0.2 + limits.lag_s * math.hypot(vx, vy))  # lead shrinks as the brake bites
+    x, y = _leash(px + vx * dt_s - vehicle[0], py + vy * dt_s - vehicle[1], leash)
     pos = fence.clamp((vehicle[0] + x, vehicle[1] + y, z))
     return Setpoint(pos, yaw, (vx, vy, 0.0))
 
