@@ -131,6 +131,7 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
         await s.wait_for("health_all_ok", telemetry.health_all_ok, bool, timeout_s=30)
         await s.call("Telemetry.health", telemetry.health())
         await _check_shell(system, s)
+        await _check_missions(system, s)
         await _check_params(ParamAsync(system), action, s)
         await _take_off(telemetry, action, s)
         await _offboard(telemetry, OffboardAsync(system), s)
@@ -156,6 +157,25 @@ async def _check_shell(system: Any, s: Session) -> None:
     assert "INFO  [commander] Disarmed" in text and "navigation mode: Hold" in text
 
 
+async def _check_missions(system: Any, s: Session) -> None:
+    """No plan is stored: downloads are empty, an upload is refused at once (not left to time out)."""
+    from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
+    from mavsdk.plugins.mission_raw import MissionItem, MissionRawError, MissionRawResult
+
+    mission_raw = MissionRawAsync(system)
+    assert await s.call("MissionRaw.download_mission", mission_raw.download_mission()) in ([], None)
+    item = MissionItem(seq=0, frame=6, command=16, current=1, autocontinue=1, x=473977420, y=85455940, z=10.0,
+                       mission_type=0)
+    started = time.monotonic()
+    with pytest.raises(MissionRawError) as refused:
+        await asyncio.wait_for(mission_raw.upload_mission([item]), CALL_TIMEOUT_S)
+    elapsed_s = time.monotonic() - started
+    s.calls.append(("MissionRaw.upload_mission(1 waypoint)", f"refused as expected: {refused.value.result.name} "
+                    f"after {elapsed_s:.2f} s"))
+    assert refused.value.result == MissionRawResult.UNSUPPORTED
+    assert elapsed_s < 3.0
+
+
 async def _echo(value: Any) -> Any:
     return value
 
@@ -168,6 +188,11 @@ async def _check_params(param: Any, action: Any, s: Session) -> None:
     assert await s.call("Param.get_param_int(BAT1_N_CELLS)", param.get_param_int("BAT1_N_CELLS")) == 6
     await s.call("Param.set_param_int(BAT1_N_CELLS, 4)", param.set_param_int("BAT1_N_CELLS", 4))
     assert await s.call("Param.get_param_int(MAV_SYS_ID)", param.get_param_int("MAV_SYS_ID")) == 1
+    all_params = await s.call("Param.get_all_params", param.get_all_params(), timeout_s=30)
+    ints = {p.name: p.value for p in all_params.int_params}
+    floats = {p.name: p.value for p in all_params.float_params}
+    assert ints["MAV_SYS_ID"] == 1 and ints["SYS_AUTOSTART"] == 10040 and floats["MIS_TAKEOFF_ALT"] == 3.0
+    assert "_HASH_CHECK" not in ints and "_HASH_CHECK" not in floats
 
 
 async def _take_off(telemetry: Any, action: Any, s: Session) -> None:
