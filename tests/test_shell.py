@@ -158,3 +158,19 @@ def test_shutdown_calls_back(vehicle):
     assert Shell(vehicle, on_shutdown=lambda: calls.append(1)).execute("shutdown") == "Exiting NOW.\n"
     assert calls == [1]
     assert "failed" in Shell(vehicle).execute("shutdown")
+
+
+def test_commander_takeoff_flies_the_real_vehicle():
+    from sitl_emu.vehicle import Vehicle
+
+    vehicle = Vehicle()
+    vehicle.run_until(3_000_000)  # ready to arm
+    shell = Shell(vehicle)
+    assert shell.execute("commander takeoff") == ""
+    vehicle.run_until(15_000_000)
+    texts = [e.text for e in vehicle.events_after(-1)]
+    assert "Armed by internal command" in texts and "Takeoff detected" in texts
+    snap = vehicle.snapshot()
+    assert snap.armed and snap.nav_state == NavState.AUTO_LOITER
+    assert -snap.pos_ned_m[2] == pytest.approx(2.5, abs=0.2)
+    assert "INFO  [commander] navigation mode: Hold" in shell.execute("commander status")
