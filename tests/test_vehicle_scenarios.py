@@ -265,3 +265,26 @@ def test_snapshot_local_setpoint_and_geo() -> None:
     assert s.local_setpoint is not None and s.local_setpoint.position_ned_m != NAN3
     assert s.alt_amsl_m == pytest.approx(488.0 - s.pos_ned_m[2])
     assert s.home is not None and s.home.alt_amsl_m == pytest.approx(488.0, abs=0.01)
+
+
+def test_takeoff_command_before_arming_keeps_its_altitude() -> None:
+    f = Flight()
+    f.run(2.5)
+    assert f.cmd(22, NAN, NAN, NAN, NAN, NAN, NAN, 488.0 + 4.0) == MavResult.ACCEPTED  # param7 AMSL
+    f.run(1.0)
+    assert f.snap.nav_state == NavState.AUTO_TAKEOFF and not f.snap.armed
+    assert f.cmd(400, 1.0) == MavResult.ACCEPTED  # like pxh> commander takeoff: takeoff, then arm
+    f.run(20.0)
+    assert _alt(f.snap) == pytest.approx(4.0, abs=0.1) and f.snap.nav_state == NavState.AUTO_LOITER
+    assert "Using default takeoff altitude: 2.5 m" not in f.texts()
+
+
+def test_default_takeoff_text_once_at_arming() -> None:
+    f = Flight()
+    f.run(2.5)
+    f.cmd(22)
+    f.run(1.0)
+    f.cmd(400, 1.0)
+    f.run(3.0)
+    assert f.texts().count("Using default takeoff altitude: 2.5 m") == 1
+    assert f.event_time_s("Using default takeoff altitude: 2.5 m") >= f.event_time_s("Armed by external command")

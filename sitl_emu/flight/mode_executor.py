@@ -3,6 +3,7 @@
 PX4 splits this between navigator (navigator_main.cpp: one task per nav_state, vehicle_command parameters for
 takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 - a new task starts when the mode in force changes, at arming, and when a command brings new navigator parameters;
+  no task runs while disarmed (navigator_main.cpp);
 - Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
   loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
 - OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
@@ -45,7 +46,7 @@ class ModeExecutor:
         self.params = params
         self.task: tasks.Task | None = None
         self._task_mode: NavState | None = None
-        self._task_armed = False
+        self._pending_takeoff: NavCommand | None = None  # NAV_TAKEOFF parameters, used when the takeoff starts
         self._offboard_kind: OffboardControlMode | None = None
         self._offboard_traj: TrajectorySetpoint | None = None
         self._offboard_att: AttitudeSetpoint | None = None
@@ -88,24 +89,32 @@ class ModeExecutor:
     # ---- task selection -----------------------------------------------------------------------------------------
     def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], tasks.NavInput],
                      commands: list[NavCommand], ref: GeoRef) -> bool:
-        """Start the task the mode (or a command) asks for; True if a new task started."""
-        if nav_state not in _TASK_MODES:
+        """Start the task the mode (or a command) asks for; True if a new task started.
+
+        navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
+        the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
+        for cmd in commands:
+            if cmd.kind == "takeoff":
+                self._pending_takeoff = cmd
+        command = commands[-1] if commands and commands[-1].kind != "takeoff" else None
+        commands.clear()
+        if nav_state not in _TASK_MODES or not armed:
             self.task, self._task_mode, self._held = None, None, None
-            commands.clear()
+            if nav_state != NavState.AUTO_TAKEOFF:
+                self._pending_takeoff = None
             return False
         previous = self._task_mode
         takeoff_target: Vec3 | None = None
         if previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
-        command = commands.pop() if commands else None
-        commands.clear()
-        changed = nav_state != previous or armed != self._task_armed
-        if not changed and command is None:
+        new_takeoff = nav_state == NavState.AUTO_TAKEOFF and self._pending_takeoff is not None
+        if nav_state == previous and command is None and not new_takeoff:
             return False
         nav = nav_fn()
-        self._task_mode, self._task_armed = nav_state, armed
+        self._task_mode = nav_state
         if nav_state == NavState.AUTO_TAKEOFF:
-            self.task = self._make_takeoff(nav, command, ref)
+            self.task = self._make_takeoff(nav, self._pending_takeoff, ref)
+            self._pending_takeoff = None
         elif nav_state == NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state == NavState.AUTO_RTL:
