@@ -288,3 +288,16 @@ def test_default_takeoff_text_once_at_arming() -> None:
     f.run(3.0)
     assert f.texts().count("Using default takeoff altitude: 2.5 m") == 1
     assert f.event_time_s("Using default takeoff altitude: 2.5 m") >= f.event_time_s("Armed by external command")
+
+
+def test_reposition_flies_to_the_point_in_hold() -> None:
+    from sitl_emu.geo import ned_to_global
+
+    f = Flight()
+    f.takeoff()
+    lat, lon, alt = ned_to_global(f.v.ref, (8.0, -6.0, -5.0))
+    assert f.cmd(192, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
+    f.run(15.0)
+    s = f.snap
+    assert s.nav_state == NavState.AUTO_LOITER
+    assert math.dist(s.pos_ned_m, (8.0, -6.0, -5.0)) < 0.3
