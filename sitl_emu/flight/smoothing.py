@@ -64,6 +64,10 @@ class AxisSmoother:
         self._vel_sp = min(max(vel_setpoint, -self.max_vel), self.max_vel)
         self._time = 0.0
         self._a0, self._v0, self._x0 = self.a, self.v, self.x
+        if self.a == 0.0 and self.v == self._vel_sp:  # steady: nothing to plan (fast path, same result)
+            self._dir = 0
+            self._t1 = self._t2 = self._t3 = 0.0
+            return
         self._dir = self._direction()
         jerk = self._dir * self.max_jerk
         if abs(jerk) <= _EPS:
@@ -88,6 +92,12 @@ class AxisSmoother:
         """Advance along the planned profile by `dt_s` (scaled by `time_stretch`, 0..1)."""
         self._time += dt_s * time_stretch
         rest = self._time
+        if self._t1 == 0.0 and self._t2 == 0.0 and self._t3 == 0.0:  # constant velocity (fast path)
+            if rest > 0.0:
+                self.j, self.a, self.v, self.x = 0.0, 0.0, self._v0, self._x0 + self._v0 * rest
+            else:
+                self.j, self.a, self.v, self.x = 0.0, self._a0, self._v0, self._x0
+            return
         j, a, v, x = self._eval(self._dir * self.max_jerk, self._a0, self._v0, self._x0, min(rest, self._t1))
         rest -= self._t1
         if rest > 0.0:
@@ -159,6 +169,8 @@ class AxisSmoother:
 
 def synchronize(axes: list[AxisSmoother]) -> None:
     """Make every axis finish its velocity change together with the slowest one (VelocitySmoothing::timeSync)."""
+    if all(a.total_time <= _EPS for a in axes):
+        return
     longest = max(range(len(axes)), key=lambda i: axes[i].total_time)
     desired = axes[longest].total_time
     if desired <= _EPS:
