@@ -26,7 +26,8 @@ class Console:
     def __init__(self, vehicle: Any, on_shutdown: Callable[[], None] | None = None,
                  stream_in: TextIO = sys.stdin, stream_out: TextIO = sys.stdout) -> None:
         self.vehicle = vehicle
-        self.shell = Shell(vehicle, on_shutdown)
+        self._on_shutdown = on_shutdown
+        self.shell = Shell(vehicle, self._shutdown if on_shutdown is not None else None)
         self._in = stream_in
         self._out: TextIO | None = stream_out
         self._lines: queue.SimpleQueue[str | None] = queue.SimpleQueue()
@@ -71,6 +72,11 @@ class Console:
             self._at_prompt = True
 
     # --- internals ---------------------------------------------------------------------------------------------
+    def _shutdown(self) -> None:
+        self._input_open = False  # `shutdown`: no prompt after "Exiting NOW."
+        if self._on_shutdown is not None:
+            self._on_shutdown()
+
     def _read_lines(self) -> None:
         try:
             for line in self._in:

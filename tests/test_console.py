@@ -77,10 +77,14 @@ def test_eof_ends_quietly_without_more_prompts():
     assert PROMPT not in out.getvalue()
 
 
-def test_shutdown_command_calls_back():
+def test_shutdown_command_calls_back_and_shows_no_prompt():
     calls = []
-    _run(FakeVehicle(), "shutdown\n", on_shutdown=lambda: calls.append(True))
+    out = io.StringIO()
+    console = Console(FakeVehicle(), lambda: calls.append(True), stream_in=io.StringIO(""), stream_out=out)
+    console._lines.put("shutdown")
+    console.pump()
     assert calls == [True]
+    assert out.getvalue() == "Exiting NOW.\n"
 
 
 def test_closed_output_does_not_break_the_loop():
