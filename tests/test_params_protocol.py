@@ -227,3 +227,23 @@ def test_hash_changes_with_values(setup):
     before = px4_param_hash(ctx.vehicle.params)
     ctx.vehicle.params.set("BAT_LOW_THR", 0.3)
     assert px4_param_hash(ctx.vehicle.params) != before
+
+
+def _crc32_part_bitwise(data: bytes, state: int) -> int:
+    """PX4's crc32part (src/lib/crc/crc.c) written out bit by bit: reflected 0xEDB88320, no inversion."""
+    for byte in data:
+        state ^= byte
+        for _ in range(8):
+            state = (state >> 1) ^ (0xEDB88320 if state & 1 else 0)
+    return state
+
+
+def test_hash_is_px4s_crc_over_names_and_value_bytes():
+    from sitl_emu.params import ParamRegistry, integer, real
+
+    registry = ParamRegistry([real("B_REAL", 2.5), integer("A_INT", 7)])
+    expected = 0
+    for name, raw in (("A_INT", struct.pack("<i", 7)), ("B_REAL", struct.pack("<f", 2.5))):
+        expected = _crc32_part_bitwise(name.encode(), expected)
+        expected = _crc32_part_bitwise(raw, expected)
+    assert px4_param_hash(registry) == expected
