@@ -90,12 +90,11 @@ class VehicleNode:
         received = 0
         for ep in self.endpoints:
             received += ep.poll(now_us, IO_BUDGET_DATAGRAMS)
-        snap = self.snapshot()
         events = self.vehicle.events_after(self._event_seq)
         if events:
             self._event_seq = events[-1].seq
         for ep in self.endpoints:
-            ep.emit(now_us, snap, events)
+            ep.emit(now_us, events)
         return received
 
     # --- services for the endpoints ------------------------------------------------------------------------------

@@ -53,7 +53,7 @@ READY_CASES = [
     (176, (1, 6, 0), [0], ""),  # OFFBOARD while disarmed: always accepted
     (176, (1, 99, 0), [1], "Unsupported main mode"),
     (176, (1, 4, 7), [1], "Unsupported auto mode"),
-    (22, (), [0], "Using default takeoff altitude: 2.5 m\t"),
+    (22, (), [0], ""),  # accepted while disarmed; the takeoff (and its text) starts at arming
     (21, (), [0], "Landing at current position\t"),
     (20, (), [0], "Returning to launch\t"),
     (192, (-1, 1, 0, NAN, NAN, NAN, NAN), [0], ""),
@@ -88,6 +88,18 @@ def test_armed_offboard_without_setpoints_is_temporarily_rejected(h):
     assert _ask(h, 400, 1)[0] == [0]
     assert _ask(h, 176, 1 | 128, 6, 0)[0] == [1]
     assert _ask(h, 400, 0)[0] == [0]
+
+
+def test_arm_then_takeoff_climbs_in_auto_takeoff_then_holds(h):
+    h.run(2.5)
+    assert _ask(h, 400, 1)[0] == [0]
+    got, texts = _ask(h, 22, wait_s=1.5)
+    assert got == [0] and "Using default takeoff altitude: 2.5 m\t" in texts
+    assert h.gcs.of_type("HEARTBEAT")[-1].custom_mode == 33816576  # AUTO.TAKEOFF
+    assert h.run_until(lambda: h.api.of_type("EXTENDED_SYS_STATE")[-1].landed_state == 3, 4.0)  # TAKEOFF
+    h.run(8.0)
+    assert h.gcs.of_type("HEARTBEAT")[-1].custom_mode == 50593792  # then Hold
+    assert h.gcs.of_type("LOCAL_POSITION_NED")[-1].z == pytest.approx(-2.5, abs=0.3)
 
 
 def test_set_mode_message_is_acked_as_do_set_mode(h):

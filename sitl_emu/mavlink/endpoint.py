@@ -181,10 +181,10 @@ class Endpoint:
         return msgs
 
     # --- transmit ------------------------------------------------------------------------------------------------
-    def emit(self, now_us: int, snap: VehicleSnapshot, events: Sequence[VehicleEvent]) -> None:
+    def emit(self, now_us: int, events: Sequence[VehicleEvent]) -> None:
         """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream."""
         self._now_us = now_us
-        self.streams.emit_due(self, snap)
+        self.streams.emit_due(self, self.node.snapshot)
         if events and self.gcs_connected():
             self.streams.send_statustexts(self, events)
         for handler in self._handlers:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import enum
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from sitl_emu.mavlink import telemetry_msgs as tm
@@ -83,12 +83,14 @@ class Streams:
         self._interval_us: dict[int, int] = dict(self._default_us)
         self._next_us: dict[int, int] = {}
         self._next_heartbeat_us = 0
+        self._earliest_us = 0  # nothing is due before this (simulated µs)
         self._statustext_id = 0
         self.build_errors = 0
 
     def restart(self) -> None:
         self._next_us.clear()
         self._next_heartbeat_us = 0
+        self._earliest_us = 0
 
     # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
     def known(self, msg_id: int) -> bool:
@@ -108,6 +110,7 @@ class Streams:
         else:
             self._interval_us[msg_id] = max(int(interval_us), 1)
         self._next_us.pop(msg_id, None)
+        self._earliest_us = 0
         return True
 
     def get_interval(self, msg_id: int) -> int:
@@ -122,22 +125,28 @@ class Streams:
         builder = BUILDERS.get(msg_id) or ON_REQUEST.get(msg_id)
         return builder(ctx, snap) if builder is not None else None
 
-    def emit_due(self, ctx: Any, snap: VehicleSnapshot) -> int:
+    def emit_due(self, ctx: Any, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
+        """Send every stream due at ctx.now_us; the snapshot is only taken when something is due."""
         now = ctx.now_us
+        if now < self._earliest_us:
+            return 0
+        snap = get_snapshot()
         sent = 0
         if now >= self._next_heartbeat_us:
             ctx.send(tm.heartbeat(ctx, snap))
             sent += 1
             self._next_heartbeat_us = _next_due(self._next_heartbeat_us, HEARTBEAT_INTERVAL_US, now)
+        earliest = self._next_heartbeat_us
         for msg_id, interval in self._interval_us.items():
             due = self._next_us.get(msg_id, now)
-            if now < due:
-                continue
-            self._next_us[msg_id] = _next_due(due, interval, now)
-            msg = self._safe_build(msg_id, ctx, snap)
-            if msg is not None:
-                ctx.send(msg)
-                sent += 1
+            if now >= due:
+                due = self._next_us[msg_id] = _next_due(due, interval, now)
+                msg = self._safe_build(msg_id, ctx, snap)
+                if msg is not None:
+                    ctx.send(msg)
+                    sent += 1
+            earliest = min(earliest, due)
+        self._earliest_us = earliest
         return sent
 
     def _safe_build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
