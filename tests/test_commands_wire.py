@@ -128,7 +128,7 @@ def test_set_and_get_message_interval_apply_to_their_own_link(h):
     h.api.command_long(510, 30)
     h.io()
     gcs_iv = [(m.message_id, m.interval_us) for m in h.gcs.of_type("MESSAGE_INTERVAL")]
-    assert gcs_iv == [(30, 20_000), (32, -1), (0, 1_000_000), (331, 50_000)]
+    assert gcs_iv == [(30, 20_000), (32, 0), (0, 1_000_000), (331, 50_000)]  # stopped: 0, as PX4's code does
     assert [(m.message_id, m.interval_us) for m in h.api.of_type("MESSAGE_INTERVAL")] == [(30, 100_000)]
     h.gcs.command_long(511, 32, 0)  # back to the default rate
     h.io()

@@ -100,9 +100,9 @@ class Streams:
         """mavlink_receiver.cpp set_message_interval: <0 stop, 0 default rate, >0 that interval. False: no stream."""
         if msg_id == HEARTBEAT_ID or msg_id not in BUILDERS:
             return False
-        if interval_us < 0:
+        if interval_us < -1e-5:
             self._interval_us.pop(msg_id, None)
-        elif interval_us == 0:
+        elif interval_us <= 1e-5:
             if msg_id in self._default_us:
                 self._interval_us[msg_id] = self._default_us[msg_id]
             else:
@@ -114,10 +114,14 @@ class Streams:
         return True
 
     def get_interval(self, msg_id: int) -> int:
-        """Current interval in µs; -1 if not streaming (MESSAGE_INTERVAL semantics)."""
+        """Current interval in µs; 0 if the link has no such stream running.
+
+        mavlink_receiver.cpp get_message_interval() starts from `unsigned interval = 0` and only overwrites it for a
+        configured stream, so a stopped or unknown stream reads 0 (not the -1 of the MAVLink spec).
+        """
         if msg_id == HEARTBEAT_ID:
             return HEARTBEAT_INTERVAL_US
-        return self._interval_us.get(msg_id, -1)
+        return self._interval_us.get(msg_id, 0)
 
     # --- sending -----------------------------------------------------------------------------------------------
     def build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
