@@ -17,7 +17,7 @@ from typing import Any
 import click
 
 from joyfly.cli_joystick import joystick
-from joyfly.clock import WallClock
+from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view, summary_lines
 from joyfly.flight import FlightSession, Phase
@@ -64,6 +64,7 @@ def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any
 @_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
 @_opt("--record", str, "Record the joystick's events with timestamps to this file (replay with --joy replay:FILE).")
 @_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
+@_opt("--speed", float, "The emulator's speed factor (sitl-emu serve --speed N): joyfly's clock runs as fast.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 def fly(config_path: str | None, **cli_options: Any) -> None:
     """Connect, take off to --alt in OFFBOARD and fly with the joystick; Ctrl-C lands (see --on-exit)."""
@@ -78,7 +79,7 @@ def fly(config_path: str | None, **cli_options: Any) -> None:
 def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) -> int:
     """Open the joystick and the link, fly until done; returns the exit status."""
     out = out or sys.stdout
-    clock = WallClock()
+    clock: WallClock | ScaledClock = WallClock() if opts.speed == 1.0 else ScaledClock(opts.speed)
     try:
         sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
     except JoystickError as err:

@@ -57,6 +57,7 @@ class FlyOptions:
     record: str | None = None
     joy_timeout: float = 5.0  # s
     connect_timeout: float = 15.0  # s
+    speed: float = 1.0  # the emulator's speed factor (sitl-emu serve --speed): joyfly's timing follows it
 
     def session_settings(self, **extra: Any) -> SessionSettings:
         limits = Limits(control=self.control, step_m=self.step, max_speed_m_s=self.max_speed,
@@ -123,6 +124,7 @@ def validate(o: FlyOptions) -> None:
         (o.max_speed > 0 and o.max_climb > 0 and o.max_yaw_rate >= 0,
          "--max-speed, --max-climb must be positive and --max-yaw-rate not negative."),
         (o.step > 0, "--step must be positive."),
+        (0.1 <= o.speed <= 20, "--speed must be between 0.1 and 20 (the emulator's --speed)."),
         (o.joy_timeout > 0 and o.connect_timeout > 0, "--joy-timeout and the connect timeout must be positive."),
     ]
     for ok, message in checks:

@@ -64,7 +64,6 @@ class FlightSession:
         self._linkw = LinkWatch()
         self._fired: frozenset[Action] = frozenset()
         self._arm_hold_s = float(getattr(getattr(sticks, "profile", None), "arm_hold_s", 1.0))
-        self._ready_noted = False
         self._last_pos: tuple[float, float, float] | None = None
         self.setpoints_sent = 0
         self.on_setpoint: list[Callable[[Setpoint], None]] = []
@@ -159,7 +158,8 @@ class FlightSession:
         return pos if pos is not None else (0.0, 0.0, 0.0)
 
     def _hold_here(self) -> Setpoint:
-        return hold_setpoint(self._vehicle_pos(), self.link.state.yaw_rad, self.fence)
+        st = self.link.state
+        return hold_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, st.vel_ned_m_s, self.s.limits.lag_s)
 
     def _send_flight_setpoint(self) -> None:
         now = self.clock.now()
@@ -263,10 +263,17 @@ class FlightSession:
     def _connecting(self, now: float) -> None:
         st = self.link.state
         if st.link_ok(now) and st.pos_ned_m is not None:
+            if not self.cmd.connected and not self.exit_requested:
+                self._note_once("Waiting for the joystick before taking off (a FIFO needs its writer).")
+                return
             self._linkw.update(True)
             self._on_connected()
         elif now - self._start_s > self.s.connect_timeout_s:
             self._fail(self._no_vehicle_message())
+
+    def _note_once(self, text: str) -> None:
+        if not any(n.text == text for n in self.notes):
+            self._note("info", text)
 
     def _no_vehicle_message(self) -> str:
         where = self.link.transport.description
@@ -305,9 +312,7 @@ class FlightSession:
         st = self.link.state
         if st.armed or st.system_status == MAV_STATE_STANDBY or now - self._phase_s > READY_WAIT_S:
             return True
-        if not self._ready_noted:
-            self._ready_noted = True
-            self._note("info", "Waiting for the vehicle to be ready to arm (its HEARTBEAT does not say STANDBY yet).")
+        self._note_once("Waiting for the vehicle to be ready to arm (its HEARTBEAT does not say STANDBY yet).")
         return False
 
     def _arming(self, now: float) -> None:

@@ -106,9 +106,13 @@ def initial_setpoint(vehicle_ned_m: Vec3, vehicle_yaw_rad: float, fence: Fence, 
     return Setpoint(fence.clamp(target), wrap_pi(vehicle_yaw_rad))
 
 
-def hold_setpoint(vehicle_ned_m: Vec3, vehicle_yaw_rad: float, fence: Fence) -> Setpoint:
-    """Stay where the vehicle is (inside the fence), no feed-forward."""
-    return Setpoint(fence.clamp(vehicle_ned_m), wrap_pi(vehicle_yaw_rad), (0.0, 0.0, 0.0))
+def hold_setpoint(vehicle_ned_m: Vec3, vehicle_yaw_rad: float, fence: Fence,
+                  vehicle_vel_ned_m_s: Vec3 = (0.0, 0.0, 0.0), lag_s: float = 0.0) -> Setpoint:
+    """Stop and stay (inside the fence), no feed-forward: at the vehicle's position, or where a moving vehicle
+    will be `lag_s` from now (its braking point; PX4's own Hold also brakes to a stop point, navigator/loiter.cpp)."""
+    ahead = (vehicle_ned_m[0] + vehicle_vel_ned_m_s[0] * lag_s, vehicle_ned_m[1] + vehicle_vel_ned_m_s[1] * lag_s,
+             vehicle_ned_m[2] + vehicle_vel_ned_m_s[2] * lag_s)
+    return Setpoint(fence.clamp(ahead), wrap_pi(vehicle_yaw_rad), (0.0, 0.0, 0.0))
 
 
 def climb_demand(cmd: StickCommand) -> float:

@@ -1,0 +1,210 @@
+"""End to end over loopback UDP: sitl_emu's vehicle node (in-process, or `sitl-emu serve` as a subprocess) and
+joyfly's flight session reading a FIFO joystick of js_event records, as a user would wire them.
+
+The emulator runs faster than real time (its runner's speed factor) and joyfly's clock runs at the same factor, so
+the flights take a few wall-clock seconds each.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+from joyfly.clock import ScaledClock
+from joyfly.demo import EmbeddedVehicle
+from joyfly.flight import FlightSession, Phase, SessionSettings
+from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.link import VehicleLink
+from joyfly.mapping import open_sticks
+from joyfly.transport import UdpTransport
+
+SPEED = 5.0
+AXIS_FULL = 32767
+
+
+@dataclass
+class Flight:
+    clock: ScaledClock
+    session: FlightSession
+    fifo_fd: int
+    emulator: EmbeddedVehicle
+    thread: threading.Thread
+    max_abs_xy: list[float] = field(default_factory=lambda: [0.0])
+
+    def stick(self, axis: int, value: float) -> None:
+        os.write(self.fifo_fd, pack_event(JS_EVENT_AXIS, axis, round(value * AXIS_FULL)))
+
+    def button(self, index: int, down: bool) -> None:
+        os.write(self.fifo_fd, pack_event(JS_EVENT_BUTTON, index, int(down)))
+
+    def wait(self, sim_s: float) -> None:
+        end = self.clock.now() + sim_s
+        while self.clock.now() < end:
+            time.sleep(0.01)
+            self._track()
+
+    def wait_for(self, phase: Phase, sim_s: float) -> None:
+        end = self.clock.now() + sim_s
+        while self.session.phase is not phase and self.clock.now() < end:
+            time.sleep(0.01)
+            self._track()
+        assert self.session.phase is phase, "\n".join(n.text for n in self.session.notes)
+
+    def _track(self) -> None:
+        pos = self.session.link.state.pos_ned_m
+        if pos is not None:
+            self.max_abs_xy[0] = max(self.max_abs_xy[0], abs(pos[0]), abs(pos[1]))
+
+    def pos(self) -> tuple[float, float, float]:
+        pos = self.session.link.state.pos_ned_m
+        assert pos is not None
+        return pos
+
+
+@pytest.fixture
+def flight(tmp_path: Path) -> Iterator[Flight]:
+    fifo = tmp_path / "js0"
+    os.mkfifo(fifo)
+    clock = ScaledClock(SPEED)
+    sticks = open_sticks(str(fifo), clock, profile="script")  # axes forward, right, up, yaw; buttons arm.. offboard
+    fd = os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
+    for index in range(7):
+        os.write(fd, pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, index, 0))
+    for index in range(4):
+        os.write(fd, pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, index, 0))
+    transport = UdpTransport(("127.0.0.1", 0), None)
+    emulator = EmbeddedVehicle(transport.local_port, SPEED)
+    transport.remote = emulator.api_address
+    emulator.start()
+    settings = SessionSettings(joy_timeout_s=5.0, fence_m=5.0)
+    session = FlightSession(VehicleLink(transport, clock), sticks, clock, settings)
+    thread = threading.Thread(target=session.run, daemon=True)
+    thread.start()
+    f = Flight(clock, session, fd, emulator, thread)
+    try:
+        f.wait_for(Phase.FLYING, 20.0)
+        f.wait(6.0)  # finish the climb to --alt
+        yield f
+    finally:
+        session.request_exit()
+        thread.join(60.0 / SPEED)
+        os.close(fd)
+        emulator.stop()
+        session.link.close()
+        sticks.close()
+
+
+def test_stick_forward_flies_north_then_right_flies_east(flight: Flight) -> None:
+    x0, y0, _ = flight.pos()
+    flight.stick(0, 0.4)
+    flight.wait(1.5)
+    flight.stick(0, 0.0)
+    flight.wait(3.0)
+    x1, y1, _ = flight.pos()
+    assert x1 - x0 > 1.5 and abs(y1 - y0) < 0.5
+    flight.stick(1, 0.4)
+    flight.wait(1.5)
+    flight.stick(1, 0.0)
+    flight.wait(3.0)
+    x2, y2, _ = flight.pos()
+    assert y2 - y1 > 1.5 and abs(x2 - x1) < 0.5
+
+
+def test_released_sticks_hold_position(flight: Flight) -> None:
+    flight.stick(0, -0.5)
+    flight.stick(1, 0.3)
+    flight.wait(1.0)
+    flight.stick(0, 0.0)
+    flight.stick(1, 0.0)
+    flight.wait(3.0)
+    settled = flight.pos()
+    flight.wait(8.0)
+    assert max(abs(a - b) for a, b in zip(flight.pos(), settled, strict=True)) < 0.5
+
+
+def test_pushing_against_the_fence_stops_at_it(flight: Flight) -> None:
+    flight.stick(0, 1.0)
+    flight.wait(6.0)
+    flight.stick(1, -1.0)
+    flight.wait(6.0)
+    flight.stick(0, 0.0)
+    flight.stick(1, 0.0)
+    flight.wait(2.0)
+    assert 4.0 < flight.max_abs_xy[0] <= 5.0 + 0.5
+    x, y, _ = flight.pos()
+    assert x > 4.0 and y < -4.0
+
+
+def test_closing_the_fifo_holds_then_lands_after_the_timeout(flight: Flight) -> None:
+    flight.stick(0, 0.4)
+    flight.wait(0.5)
+    os.close(flight.fifo_fd)
+    flight.fifo_fd = os.open("/dev/null", os.O_WRONLY)  # for the fixture's cleanup
+    flight.wait(1.0)
+    assert any("Joystick lost" in n.text for n in flight.session.notes)
+    held = flight.pos()
+    flight.wait(2.5)
+    assert flight.session.phase is Phase.FLYING
+    assert max(abs(a - b) for a, b in zip(flight.pos(), held, strict=True)) < 0.5
+    flight.wait_for(Phase.LANDING, 3.0)
+    flight.wait_for(Phase.GROUNDED, 30.0)
+    assert not flight.session.link.state.armed
+
+
+def _free_udp_port() -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def test_sigint_lands_disarms_and_exits_0(tmp_path: Path) -> None:
+    """Two programs as a user runs them: `sitl-emu serve` and `joyfly fly`, then Ctrl-C to joyfly."""
+    joy_port, emu_port, gcs_port = _free_udp_port(), _free_udp_port(), _free_udp_port()
+    speed = "4"
+    emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
+                            f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
+                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    script = tmp_path / "hover.txt"
+    script.write_text("0 forward=0\n+60 end\n")
+    joy = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", f"script:{script}", "--url",
+                            f"udp://127.0.0.1:{joy_port}@127.0.0.1:{emu_port}", "--speed", speed],
+                           stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        out = _read_until(joy, "OFFBOARD: you have control", 30.0)
+        time.sleep(1.0)
+        joy.send_signal(signal.SIGINT)
+        stdout, stderr = joy.communicate(timeout=40.0)
+    finally:
+        for proc in (joy, emu):
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    out += stdout
+    assert joy.returncode == 0, out + stderr
+    assert "Exiting: land" in out and "Landed and disarmed" in out
+    assert "Traceback" not in stderr
+
+
+def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str:
+    assert proc.stdout is not None
+    seen = ""
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        line = proc.stdout.readline()
+        if not line and proc.poll() is not None:
+            break
+        seen += line
+        if text in line:
+            return seen
+    raise AssertionError(f"never saw {text!r}:\n{seen}")
