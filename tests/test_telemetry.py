@@ -151,3 +151,14 @@ def test_offboard_flight_reports_setpoint_and_intended_mode(h):
     assert _last(h.api, "HEARTBEAT").custom_mode == 84148224
     modes = [(m.custom_mode, m.intended_custom_mode) for m in h.api.of_type("CURRENT_MODE")]
     assert modes[-1] == (84148224, 393216)
+
+
+def test_imu_and_barometer_at_rest_read_gravity_and_isa_pressure(h):
+    h.run(1.0)
+    imu = _last(h.api, "HIGHRES_IMU")
+    assert (imu.xacc, imu.yacc) == pytest.approx((0.0, 0.0), abs=0.05) and imu.zacc == pytest.approx(-9.81, abs=0.05)
+    assert imu.abs_pressure == pytest.approx(955.0, abs=2.0)  # ISA at 488 m
+    assert imu.xmag > 0 and imu.zmag > 0  # northern hemisphere: field points north and down
+    assert len(h.api.of_type("HIGHRES_IMU")) == pytest.approx(50, abs=2)
+    assert not h.gcs.of_type("HIGHRES_IMU"), "not in the normal-mode set"
+    assert _last(h.gcs, "SCALED_PRESSURE").press_abs == pytest.approx(imu.abs_pressure)

@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from sitl_emu.mavlink import telemetry_msgs as tm
+from sitl_emu.mavlink import telemetry_sensors as ts
 from sitl_emu.mavlink.version import autopilot_version, protocol_version
 from sitl_emu.types import VehicleEvent, VehicleSnapshot
 
@@ -42,8 +43,10 @@ BUILDERS: dict[int, tm.Builder] = {
     33: tm.global_position_int,
     74: tm.vfr_hud,
     83: tm.attitude_target,
+    105: ts.highres_imu,
     85: tm.position_target_local_ned,
     111: tm.timesync,
+    29: ts.scaled_pressure,
     141: tm.altitude,
     147: tm.battery_status,
     242: tm.home_position,
@@ -60,12 +63,12 @@ ON_REQUEST: dict[int, tm.Builder] = {
 # Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
 ONBOARD_RATES_HZ: dict[int, float] = {
     111: 10, 32: 30, 30: 100, 141: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5, 245: 5, 33: 50, 24: 8,
-    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10,
+    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10, 105: 50, 29: 1,
 }
 # MAVLINK_MODE_NORMAL with the SITL GCS-link overrides (px4-rc.mavlink: 50 Hz for position/attitude streams)
 NORMAL_RATES_HZ: dict[int, float] = {
     141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 245: 1, 33: 50, 24: 5, 242: 0.5, 32: 50, 85: 50, 1: 1,
-    74: 4,
+    74: 4, 29: 1,
 }
 
 
