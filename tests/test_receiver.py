@@ -256,6 +256,17 @@ def test_statustext_needs_a_gcs_heartbeat_within_2_5_s(h):
     assert len(h.gcs.of_type("STATUSTEXT")) == 1
 
 
+def test_texts_wait_for_a_gcs_up_to_5_s(h):
+    h.vehicle.report(6, "commander", "Ready for takeoff!")
+    h.run(2.0)
+    h.vehicle.report(6, "commander", "Takeoff detected")
+    h.run(3.5)  # the first text is now 5.5 s old, the second 3.5 s
+    assert not h.gcs.of_type("STATUSTEXT")
+    h.gcs.heartbeat()
+    h.io()
+    assert [m.text for m in h.gcs.of_type("STATUSTEXT")] == ["Takeoff detected\t"]
+
+
 def test_long_statustext_is_chunked_with_one_id(h):
     h.gcs.heartbeat()
     h.vehicle.report(4, "commander", "x" * 60 + "y" * 50)

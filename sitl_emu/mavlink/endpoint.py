@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import logging
 import struct
+from collections import deque
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
@@ -27,6 +28,7 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 COMPID = 1  # MAV_COMP_ID default (mavlink_params.yaml)
+MAVLINK_LOG_QUEUE = 8  # msg/MavlinkLog.msg ORB_QUEUE_LENGTH
 
 # Protocol handlers by other modules, one instance per link (sitl_emu/mavlink/context.py). Missing modules are skipped.
 HANDLER_CLASSES: tuple[tuple[str, str], ...] = (
@@ -105,6 +107,8 @@ class Endpoint:
         self.receiver = Receiver()
         self.seen_components: set[tuple[int, int]] = set()
         self.last_gcs_heartbeat_us: int | None = None
+        # mavlink_log messages wait (uORB queue of 8) until a GCS is connected; older than 5 s they are dropped
+        self._pending_texts: deque[VehicleEvent] = deque(maxlen=MAVLINK_LOG_QUEUE)
         self._now_us = 0
         self._handlers = [cls() for cls in handler_classes]
         self._routes: dict[str, list[Any]] = {}
@@ -185,8 +189,10 @@ class Endpoint:
         """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream."""
         self._now_us = now_us
         self.streams.emit_due(self, self.node.snapshot)
-        if events and self.gcs_connected():
-            self.streams.send_statustexts(self, events)
+        self._pending_texts.extend(e for e in events if e.statustext)
+        if self._pending_texts and self.gcs_connected():
+            self.streams.send_statustexts(self, list(self._pending_texts))
+            self._pending_texts.clear()
         for handler in self._handlers:
             try:
                 handler.tick(self)
@@ -198,6 +204,7 @@ class Endpoint:
         """After a vehicle reboot: streams restart from time 0 at their current rates; the GCS must be heard again."""
         self.streams.restart()
         self.last_gcs_heartbeat_us = None
+        self._pending_texts.clear()
 
     def close(self) -> None:
         self.link.close()
