@@ -34,8 +34,8 @@ class Demo:
                  f"{LandedState(s.landed_state).name:<9} pos N {x:6.2f} E {y:6.2f} alt {0.0 - z:5.2f} m")
 
     def command(self, name: str, command: int, *params: float) -> None:
-        p = tuple(params) + (NAN,) * (7 - len(params))
-        ack = self.v.handle_command(VehicleCommand(command, p))
+        p = (*params, *(NAN,) * (7 - len(params)))
+        ack = self.v.handle_command(VehicleCommand(command, p))  # type: ignore[arg-type]
         self.say(f"> {name}: {'no ACK' if ack is None else MavResult(ack.result).name}")
         self._print_events()
 

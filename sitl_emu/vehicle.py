@@ -67,6 +67,7 @@ class Vehicle:
         self._boot()
 
     def _boot(self) -> None:
+        self._snap: VehicleSnapshot | None = None
         self._time_us = 0
         self.ref = GeoRef(*self._home_tuple)
         self._rng = np.random.default_rng(self._seed)
@@ -92,6 +93,7 @@ class Vehicle:
             return
         now = self._time_us + self.dt_us
         self._time_us = now
+        self._snap = None
         dt_s = self.dt_us * 1e-6
         c = self.commander
         c.observe(Observation(now, now >= self._ready_delay_us, self._here(), self._task_finished))
@@ -137,11 +139,13 @@ class Vehicle:
     # ---- inputs -------------------------------------------------------------------------------------------------
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
+        self._snap = None
         return self.commander.handle_command(cmd, self._time_us)
 
     def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
                        attitude: AttitudeSetpoint | None = None) -> None:
         """An offboard message: refreshes the COM_OF_LOSS_T watchdog in any mode; setpoints are used in OFFBOARD."""
+        self._snap = None
         self.commander.offboard_signal(self._time_us, mode)
         self.parts.executor.offboard(mode, trajectory, attitude)
 
@@ -188,7 +192,12 @@ class Vehicle:
         return LandedState.IN_AIR
 
     def snapshot(self) -> VehicleSnapshot:
-        """Everything telemetry needs at the current simulated time."""
+        """Everything telemetry needs at the current simulated time (cached until the next step or input)."""
+        if self._snap is None:
+            self._snap = self._make_snapshot()
+        return self._snap
+
+    def _make_snapshot(self) -> VehicleSnapshot:
         c, s = self.commander, self._estimate
         lat, lon, alt = ned_to_global(self.ref, s.pos_ned_m)
         ctrl = self.parts.control
