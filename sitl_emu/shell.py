@@ -11,6 +11,7 @@ Log-style output uses PX4's console format "%-5s [%s] %s" (platforms/common/px4_
 from __future__ import annotations
 
 import fnmatch
+import logging
 import math
 from collections.abc import Callable
 from typing import Any
@@ -18,6 +19,8 @@ from typing import Any
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavResult, NavState, main_sub
 from sitl_emu.types import VehicleCommand
+
+log = logging.getLogger(__name__)
 
 NAN = math.nan
 FORCE_MAGIC = 21196.0  # ARM_DISARM param2: force (Commander.cpp)
@@ -86,7 +89,11 @@ class Shell:
         app = self._apps.get(command)
         if app is None:
             return f"Invalid command: {command}\ntype 'help' for a list of commands\n"
-        status, out = app(words[1:])
+        try:
+            status, out = app(words[1:])
+        except Exception as err:  # a failing command must never take the console or the link down
+            log.exception("pxh> %s", line)
+            status, out = 1, log_line("ERROR", command, f"internal error: {err}")
         if status != 0:
             out += f"Command '{command}' failed, returned {status}.\n"
         return out

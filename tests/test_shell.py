@@ -174,3 +174,11 @@ def test_commander_takeoff_flies_the_real_vehicle():
     assert snap.armed and snap.nav_state == NavState.AUTO_LOITER
     assert -snap.pos_ned_m[2] == pytest.approx(2.5, abs=0.2)
     assert "INFO  [commander] navigation mode: Hold" in shell.execute("commander status")
+
+
+def test_a_failing_command_reports_instead_of_raising(vehicle):
+    def boom(cmd):
+        raise RuntimeError("vehicle exploded")
+    vehicle.on_command = boom
+    out = Shell(vehicle).execute("commander arm")
+    assert out == "ERROR [commander] internal error: vehicle exploded\nCommand 'commander' failed, returned 1.\n"

@@ -126,3 +126,12 @@ def test_other_devices_and_replies_are_ignored(setup, device, flags):
     bridge.handle(_serial(client, b"commander arm\n", flags=flags, device=device), ctx)
     assert not bridge.is_open
     assert ctx.vehicle.commands == []
+
+
+def test_endless_line_is_cut_and_memory_stays_bounded(setup):
+    bridge, ctx, client = setup
+    for _ in range(100):
+        _type(bridge, ctx, client, b"x" * 70)
+    _type(bridge, ctx, client, b"\n")
+    out = _read(bridge, ctx)
+    assert out.endswith(b"\nInvalid command: " + b"x" * 1024 + b"\ntype 'help' for a list of commands\npxh> ")

@@ -25,6 +25,7 @@ SERIAL_CONTROL_FLAG_REPLY = 1
 SERIAL_CONTROL_FLAG_RESPOND = 2
 MAX_CHUNK = 70
 CHUNKS_PER_TICK = 8
+MAX_LINE = 1024  # longer input lines are cut (a client streaming bytes without a newline must not grow memory)
 MAX_PENDING_OUTPUT = 64 * 1024  # a vanished client must not make the buffer grow forever
 PROMPT = b"pxh> "
 
@@ -71,7 +72,7 @@ class ShellBridge:
         for byte in data:
             if byte == 0x0A:
                 self._run_line(ctx)
-            elif byte > 3:
+            elif byte > 3 and len(self._line) < MAX_LINE:
                 self._out.append(byte)  # echo
                 self._line.append(byte)
 
