@@ -38,7 +38,7 @@ from sitl_emu.types import (
     VehicleEvent,
     VehicleSnapshot,
 )
-from sitl_emu.vehicle_parts import Parts, build_parts
+from sitl_emu.vehicle_parts import Parts, yaw_of
 
 EVENT_HISTORY = 1000
 
@@ -76,7 +76,7 @@ class Vehicle:
         self._sih_version = -1
         self._sih = SihConfig.from_params(self.params)
         self.commander = Commander(self.params, self._emit, self._ned_of)
-        self.parts: Parts = build_parts(self.params)
+        self.parts = Parts(self.params)
         self._setpoint_type = "none"
         self._task_finished = False
 
@@ -178,7 +178,7 @@ class Vehicle:
             return None
         pos = self._estimate.pos_ned_m
         lat, lon, alt = ned_to_global(self.ref, pos)
-        return HomePosition(lat, lon, alt, pos, _yaw(self._estimate.q_wxyz))
+        return HomePosition(lat, lon, alt, pos, yaw_of(self._estimate.q_wxyz))
 
     def landed_state(self) -> LandedState:
         """EXTENDED_SYS_STATE.landed_state (reference 5.5)."""
@@ -216,14 +216,9 @@ class Vehicle:
         )
 
 
-def _yaw(q: Vec4) -> float:
-    w, x, y, z = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def _euler(q: Vec4) -> Vec3:
     """(roll, pitch, yaw) of a w-first quaternion, ZYX (PX4 matrix::Eulerf)."""
     w, x, y, z = q
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch, _yaw(q)
+    return roll, pitch, yaw_of(q)
