@@ -136,7 +136,8 @@ def exit_signals(session: FlightSession) -> Iterator[None]:
 @main.command()
 @click.option("--url", default=None, help="Fly a vehicle already listening there instead of the built-in emulator.")
 @click.option("--speed", type=click.FloatRange(min=0.1, max=20), default=1.0, show_default=True,
-              help="Run the built-in emulator (and the script) this many times faster than real time.")
+              help="Run the built-in emulator (and the script) this many times faster than real time; with --url, "
+                   "the speed that vehicle runs at.")
 @click.option("--script", "script_path", default=None, help="Joystick script (default: the built-in demo flight).")
 @click.option("--live/--plain", default=None, help="Force the live terminal view or plain log lines.")
 def demo(url: str | None, speed: float, script_path: str | None, live: bool | None) -> None:

@@ -102,7 +102,7 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
         transport.remote = emulator.api_address
         transport.description = f"the built-in emulator (UDP {emulator.api_address[1]})"
         emulator.start()
-    clock = ScaledClock(speed if emulator is not None else 1.0)
+    clock = ScaledClock(speed)  # with --url, `speed` is the speed that vehicle runs at
     sticks = script_source(script_path, clock)
     view = make_view(out, live)
     out.write(f"joyfly demo: {transport.description}, scripted joystick "

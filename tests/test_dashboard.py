@@ -1,0 +1,71 @@
+"""The live view and the plain log: what a user reads while flying."""
+
+from __future__ import annotations
+
+import io
+
+from joyfly.dashboard import LiveDashboard, PlainLog, bar, make_view, render, summary_lines
+from joyfly.flight import FlightStats, Note, Phase, SessionView
+from joyfly.setpoints import Fence, Setpoint
+from joyfly.types import Action, StickCommand
+
+
+def view(t: float = 1.0, phase: Phase = Phase.FLYING, mode: str = "OFFBOARD", link_ok: bool = True,
+         pos: tuple[float, float, float] | None = (4.5, -1.0, -3.0), streaming: bool = True) -> SessionView:
+    return SessionView(
+        time_s=t, phase=phase, link_ok=link_ok, mode=mode, armed=True, landed_state=2, pos_ned_m=pos,
+        setpoint=Setpoint((4.8, -1.0, -3.0), 0.0, (1.0, 0.0, 0.0)), streaming=streaming,
+        stick=StickCommand(forward=1.0, right=-0.5, pressed=frozenset({Action.LAND})), joystick_ok=True,
+        fence=Fence((0.0, 0.0, 0.0), 5.0, 0.5, 10.0), stats=FlightStats(12.0, 0.3, 8.0, 3.0),
+        statustexts=("Armed by external command", "Takeoff detected"), notes=(), link_description="UDP 0.0.0.0:14540")
+
+
+def test_bar_shows_direction_and_size() -> None:
+    assert bar(0.0) == "[     |     ]"
+    assert bar(1.0) == "[     |#####]"
+    assert bar(-0.4) == "[   ##|     ]"
+
+
+def test_live_block_has_link_mode_position_setpoint_sticks_margin_and_texts() -> None:
+    text = "\n".join(render(view()))
+    for expected in ("link OK", "OFFBOARD", "ARMED", "+4.50", "+4.80", "fence margin +0.50 m", "buttons land",
+                     "[     |#####]", "vehicle: Takeoff detected", "flying in OFFBOARD"):
+        assert expected in text
+
+
+def test_outside_the_fence_and_lost_link_stand_out() -> None:
+    text = "\n".join(render(view(pos=(5.4, 0.0, -3.0), link_ok=False)))
+    assert "OUTSIDE" in text and "link LOST" in text
+
+
+def test_live_view_redraws_in_place_at_most_10_times_a_second() -> None:
+    out = io.StringIO()
+    live = LiveDashboard(out)
+    for i in range(20):  # 20 views over one second
+        live.show(view(t=i * 0.05))
+    assert out.getvalue().count("\x1b[J") == 9  # 10 frames, each after the first erases the previous
+    live.note(Note(1.0, "warn", "Joystick lost"))
+    assert "! Joystick lost\n" in out.getvalue()
+
+
+def test_plain_log_prints_state_changes_and_at_most_one_line_a_second() -> None:
+    out = io.StringIO()
+    plain = PlainLog(out)
+    for i in range(40):  # 2 s of flying at 20 Hz
+        plain.show(view(t=i * 0.05))
+    plain.show(view(t=2.0, phase=Phase.PAUSED, mode="AUTO.RTL", streaming=False))
+    plain.note(Note(2.0, "warn", "The vehicle left OFFBOARD"))
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 4
+    assert "AUTO.RTL" in lines[2] and "\x1b" not in out.getvalue()
+    assert lines[3].endswith("WARNING The vehicle left OFFBOARD")
+
+
+def test_make_view_picks_plain_lines_without_a_terminal() -> None:
+    assert isinstance(make_view(io.StringIO()), PlainLog)
+    assert isinstance(make_view(io.StringIO(), live=True), LiveDashboard)
+
+
+def test_summary_reports_distance_fence_and_offboard_time() -> None:
+    text = "\n".join(summary_lines(FlightStats(31.5, -0.2, 29.0, 4.1)))
+    assert "31.5 m" in text and "0.20 m OUTSIDE" in text and "29.0 s" in text

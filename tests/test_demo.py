@@ -1,0 +1,49 @@
+"""`joyfly demo`: a whole scripted flight against the built-in emulator, ending with a summary, with or without a
+terminal (CI), and against a vehicle already listening at --url."""
+
+from __future__ import annotations
+
+import io
+import socket
+import subprocess
+import sys
+
+from joyfly.demo import EmbeddedVehicle, run_demo
+
+SPEED = 8.0
+
+
+def test_demo_flies_the_script_and_ends_with_a_summary() -> None:
+    out = io.StringIO()
+    assert run_demo(speed=SPEED, live=False, out=out) == 0
+    text = out.getvalue()
+    assert "OFFBOARD: you have control" in text
+    assert "LAND pressed: landing" in text and "Landed and disarmed" in text
+    assert "distance flown" in text and "time in OFFBOARD" in text
+    closest = next(line for line in text.splitlines() if line.startswith("closest to the fence"))
+    assert "inside" in closest or float(closest.split()[4]) <= 0.5  # the fence push stops at the fence
+    distance = next(line for line in text.splitlines() if line.startswith("distance flown"))
+    assert float(distance.split()[2]) > 20.0  # climb + square + fence push + return
+
+
+def test_demo_runs_without_a_terminal_as_in_ci() -> None:
+    proc = subprocess.run([sys.executable, "-m", "joyfly", "demo", "--speed", str(SPEED)], stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "time in OFFBOARD" in proc.stdout and "\x1b[" not in proc.stdout
+    assert "Traceback" not in proc.stderr
+
+
+def test_demo_flies_a_vehicle_already_listening_at_url() -> None:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        joy_port = probe.getsockname()[1]
+    vehicle = EmbeddedVehicle(joy_port, SPEED)
+    vehicle.start()
+    try:
+        host, port = vehicle.api_address
+        out = io.StringIO()
+        assert run_demo(url=f"udp://127.0.0.1:{joy_port}@{host}:{port}", speed=SPEED, live=False, out=out) == 0
+    finally:
+        vehicle.stop()
+    assert "Landed and disarmed" in out.getvalue()
