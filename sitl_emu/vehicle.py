@@ -96,7 +96,7 @@ class Vehicle:
         self._snap = None
         dt_s = self.dt_us * 1e-6
         c = self.commander
-        c.observe(Observation(now, now >= self._ready_delay_us, self._here(), self._task_finished))
+        c.observe(Observation(now, now >= self._ready_delay_us, self._here, self._task_finished))
         c.update(now)
         est = self._estimate
         out = self.parts.executor.update(c.nav_state, c.armed, now,

@@ -32,7 +32,9 @@ class Observation:
 
     now_us: int
     estimator_ready: bool
-    here: HomePosition | None  # the current position as a home candidate; None while the estimator is not ready
+    # the current position as a home candidate (None while the estimator is not ready), or a function giving it
+    # (evaluated only when home is set: at arming, when first ready, on DO_SET_HOME)
+    here: HomePosition | Callable[[], HomePosition | None] | None
     task_finished: bool = False  # the navigator's current task says it is done (takeoff reached)
 
 
@@ -110,6 +112,10 @@ class Commander:
     def observe(self, obs: Observation) -> None:
         self._obs = obs
 
+    def _here(self) -> HomePosition | None:
+        here = self._obs.here
+        return here() if callable(here) else here
+
     @property
     def now_us(self) -> int:
         return self._obs.now_us
@@ -184,8 +190,9 @@ class Commander:
         self._armed_at_us = now_us
         self._landed_since_us = None
         self._failsafe.reset()
-        if self.settings.home_enabled and self._obs.here is not None:
-            self.home = self._obs.here
+        here = self._here()
+        if self.settings.home_enabled and here is not None:
+            self.home = here
         self.say(Severity.INFO, f"Armed by {'external' if external else 'internal'} command")
         return True
 
@@ -242,8 +249,8 @@ class Commander:
     def _update_ready(self) -> None:
         if not self.estimator_ready:
             return
-        if self.home is None and not self.armed and self.settings.home_enabled and self._obs.here is not None:
-            self.home = self._obs.here  # HomePosition::update: first valid global position on the ground
+        if self.home is None and not self.armed and self.settings.home_enabled:
+            self.home = self._here()  # HomePosition::update: first valid global position on the ground
         if not self._ready_announced:
             self._ready_announced = True
             self.say(Severity.INFO, "Ready for takeoff!", is_event=False, statustext=False)
@@ -298,7 +305,8 @@ class Commander:
         return True
 
     def home_here(self) -> bool:
-        if not self.estimator_ready or self._obs.here is None:
+        here = self._here()
+        if not self.estimator_ready or here is None:
             return False
-        self.home = self._obs.here
+        self.home = here
         return True
