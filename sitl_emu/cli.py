@@ -18,7 +18,8 @@ import click
 
 from sitl_emu.mavlink.link import PortInUseError
 from sitl_emu.runner import RealTimeRunner
-from sitl_emu.server import LinkSettings, VehicleNode
+from sitl_emu.server import LinkSettings
+from sitl_emu.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
 log = logging.getLogger(__name__)
 
@@ -124,6 +125,8 @@ def main(verbose: int) -> None:
               help="Vehicle instance N: sysid N+1 and every port offset by N, as PX4's -i.")
 @click.option("--speed", type=click.FloatRange(min=0.01, max=1000), default=1.0, show_default=True,
               help="Simulation speed factor.")
+@click.option("--count", type=click.IntRange(1, 250), default=1, show_default=True,
+              help="Number of vehicles: instances --instance.., sysids and ports offset per vehicle, homes 3 m apart.")
 @click.option("--home", default=None, help="Home as LAT,LON,ALT (deg, deg, m AMSL).")
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
@@ -131,24 +134,30 @@ def main(verbose: int) -> None:
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed for sensor noise.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
-          home: str | None, assignments: tuple[str, ...], params_file: Path | None, seed: int,
+          count: int, home: str | None, assignments: tuple[str, ...], params_file: Path | None, seed: int,
           no_console: bool) -> None:
-    """Run one emulated PX4 quadrotor with its API and GCS MAVLink links."""
+    """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
-                                parse_address(gcs_remote, "--gcs-remote")).for_instance(instance)
-        params = build_params(params_file, assignments)
-        vehicle = build_vehicle(params, parse_home(home) if home else None, seed, instance + 1)
-        node = VehicleNode(vehicle, settings, epoch_unix_us=int(time.time() * 1e6))
+                                parse_address(gcs_remote, "--gcs-remote"))
+        home_lla = parse_home(home) if home else DEFAULT_HOME
+        if instance + count > 251:
+            raise UsageProblem(f"--instance {instance} with --count {count} needs sysids above 251; use fewer.")
+        build_params(params_file, assignments)  # report a bad --param once, before any port is opened
+        nodes = build_nodes(count, settings, lambda i, h: build_vehicle(
+            build_params(params_file, assignments), h, seed + i - instance, i + 1), first_instance=instance,
+            home=home_lla, epoch_unix_us=int(time.time() * 1e6))
     except (UsageProblem, PortInUseError) as err:
         click.echo(f"sitl-emu: {err}", err=True)
         sys.exit(2)
-    runner = RealTimeRunner([node], speed=speed)
-    click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
+    runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
+    for node in nodes:
+        click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
-    start_console(vehicle, runner, not no_console)
+    start_console(nodes[0].vehicle, runner, not no_console)
     _run_until_signalled(runner)
-    node.close()
+    for node in nodes:
+        node.close()
 
 
 def _run_until_signalled(runner: RealTimeRunner) -> None:

@@ -1,0 +1,100 @@
+"""Many vehicles in one process: N nodes with PX4's multi-vehicle numbering, and a runner that keeps them on time.
+
+Instance i (0-based, after `first_instance`) gets sysid 1 + i and every port offset by i, as PX4's `px4 -i N` does
+(ROMFS/px4fmu_common/init.d-posix/px4-rc.mavlink, reference 1.1/1.3; LinkSettings.for_instance), and its home
+`spacing_m` further east than the previous one so the vehicles do not start on top of each other (PX4's
+Tools/simulation/gazebo-classic/sitl_multiple_run.sh spawns instance N at 3 m x N). Each vehicle keeps its own local
+frame with its own home as origin, as each PX4 instance has its own EKF origin.
+
+`SwarmRunner` advances every vehicle's physics to the wall-clock target before it does any I/O, and then lets each
+node read at most `io_budget` datagrams per link per pass: a flood on one vehicle's port costs a bounded amount of
+time per pass and never holds back the physics of the others (its datagrams wait in its own socket buffer).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any
+
+from sitl_emu.geo import GeoRef, ned_to_global
+from sitl_emu.runner import RealTimeRunner
+from sitl_emu.server import LinkSettings, VehicleNode
+
+log = logging.getLogger(__name__)
+
+DEFAULT_HOME = (47.397742, 8.545594, 488.0)  # Vehicle's default home (PX4 SIH default, Zurich)
+DEFAULT_SPACING_M = 3.0  # gazebo-classic sitl_multiple_run.sh: instance N spawned at 3*N m
+SWARM_IO_BUDGET = 20  # datagrams per link per I/O pass in the swarm runner (a pass happens every 4 ms of sim time)
+
+VehicleFactory = Callable[[int, tuple[float, float, float]], Any]  # (instance, home) -> Vehicle
+
+
+def instance_home(home: tuple[float, float, float], index: int, spacing_m: float = DEFAULT_SPACING_M
+                  ) -> tuple[float, float, float]:
+    """Home of the `index`-th vehicle of a swarm: `index * spacing_m` east of `home` (lat_deg, lon_deg, alt_m)."""
+    if index == 0:
+        return home
+    return ned_to_global(GeoRef(*home), (0.0, index * spacing_m, 0.0))
+
+
+def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory, *, first_instance: int = 0,
+                home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
+                epoch_unix_us: int = 0, handler_classes: Sequence[type] | None = None) -> list[VehicleNode]:
+    """`count` nodes for instances first_instance.., ports offset per instance; closes them all if one fails."""
+    if count < 1:
+        raise ValueError("count must be at least 1")
+    nodes: list[VehicleNode] = []
+    try:
+        for i in range(count):
+            instance = first_instance + i
+            vehicle = make_vehicle(instance, instance_home(home, i, spacing_m))
+            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, handler_classes))
+    except BaseException:
+        for node in nodes:
+            node.close()
+        raise
+    return nodes
+
+
+def _offset(settings: LinkSettings, instance: int) -> LinkSettings:
+    """settings.for_instance(instance), except that a local port 0 (let the OS pick) stays 0."""
+    s = settings.for_instance(instance)
+    return replace(s, api_port=s.api_port if settings.api_port else 0, gcs_port=s.gcs_port if settings.gcs_port else 0)
+
+
+class SwarmRunner(RealTimeRunner):
+    """A RealTimeRunner for many nodes: all vehicles advance tick by tick together, I/O after each tick.
+
+    Tick k of every vehicle runs before tick k+1 of any, so the vehicles stay within one tick of each other however
+    far the runner has to catch up, and after each tick every node does its I/O (streams keep their rates). Reads
+    per node are capped at `io_budget` datagrams per link per tick, so a flood costs that node a bounded time and
+    the other vehicles' physics are not held back.
+    """
+
+    def __init__(self, nodes: Sequence[Any], speed: float = 1.0, hooks: Sequence[Callable[[], None]] = (),
+                 io_budget: int = SWARM_IO_BUDGET) -> None:
+        super().__init__(nodes, speed, hooks)
+        for node in self.nodes:
+            node.io_budget = io_budget
+
+    def _advance(self, target_us: int, dt_us: int) -> None:
+        stepped = True
+        any_stepped = False
+        while stepped:
+            stepped = False
+            for node in self.nodes:
+                vehicle = node.vehicle
+                if vehicle.time_us + dt_us <= target_us:
+                    vehicle.step()
+                    stepped = any_stepped = True
+                    self.steps += 1
+            if stepped:
+                self._io_pass()
+        if not any_stepped:
+            self._io_pass()
+
+    def _io_pass(self) -> None:
+        for node in self.nodes:
+            node.step_io(node.vehicle.time_us)
