@@ -181,7 +181,7 @@ class Commander:
         if run_checks:
             failure = arming.arming_failure(self.nav_state, self.check_inputs(now_us))
             if failure is not None:
-                self.say(Severity.CRITICAL, f"Preflight Fail: {failure}", is_event=False, statustext=False,
+                self.say(Severity.WARNING, f"Preflight Fail: {failure}", is_event=False, statustext=False,
                          module="health_and_arming_checks")
                 self.say(Severity.CRITICAL, "Arming denied: Resolve system health failures first")
                 return False
