@@ -2,13 +2,12 @@
 
 Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (4000 us, 250 Hz):
  1. pending reboot (PREFLIGHT_REBOOT_SHUTDOWN param1=1, acknowledged before): back to the boot state, time 0;
- 2. estimate: the truth state (plus optional seeded noise) becomes the estimate everything else reads;
- 3. commander: readiness ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
- 4. mode executor: the navigator task of the mode in force, or the offboard setpoint (OFFBOARD);
- 5. control cascade: setpoint -> motor commands (idle/zero when disarmed or terminated);
- 6. physics: rigid-body step by dt;
- 7. land detector on the new state -> commander ("Takeoff detected" / "Landing detected");
- 8. events: the task's messages join the event stream.
+ 2. commander: readiness ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
+ 3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
+ 4. control cascade: setpoint -> motor commands (zero when disarmed or terminated);
+ 5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
+ 6. land detector on the new estimate -> commander ("Takeoff detected" / "Landing detected");
+ 7. events: the task's messages join the event stream.
 Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
 on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
 """
