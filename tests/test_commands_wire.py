@@ -194,3 +194,21 @@ def test_seed_sequence_arm_stream_offboard_climb_follow_then_loss_returns(h):
     hb = h.api.of_type("HEARTBEAT")[-1]
     assert hb.custom_mode == 84148224 and hb.base_mode & 128
     assert "Failsafe activated\t" in _texts(h.gcs, n_txt)
+
+
+def test_available_modes_on_request_all_or_one(h):
+    h.gcs.command_long(512, 435, 0)
+    h.io()
+    modes = h.gcs.of_type("AVAILABLE_MODES")
+    assert [m.mode_index for m in modes] == list(range(1, len(modes) + 1))
+    assert {m.number_modes for m in modes} == {len(modes)}
+    by_mode = {m.custom_mode: m for m in modes}
+    assert by_mode[50593792].mode_name == "Hold" and by_mode[50593792].standard_mode == 0
+    assert by_mode[84148224].standard_mode == 5 and by_mode[84148224].mode_name == ""  # Return = SAFE_RECOVERY
+    assert by_mode[196608].properties == 0 and by_mode[393216].properties == 1  # Position basic, Offboard advanced
+    assert _acks(h.gcs) == [(512, 0)]
+    h.gcs.command_long(512, 435, 3)
+    h.gcs.command_long(512, 435, len(modes) + 1)
+    h.io()
+    assert h.gcs.of_type("AVAILABLE_MODES")[-1].mode_index == 3
+    assert _acks(h.gcs)[1:] == [(512, 0), (512, 2)]

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from sitl_emu.mavlink.modes_msgs import available_modes
 from sitl_emu.px4 import MavResult
 from sitl_emu.types import VehicleCommand
 
@@ -24,6 +25,7 @@ MSG_HOME_POSITION = 242
 MSG_MESSAGE_INTERVAL = 244
 MSG_AUTOPILOT_VERSION = 148
 MSG_PROTOCOL_VERSION = 300
+MSG_AVAILABLE_MODES = 435
 
 # legacy request commands -> the message they ask for (PX4@2024 mavlink_receiver.cpp)
 LEGACY_REQUESTS = {
@@ -62,6 +64,8 @@ class CommandHandler:
             msg_id = _msg_id(cmd.param(1))
             if msg_id == MSG_MESSAGE_INTERVAL:
                 return self._get_interval(_msg_id(cmd.param(2)), ctx)
+            if msg_id == MSG_AVAILABLE_MODES:
+                return self._send_all(available_modes(ctx, cmd.param(2)), ctx)
             return self._request(msg_id, ctx)
         return self._request(LEGACY_REQUESTS[cmd.command], ctx)
 
@@ -91,9 +95,14 @@ class CommandHandler:
         if msg_id is None:
             return MavResult.DENIED
         msg = ctx.streams.build(msg_id, ctx, ctx.node.snapshot())
-        if msg is None:
+        return CommandHandler._send_all(None if msg is None else [msg], ctx)
+
+    @staticmethod
+    def _send_all(msgs: list[Any] | None, ctx: Any) -> int:
+        if not msgs:
             return MavResult.DENIED
-        ctx.send(msg)
+        for msg in msgs:
+            ctx.send(msg)
         return MavResult.ACCEPTED
 
 
