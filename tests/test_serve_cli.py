@@ -136,3 +136,35 @@ def test_params_file_in_both_formats_sets_parameters(tmp_path):
     assert registry.get("MIS_TAKEOFF_ALT") == 5.0
     assert registry.get("COM_OF_LOSS_T") == 2.0
     assert registry.get("COM_DISARM_LAND") == 3.0
+
+
+def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
+    """mavutil's own PX4 mode map and arm helper against the real process (run at 5x real time)."""
+    from pymavlink import mavutil
+
+    api_port, gcs_port, remote = _free_ports(3)
+    conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{remote}", source_system=255, source_component=190)
+    proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}",
+                  "--speed", "5")
+    try:
+        hb = conn.wait_heartbeat(timeout=10)
+        assert hb is not None and conn.target_system == 1
+        assert conn.recv_match(type="HEARTBEAT", condition="HEARTBEAT.system_status==3", blocking=True, timeout=10)
+        assert conn.flightmode == "LOITER"
+        conn.arducopter_arm()
+        ack = conn.recv_match(type="COMMAND_ACK", blocking=True, timeout=5)
+        assert (ack.command, ack.result) == (400, 0)
+        conn.set_mode("TAKEOFF")
+        assert conn.recv_match(type="COMMAND_ACK", blocking=True, timeout=5).result == 0
+        seen: list[str] = []
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and not (seen and seen[-1] == "LOITER" and "TAKEOFF" in seen):
+            if conn.recv_match(type="HEARTBEAT", blocking=True, timeout=1) is not None:
+                seen.append(conn.flightmode)
+        assert seen[0] == "TAKEOFF" and seen[-1] == "LOITER", seen
+        gpi = conn.recv_match(type="GLOBAL_POSITION_INT", blocking=True, timeout=5)
+        assert gpi.relative_alt > 1500
+    finally:
+        proc.terminate()
+        proc.communicate(timeout=10)
+        conn.close()
