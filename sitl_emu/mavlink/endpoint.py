@@ -56,8 +56,10 @@ class NodeServices(Protocol):
     """What an endpoint needs from the node that owns it."""
 
     vehicle: Any
-    sysid: int
     epoch_unix_us: int
+
+    @property
+    def sysid(self) -> int: ...
 
     def broadcast(self, msg: Any) -> None: ...
 

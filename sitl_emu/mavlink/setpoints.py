@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from sitl_emu.mavlink.telemetry_msgs import rotate_body_to_ned
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, VehicleSnapshot
@@ -46,13 +47,13 @@ class Decoded:
 DROPPED = Decoded()
 
 
-def decode_local_ned(msg: object, snap: VehicleSnapshot) -> Decoded:
+def decode_local_ned(msg: Any, snap: VehicleSnapshot) -> Decoded:
     """SET_POSITION_TARGET_LOCAL_NED: frames LOCAL_NED (1) and BODY_NED (8) only."""
-    frame = int(msg.coordinate_frame)  # type: ignore[attr-defined]
-    mask = int(msg.type_mask)  # type: ignore[attr-defined]
-    pos = (msg.x, msg.y, msg.z)  # type: ignore[attr-defined]
-    vel = (msg.vx, msg.vy, msg.vz)  # type: ignore[attr-defined]
-    acc = (msg.afx, msg.afy, msg.afz)  # type: ignore[attr-defined]
+    frame = int(msg.coordinate_frame)
+    mask = int(msg.type_mask)
+    pos = (msg.x, msg.y, msg.z)
+    vel = (msg.vx, msg.vy, msg.vz)
+    acc = (msg.afx, msg.afy, msg.afz)
     if frame == MAV_FRAME_LOCAL_NED:
         pos_ned, vel_ned, acc_ned = _masked(pos, mask, 0), _masked(vel, mask, 3), _masked(acc, mask, 6)
     elif frame == MAV_FRAME_BODY_NED:
@@ -62,47 +63,48 @@ def decode_local_ned(msg: object, snap: VehicleSnapshot) -> Decoded:
     else:
         return Decoded(error=f"SET_POSITION_TARGET_LOCAL_NED coordinate frame {frame} unsupported")
     return _trajectory("SET_POSITION_TARGET_LOCAL_NED", mask, pos_ned, vel_ned, acc_ned,
-                       msg.yaw, msg.yaw_rate)  # type: ignore[attr-defined]
+                       msg.yaw, msg.yaw_rate)
 
 
-def decode_global_int(msg: object, snap: VehicleSnapshot) -> Decoded:
+def decode_global_int(msg: Any, snap: VehicleSnapshot) -> Decoded:
     """SET_POSITION_TARGET_GLOBAL_INT: lat/lon projected into the local frame; z per frame as PX4 codes it."""
-    frame = int(msg.coordinate_frame)  # type: ignore[attr-defined]
-    mask = int(msg.type_mask)  # type: ignore[attr-defined]
+    frame = int(msg.coordinate_frame)
+    mask = int(msg.type_mask)
     if frame not in (MAV_FRAME_GLOBAL_INT, MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, MAV_FRAME_GLOBAL_TERRAIN_ALT_INT):
         return Decoded(error=f"SET_POSITION_TARGET_GLOBAL_INT invalid coordinate frame {frame}")
     if not snap.position_valid:  # no global reference: silently dropped
         return DROPPED
     pos_ned: Vec3 = (NAN, NAN, NAN)
     if not mask & POS_MASK:
-        z = _global_z(frame, float(msg.alt), snap)  # type: ignore[attr-defined]
+        z = _global_z(frame, float(msg.alt), snap)
         if z is None:
             return DROPPED
-        x, y = project(snap.ref_lat_deg, snap.ref_lon_deg, msg.lat_int * 1e-7, msg.lon_int * 1e-7)  # type: ignore
+        x, y = project(snap.ref_lat_deg, snap.ref_lon_deg, msg.lat_int * 1e-7, msg.lon_int * 1e-7)
         pos_ned = _finite((x, y, z))
-    vel = _masked((msg.vx, msg.vy, msg.vz), mask, 3)  # type: ignore[attr-defined]
-    acc = _masked((msg.afx, msg.afy, msg.afz), mask, 6)  # type: ignore[attr-defined]
+    vel = _masked((msg.vx, msg.vy, msg.vz), mask, 3)
+    acc = _masked((msg.afx, msg.afy, msg.afz), mask, 6)
     return _trajectory("SET_POSITION_TARGET_GLOBAL_INT", mask, pos_ned, vel, acc, msg.yaw,
-                       msg.yaw_rate)  # type: ignore[attr-defined]
+                       msg.yaw_rate)
 
 
-def decode_attitude_target(msg: object) -> Decoded:
+def decode_attitude_target(msg: Any) -> Decoded:
     """SET_ATTITUDE_TARGET: attitude and/or body rates, with thrust; otherwise dropped."""
-    mask = int(msg.type_mask)  # type: ignore[attr-defined]
+    mask = int(msg.type_mask)
     use_attitude = not mask & ATTITUDE_IGNORE
     use_rates = not mask & ROLL_RATE_IGNORE and not mask & PITCH_RATE_IGNORE
     has_thrust = not mask & THROTTLE_IGNORE or bool(mask & THRUST_BODY_SET)
     if not (use_attitude or use_rates) or not has_thrust:
         return DROPPED
-    q = tuple(float(v) for v in msg.q)  # type: ignore[attr-defined]
+    w, x, y, z = (float(v) for v in msg.q)
+    q = (w, x, y, z)
     if use_attitude and (not all(math.isfinite(v) for v in q) or sum(v * v for v in q) < 1e-6):
         return DROPPED
     thrust = _thrust_body(msg, mask)
     if thrust is None:
         return DROPPED
-    yaw_rate = NAN if mask & YAW_RATE_IGNORE_ATT else msg.body_yaw_rate  # type: ignore[attr-defined]
-    rates = _finite((msg.body_roll_rate, msg.body_pitch_rate, yaw_rate)) if use_rates else (NAN, NAN, NAN)  # type: ignore
-    setpoint = AttitudeSetpoint(q_wxyz=_normalized(q) if use_attitude else None,  # type: ignore[arg-type]
+    yaw_rate = NAN if mask & YAW_RATE_IGNORE_ATT else msg.body_yaw_rate
+    rates = _finite((msg.body_roll_rate, msg.body_pitch_rate, yaw_rate)) if use_rates else (NAN, NAN, NAN)
+    setpoint = AttitudeSetpoint(q_wxyz=_normalized(q) if use_attitude else None,
                                 body_rates_rad_s=rates, thrust_body=thrust)
     mode = OffboardControlMode(attitude=bool(use_attitude), body_rate=bool(use_rates))
     return Decoded(mode=mode, attitude=setpoint)
@@ -146,11 +148,11 @@ def _global_z(frame: int, alt_m: float, snap: VehicleSnapshot) -> float | None:
     return None  # GLOBAL_TERRAIN_ALT_INT needs terrain data, which SIH does not estimate
 
 
-def _thrust_body(msg: object, mask: int) -> Vec3 | None:
+def _thrust_body(msg: Any, mask: int) -> Vec3 | None:
     if mask & THRUST_BODY_SET:
-        tb = tuple(float(v) for v in getattr(msg, "thrust_body", (0.0, 0.0, 0.0)))
-        return tb if all(math.isfinite(v) for v in tb) else None  # type: ignore[return-value]
-    thrust = float(msg.thrust)  # type: ignore[attr-defined]
+        tx, ty, tz = (float(v) for v in getattr(msg, "thrust_body", (0.0, 0.0, 0.0)))
+        return (tx, ty, tz) if all(math.isfinite(v) for v in (tx, ty, tz)) else None
+    thrust = float(msg.thrust)
     if not math.isfinite(thrust):
         return None
     return (0.0, 0.0, -min(max(thrust, 0.0), 1.0))
