@@ -3,9 +3,10 @@ command retries that explain a refusal with the vehicle's own words (COMMAND_ACK
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
-from joyfly.link import CommandHandle, VehicleLink
+from joyfly.link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink
 
 # PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
@@ -127,3 +128,36 @@ class Retry:
 
     def failure_message(self) -> str:
         return f"{self.what} failed after {self.attempt} attempt(s). {self.last_refusal}"
+
+
+class ExitPlan:
+    """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
+    until the vehicle is disarmed (land, rtl) or out of OFFBOARD (hold). The caller enforces the overall timeout."""
+
+    def __init__(self, on_exit: str, link: VehicleLink, now_s: float) -> None:
+        self.on_exit = on_exit
+        self.link = link
+        self.retry = Retry(f"Exit action {on_exit}", 3, now_s, settle_s=math.inf)
+        self._gave_up = False
+
+    def _send(self) -> CommandHandle:
+        if self.on_exit == "land":
+            return self.link.land()
+        if self.on_exit == "rtl":
+            return self.link.return_to_launch()
+        return self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+
+    def done(self) -> bool:
+        st = self.link.state
+        return not st.offboard if self.on_exit == "hold" else not st.armed
+
+    def update(self, now_s: float) -> str | None:
+        """"done", a refusal to report, or None while in progress."""
+        if self.done():
+            return "done"
+        outcome = self.retry.update(now_s, self.link, self._send, lambda: False)
+        if outcome == "failed":
+            if self._gave_up:
+                return None
+            self._gave_up = True
+        return self.retry.last_refusal if outcome else None

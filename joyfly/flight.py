@@ -14,7 +14,7 @@ import logging
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.failsafes import JoystickWatch, LinkWatch, Retry
+from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
 from joyfly.flight_session import (
     STREAMING_PHASES,
     FlightStats,
@@ -23,6 +23,8 @@ from joyfly.flight_session import (
     SessionSettings,
     SessionView,
     StickSource,
+    left_offboard_message,
+    no_vehicle_message,
     update_stats,
 )
 from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, VehicleLink
@@ -67,8 +69,7 @@ class FlightSession:
         self._last_pos: tuple[float, float, float] | None = None
         self.setpoints_sent = 0
         self.on_setpoint: list[Callable[[Setpoint], None]] = []
-        self._exit_done: Callable[[], bool] = lambda: True
-        self._exit_action: Callable[[], object] = lambda: None
+        self._exit: ExitPlan | None = None
 
     # --- the loop ----------------------------------------------------------------------------------------------
     @property
@@ -269,19 +270,13 @@ class FlightSession:
             self._linkw.update(True)
             self._on_connected()
         elif now - self._start_s > self.s.connect_timeout_s:
-            self._fail(self._no_vehicle_message())
+            st = self.link.state
+            self._fail(no_vehicle_message(self.link.transport.description, st.last_heartbeat_s is not None,
+                                          self.s.connect_timeout_s))
 
     def _note_once(self, text: str) -> None:
         if not any(n.text == text for n in self.notes):
             self._note("info", text)
-
-    def _no_vehicle_message(self) -> str:
-        where = self.link.transport.description
-        if self.link.state.last_heartbeat_s is not None:
-            return (f"The vehicle on {where} sends HEARTBEATs but no LOCAL_POSITION_NED after "
-                    f"{self.s.connect_timeout_s:g} s: it has no position estimate yet; wait for it, then retry.")
-        return (f"No HEARTBEAT from a vehicle on {where} after {self.s.connect_timeout_s:g} s: start "
-                "`sitl-emu serve` or PX4 SITL first (PX4 sends to UDP port 14540), or fix --url.")
 
     def _on_connected(self) -> None:
         st = self.link.state
@@ -368,17 +363,11 @@ class FlightSession:
     def _flying(self, now: float) -> None:
         st = self.link.state
         if not st.offboard:
-            self._note("warn", self._left_offboard_message())
+            recent = [t.text for t in self.link.statustexts if self.clock.now() - t.time_s < 3.0]
+            self._note("warn", left_offboard_message(st.mode, recent))
             self._set_phase(Phase.PAUSED if st.armed else Phase.GROUNDED)
             return
         self._send_flight_setpoint()
-
-    def _left_offboard_message(self) -> str:
-        st = self.link.state
-        recent = [t.text for t in self.link.statustexts if self.clock.now() - t.time_s < 3.0]
-        why = f" ({recent[-1]})" if recent else ""
-        return (f"The vehicle left OFFBOARD for {st.mode}{why}: joyfly stopped sending setpoints and will not "
-                "fight it; press OFFBOARD to take control again.")
 
     def _paused(self, now: float) -> None:
         st = self.link.state
@@ -405,24 +394,17 @@ class FlightSession:
         self._set_phase(Phase.EXITING)
 
     def _exiting(self, now: float) -> None:
-        st = self.link.state
-        on_exit = self.s.on_exit
-        if self._retry is None:
-            action = {"land": self.link.land, "rtl": self.link.return_to_launch}.get(
-                on_exit, lambda: self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER))
-            done = (lambda: not self.link.state.offboard) if on_exit == "hold" else (lambda: not self.link.state.armed)
-            self._retry = Retry(f"Exit action {on_exit}", 3, now, settle_s=self.s.exit_timeout_s)
-            self._exit_done = done
-            self._exit_action = action
-        if st.offboard and self.sp is not None:
+        if self._exit is None:
+            self._exit = ExitPlan(self.s.on_exit, self.link, now)
+        if self.link.state.offboard and self.sp is not None:  # until the vehicle switched, keep it fed
             self._send(replace(self.sp, vel_ned_m_s=(0.0, 0.0, 0.0) if self.sp.vel_ned_m_s else None))
-        if self._exit_done():
-            self._note("info", "Landed and disarmed." if on_exit != "hold" else "The vehicle holds position.")
+        outcome = self._exit.update(now)
+        if outcome == "done":
+            self._note("info", "Landed and disarmed." if self.s.on_exit != "hold" else "The vehicle holds position.")
             self._set_phase(Phase.DONE)
             return
-        outcome = self._retry.update(now, self.link, self._exit_action, lambda: False)
-        if outcome == "refused":
-            self._note("warn", self._retry.last_refusal)
+        if outcome:
+            self._note("warn", outcome)
         self._tick_exit_timeout(now)
 
     def _tick_exit_timeout(self, now: float) -> None:

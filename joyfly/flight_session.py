@@ -104,3 +104,18 @@ def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None
     margin = min(stats.min_fence_margin_m, fence.margin_m(pos)) if in_air else stats.min_fence_margin_m
     offboard = stats.offboard_time_s + (dt_s if st.offboard else 0.0)
     return FlightStats(dist, margin, offboard, max(stats.max_alt_m, fence.alt_m(pos)))
+
+
+def no_vehicle_message(where: str, heard: bool, timeout_s: float) -> str:
+    """Why the session could not start, and what to do about it."""
+    if heard:
+        return (f"The vehicle on {where} sends HEARTBEATs but no LOCAL_POSITION_NED after {timeout_s:g} s: it has "
+                "no position estimate yet; wait for it, then retry.")
+    return (f"No HEARTBEAT from a vehicle on {where} after {timeout_s:g} s: start `sitl-emu serve` or PX4 SITL "
+            "first (PX4 sends to UDP port 14540), or fix --url.")
+
+
+def left_offboard_message(mode: str, recent_texts: list[str]) -> str:
+    why = f" ({recent_texts[-1]})" if recent_texts else ""
+    return (f"The vehicle left OFFBOARD for {mode}{why}: joyfly stopped sending setpoints and will not fight it; "
+            "press OFFBOARD to take control again.")
