@@ -48,6 +48,7 @@ class Observed:
     sys_status: Any = None
     home_seen: bool = False
     pos_ned_m: tuple[float, float, float] | None = None
+    lat_lon_deg: tuple[float, float] | None = None
     acks: list[tuple[int, int]] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
     texts: list[str] = field(default_factory=list)
@@ -107,6 +108,8 @@ class FlightClient:
             self._on_heartbeat(msg)
         elif kind == "LOCAL_POSITION_NED":
             self.seen.pos_ned_m = (msg.x, msg.y, msg.z)
+        elif kind == "GLOBAL_POSITION_INT":
+            self.seen.lat_lon_deg = (msg.lat * 1e-7, msg.lon * 1e-7)
         elif kind == "SYS_STATUS":
             self.seen.sys_status = msg
         elif kind == "HOME_POSITION":

@@ -64,6 +64,7 @@ class VehicleNode:
         self._snapshot: VehicleSnapshot | None = None
         self._snapshot_time_us = -1
         self._last_now_us = -1
+        self.io_budget = IO_BUDGET_DATAGRAMS  # datagrams read per link per step_io (the swarm runner lowers it)
 
     @property
     def sysid(self) -> int:
@@ -89,7 +90,7 @@ class VehicleNode:
         self._last_now_us = now_us
         received = 0
         for ep in self.endpoints:
-            received += ep.poll(now_us, IO_BUDGET_DATAGRAMS)
+            received += ep.poll(now_us, self.io_budget)
         events = self.vehicle.events_after(self._event_seq)
         if events:
             self._event_seq = events[-1].seq
