@@ -72,8 +72,9 @@ class RealTimeRunner:
         lag = target_us - int(lead.time_us)
         if lag > MAX_LAG_US:
             skipped = lag - MAX_LAG_US
+            if self.dropped_us == 0:
+                log.warning("cannot keep up with --speed %g: simulated time falls behind the wall clock", self.speed)
             self.dropped_us += skipped
-            log.warning("runner fell %.1f s behind; skipping ahead", lag / 1e6)
             return start_sim_us + skipped, target_us - skipped
         return start_sim_us, target_us
 
