@@ -178,6 +178,9 @@ def test_other_commands(command: int, result: MavResult, text: str | None) -> No
 
 def test_reboot_requested_only_when_disarmed() -> None:
     h = Harness()
+    assert h.cmd(246, 0.0).result == MavResult.ACCEPTED and not h.c.reboot_requested
+    assert h.cmd(246, 3.0).result == MavResult.DENIED and not h.c.reboot_requested
+    assert h.cmd(246, NAN).result == MavResult.DENIED and not h.c.reboot_requested
     assert h.cmd(246, 1.0).result == MavResult.ACCEPTED and h.c.reboot_requested
     h = Harness()
     h.arm_and_fly()

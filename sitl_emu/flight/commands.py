@@ -203,11 +203,16 @@ def _calibration(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 
 
 def _reboot(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
-    if c.armed:
-        return _ack(cmd, MavResult.DENIED)  # shutdown/reboot is not allowed while armed
-    if math.isfinite(cmd.param(1)) and lround(cmd.param(1)) == 1:
+    """Commander.cpp: `const int param1 = cmd.param1`; 0 nothing, 1 reboot, 2 shutdown, only while disarmed."""
+    p1 = cmd.param(1)
+    action = int(p1) if math.isfinite(p1) else -1
+    if action == 0:
+        return _ack(cmd, MavResult.ACCEPTED)
+    if action not in (1, 2) or c.armed:
+        return _ack(cmd, MavResult.DENIED)
+    if action == 1:
         c.reboot_requested = True  # the Vehicle resets at its next step, after this ACK went out
-    return _ack(cmd, MavResult.ACCEPTED)
+    return _ack(cmd, MavResult.ACCEPTED)  # shutdown: acknowledged; stopping the process is the runner's business
 
 
 def _prearm_checks(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
