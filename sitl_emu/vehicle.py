@@ -2,7 +2,8 @@
 
 Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (4000 us, 250 Hz):
  1. pending reboot (PREFLIGHT_REBOOT_SHUTDOWN param1=1, acknowledged before): back to the boot state, time 0;
- 2. commander: readiness ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
+ 2. commander (every COMMANDER_PERIOD_US): readiness ("Ready for takeoff!"), home, auto-disarm, takeoff
+    completion, failsafes, mode in force;
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
  4. control cascade: setpoint -> motor commands (zero when disarmed or terminated);
  5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
@@ -40,6 +41,7 @@ from sitl_emu.types import (
 from sitl_emu.vehicle_parts import Parts, yaw_of
 
 EVENT_HISTORY = 1000
+COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
 
 
 class Vehicle:
@@ -78,6 +80,7 @@ class Vehicle:
         self.parts = Parts(self.params)
         self._setpoint_type = "none"
         self._task_finished = False
+        self._commander_last_us = -COMMANDER_PERIOD_US
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -95,8 +98,10 @@ class Vehicle:
         self._snap = None
         dt_s = self.dt_us * 1e-6
         c = self.commander
-        c.observe(Observation(now, now >= self._ready_delay_us, self._here, self._task_finished))
-        c.update(now)
+        if now - self._commander_last_us >= COMMANDER_PERIOD_US:
+            self._commander_last_us = now
+            c.observe(Observation(now, now >= self._ready_delay_us, self._here, self._task_finished))
+            c.update(now)
         est = self._estimate
         out = self.parts.executor.update(c.nav_state, c.armed, now,
                                          lambda: self.parts.nav_input(now, est, c, self.ref),
