@@ -301,3 +301,14 @@ def test_reposition_flies_to_the_point_in_hold() -> None:
     s = f.snap
     assert s.nav_state == NavState.AUTO_LOITER
     assert math.dist(s.pos_ned_m, (8.0, -6.0, -5.0)) < 0.3
+
+
+def test_change_altitude_in_hold() -> None:
+    f = Flight()
+    f.takeoff()
+    assert f.cmd(186, 488.0 + 6.0, 0.0) == MavResult.ACCEPTED  # MAV_FRAME_GLOBAL: AMSL
+    f.run(10.0)
+    s = f.snap
+    assert _alt(s) == pytest.approx(6.0, abs=0.15) and math.hypot(s.pos_ned_m[0], s.pos_ned_m[1]) < 0.3
+    f.set_mode(NavState.AUTO_RTL)
+    assert f.cmd(186, 490.0, 0.0) == MavResult.DENIED  # only in Hold
