@@ -31,13 +31,22 @@ def _local_ned(client: Client, mask: int, frame: int = 1, pos=(0.0, 0.0, 0.0), v
 
 # --- commands: routing (3.1) ---------------------------------------------------------------------------------------
 @pytest.mark.parametrize("target, answered", [
-    ((1, 1), True), ((0, 0), True), ((1, 0), True), ((0, 1), True), ((2, 1), False), ((1, 2), False),
+    ((1, 1), True), ((1, 0), True), ((0, 0), False), ((0, 1), False), ((2, 1), False), ((1, 2), False),
 ])
-def test_command_long_is_ours_only_for_our_sysid_or_broadcast(h, target, answered):
+def test_command_long_is_ours_only_for_exactly_our_sysid(h, target, answered):
+    """evaluate_target_ok(): target_system must be ours (0 is not enough), target_component ours or 0."""
     h.api.command_long(400, 1.0, target=target)
     h.io()
     assert bool(h.vehicle.commands) is answered
     assert _acks(h.api) == ([(400, MavResult.ACCEPTED)] if answered else [])
+
+
+@pytest.mark.parametrize("target", [(0, 0), (1, 0), (1, 5), (0, 99)])
+def test_legacy_capability_requests_accept_broadcast_and_any_component(h, target):
+    h.api.command_long(520, 1.0, target=target)
+    h.io()
+    assert _acks(h.api) == [(520, MavResult.ACCEPTED)]
+    assert h.api.of_type("AUTOPILOT_VERSION")
 
 
 def test_command_params_source_and_external_flag_reach_the_vehicle(h):
@@ -77,17 +86,15 @@ def _command_int(client: Client, command: int, frame: int, x: int, y: int, z: fl
     client.send(client.mav.command_int_encode(1, 1, frame, command, 0, 0, 1.0, 2.0, 3.0, 4.0, x, y, z))
 
 
-def test_command_int_scales_locations_per_frame(h):
+def test_command_int_x_y_are_degrees_e7_and_int32_max_means_unset(h):
     _command_int(h.api, 192, 5, 473977420, 85455940)  # GLOBAL_INT: degrees * 1e7
-    _command_int(h.api, 192, 1, 123456, -50000)  # LOCAL_NED: metres * 1e4
-    _command_int(h.api, 183, 5, 7, 9)  # not a location command: raw
+    _command_int(h.api, 192, 1, 123456, -50000)  # a local frame: PX4 <= v1.17 still divides by 1e7
     _command_int(h.api, 192, 5, 2147483647, 2147483647)  # INT32_MAX: "not set" -> NaN
     h.io()
     c = h.vehicle.commands
     assert (c[0].param(5), c[0].param(6), c[0].param(7)) == pytest.approx((47.397742, 8.545594, 10.0))
-    assert (c[1].param(5), c[1].param(6)) == pytest.approx((12.3456, -5.0))
-    assert (c[2].param(5), c[2].param(6)) == (7.0, 9.0)
-    assert math.isnan(c[3].param(5)) and math.isnan(c[3].param(6))
+    assert (c[1].param(5), c[1].param(6)) == pytest.approx((0.0123456, -0.005))
+    assert math.isnan(c[2].param(5)) and math.isnan(c[2].param(6))
     assert c[0].params[:4] == (1.0, 2.0, 3.0, 4.0)
 
 

@@ -2,8 +2,11 @@
 
 Sources: src/modules/mavlink/mavlink_receiver.cpp (handle_message_command_long/int/both ~l.493-930, set_mode ~l.1061,
 heartbeat, ping ~l.1912), mavlink_timesync.cpp; reference 1.8-1.10, 3.1, 3.4, 4.4, 4.7, 4.8.
-Routing rule (3.1): a command is ours iff target_system is 0 or our sysid and target_component is 0 or our compid;
-anything else is ignored without an ACK.
+Command routing as mavlink_receiver.cpp evaluate_target_ok() codes it (every version up to v1.17): a command is ours
+iff target_system is exactly our sysid and target_component is our compid or 0; only REQUEST_AUTOPILOT_CAPABILITIES
+and REQUEST_PROTOCOL_VERSION also accept target_system 0 and any component. Anything else is ignored without an ACK.
+(Reference 3.1 says target_system 0 is accepted for all commands; the code says otherwise, and PX4 is right.)
+Offboard setpoints do accept target_system 0.
 """
 
 from __future__ import annotations
@@ -22,12 +25,10 @@ log = logging.getLogger(__name__)
 
 MAV_TYPE_GCS = 6
 CMD_DO_SET_MODE = 176
-INT32_MAX_F = float(2**31)  # INT32_MAX as a float32 reads back as 2^31
+# COMMAND_LONG param5 and param6 within one float32 ulp of INT32_MAX: "INT32_MAX sent in a COMMAND_LONG" -> DENIED
+INT32_MAX_LO, INT32_MAX_HI = float(2**31 - 128), float(2**31 + 256)  # nextafterf((float)INT32_MAX, 0 / +inf)
 COMMAND_INT_NAN_XY = 0x7FF80000  # x == y == this: DENIED (reference 3.1)
 INT32_MAX = 2**31 - 1
-# MAV_CMDs whose COMMAND_INT x/y are a location (mavlink_receiver.cpp handle_message_command_int)
-LOCATION_COMMANDS = frozenset({21, 22, 23, 34, 35, 80, 84, 179, 189, 192, 195, 201, 30001, 43003, 611})
-LOCAL_FRAMES = frozenset({1, 4, 7, 8, 9, 12, 20, 21})
 ERROR_TEXT_INTERVAL_US = 1_000_000  # one copy of the same complaint per second, so a flood cannot flood the log
 
 
@@ -75,7 +76,7 @@ class Receiver:
 
     # --- commands ----------------------------------------------------------------------------------------------
     def _command_long(self, msg: Any, ctx: Any) -> None:
-        if not _targets_us(msg, ctx, any_component=msg.command in ANY_COMPONENT):
+        if not _command_for_us(msg, ctx):
             return
         params = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
         cmd = _command(msg, params)
@@ -85,14 +86,14 @@ class Receiver:
         ctx.commands.execute(cmd, ctx)
 
     def _command_int(self, msg: Any, ctx: Any) -> None:
-        if not _targets_us(msg, ctx, any_component=msg.command in ANY_COMPONENT):
+        if not _command_for_us(msg, ctx):
             return
         x, y = int(msg.x), int(msg.y)
         if x == COMMAND_INT_NAN_XY and y == COMMAND_INT_NAN_XY:
             _ack_here(ctx, _command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, 0.0, 0.0, msg.z)),
                       MavResult.DENIED)
             return
-        p5, p6 = _command_int_xy(msg.command, int(msg.frame), x, y)
+        p5, p6 = _command_int_xy(x, y)
         ctx.commands.execute(_command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z)), ctx)
 
     def _set_mode(self, msg: Any, ctx: Any) -> None:
@@ -135,9 +136,16 @@ class Receiver:
         ctx.vehicle.report(Severity.CRITICAL, "mavlink", text, is_event=True)
 
 
-def _targets_us(msg: Any, ctx: Any, any_component: bool = False) -> bool:
-    ts, tc = msg.target_system, msg.target_component
-    return ts in (0, ctx.sysid) and (any_component or tc in (0, ctx.compid))
+def _targets_us(msg: Any, ctx: Any) -> bool:
+    """Setpoint messages: target_system 0 or ours, target_component 0 or ours."""
+    return msg.target_system in (0, ctx.sysid) and msg.target_component in (0, ctx.compid)
+
+
+def _command_for_us(msg: Any, ctx: Any) -> bool:
+    """evaluate_target_ok(): exact sysid for commands, except the two legacy broadcast requests."""
+    if msg.command in ANY_COMPONENT:
+        return msg.target_system in (0, ctx.sysid)
+    return msg.target_system == ctx.sysid and msg.target_component in (0, ctx.compid)
 
 
 def _command(msg: Any, params: tuple[float, ...]) -> VehicleCommand:
@@ -150,14 +158,14 @@ def _ack_here(ctx: Any, cmd: VehicleCommand, result: int) -> None:
 
 
 def _is_int32_max(value: float) -> bool:
-    return math.isfinite(value) and abs(value - INT32_MAX_F) < 1.0
+    return INT32_MAX_LO <= value <= INT32_MAX_HI
 
 
-def _command_int_xy(command: int, frame: int, x: int, y: int) -> tuple[float, float]:
-    """COMMAND_INT x/y -> param5/6: INT32_MAX means NaN; locations are scaled by 1e4 (local) or 1e7 (global)."""
+def _command_int_xy(x: int, y: int) -> tuple[float, float]:
+    """COMMAND_INT x/y -> param5/6 as PX4 <= v1.17 does: both INT32_MAX means "not set" (NaN), else x/1e7, y/1e7.
+
+    (PX4 main later scales by frame, /1e4 for local frames and raw for non-location commands; v1.15-v1.17 do not.)
+    """
     if x == INT32_MAX and y == INT32_MAX:
         return math.nan, math.nan
-    if command not in LOCATION_COMMANDS:
-        return float(x), float(y)
-    scale = 1e4 if frame in LOCAL_FRAMES else 1e7
-    return x / scale, y / scale
+    return x / 1e7, y / 1e7
