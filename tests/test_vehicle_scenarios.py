@@ -303,6 +303,18 @@ def test_reposition_flies_to_the_point_in_hold() -> None:
     assert math.dist(s.pos_ned_m, (8.0, -6.0, -5.0)) < 0.3
 
 
+
+def test_reposition_without_yaw_faces_the_target() -> None:
+    """PX4 passes a NaN yaw (param4) on; with MPC_YAW_MODE 0 the vehicle turns to face where it flies."""
+    from sitl_emu.geo import ned_to_global
+
+    f = Flight()
+    f.takeoff()
+    lat, lon, alt = ned_to_global(f.v.ref, (40.0, 30.0, -2.5))
+    assert f.cmd(192, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
+    f.run(25.0)
+    assert math.degrees(f.snap.euler_rad[2]) == pytest.approx(math.degrees(math.atan2(30.0, 40.0)), abs=3.0)
+
 def test_change_altitude_in_hold() -> None:
     f = Flight()
     f.takeoff()

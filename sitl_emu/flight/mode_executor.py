@@ -134,7 +134,10 @@ class ModeExecutor:
         if command is not None and command.kind in ("reposition", "change_altitude") and nav.armed:
             target = _command_target(command, nav, ref)
             speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
-            yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else nav.yaw_rad
+            # DO_REPOSITION with yaw NaN: PX4 passes NaN on and the vehicle faces the target (MPC_YAW_MODE 0,
+            # navigator_main.cpp); a change of altitude keeps the current heading.
+            keep = nav.yaw_rad if command.kind == "change_altitude" else math.nan
+            yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else keep
             return tasks.make_reposition(nav, self.params, target, yaw, speed)
         if takeoff_target is not None:
             return tasks.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
