@@ -114,6 +114,14 @@ class VehicleNode:
         for ep in self.endpoints:
             ep.send(msg)
 
+    def forward(self, msg: Any, origin: Endpoint, target_system: int, target_component: int) -> None:
+        """Pass a received message to the other links that should see it (Mavlink::forward_message)."""
+        for ep in self.endpoints:
+            if ep is origin:
+                continue
+            if target_system == 0 or (target_system, target_component) in ep.seen_components:
+                ep.pass_message(msg)
+
     def route_ack(self, command: int, result: int, target_system: int, target_component: int) -> None:
         """COMMAND_ACK on every link where the commanding component has been heard (mavlink_main.cpp ~l.2996)."""
         for ep in self.endpoints:

@@ -129,8 +129,10 @@ class Client:
         self.received.extend(new)
         return new
 
-    def of_type(self, msg_type: str) -> list[Any]:
-        return [m for m in self.received if m.get_type() == msg_type]
+    def of_type(self, msg_type: str, source: tuple[int, int] | None = (1, 1)) -> list[Any]:
+        """Received messages of one type from `source` (the vehicle by default; None: from anyone, e.g. forwarded)."""
+        return [m for m in self.received if m.get_type() == msg_type
+                and (source is None or (m.get_srcSystem(), m.get_srcComponent()) == source)]
 
     def heartbeat(self, mav_type: int = 6) -> None:
         self.send(self.mav.heartbeat_encode(mav_type, 8, 0, 0, 0, 3))

@@ -98,3 +98,22 @@ def test_node_releases_the_first_port_when_the_second_is_taken():
 def test_instance_offsets_ports_like_px4():
     s = LinkSettings().for_instance(2)
     assert (s.api_port, s.api_remote[1], s.gcs_port, s.gcs_remote[1]) == (14559, 14542, 18572, 14550)
+
+
+def test_messages_not_only_for_us_are_forwarded_to_the_other_link_unchanged(h):
+    """Both SITL links run with -f: heartbeats and broadcasts pass between the GCS and API peers as PX4 does."""
+    qgc, mavros = h.gcs, h.api
+    mavros.heartbeat(18)  # MAVROS identity differs: sysid 1, compid 191 on a real setup; here 255/190 on both
+    qgc.heartbeat(6)
+    qgc.command_long(512, 148)  # for us (1/1): answered, never forwarded
+    h.io()
+    forwarded = [m for m in mavros.received if m.get_srcSystem() == 255]
+    assert [m.get_type() for m in forwarded] == ["HEARTBEAT"]
+    assert forwarded[0].type == 6 and bytes(forwarded[0].get_msgbuf())[0] == 0xFD
+    assert not [m for m in mavros.received if m.get_type() == "COMMAND_LONG"]
+    mavros.send(mavros.mav.command_ack_encode(400, 0, 0, 0, 255, 190))  # to a component heard on the GCS link
+    mavros.send(mavros.mav.command_ack_encode(400, 0, 0, 0, 42, 42))  # to nobody we know
+    h.io()
+    acks = qgc.of_type("COMMAND_ACK", source=(255, 190))  # forwarded ones, not the vehicle's own
+    assert [(a.target_system, a.target_component) for a in acks] == [(255, 190)]
+    assert (h.node.gcs.stats.tx_forwarded, h.node.api.stats.tx_forwarded) == (2, 1)  # +MAVROS heartbeat

@@ -69,6 +69,8 @@ class NodeServices(Protocol):
 
     def invalidate_snapshot(self) -> None: ...
 
+    def forward(self, msg: Any, origin: Any, target_system: int, target_component: int) -> None: ...
+
 
 @dataclass(slots=True)
 class EndpointStats:
@@ -77,6 +79,7 @@ class EndpointStats:
     rx_own_echo: int = 0
     handler_errors: int = 0
     tx_pack_errors: int = 0
+    tx_forwarded: int = 0
 
 
 class _LinkWriter:
@@ -166,6 +169,25 @@ class Endpoint:
         except Exception:  # a bad message must never stop the vehicle
             self.stats.handler_errors += 1
             log.exception("%s link: error handling %s", self.link_name, msg_type)
+        self._forward(msg)
+
+    def _forward(self, msg: Any) -> None:
+        """Mavlink::forward_message (both SITL links run with -f): pass on what is not only for us, unchanged.
+
+        A message with target (our sysid, our compid) stays here; others go to every other link, if broadcast
+        (target_system 0 or no target) or if that link has heard the target component. Heartbeats are forwarded too
+        (MAV_HB_FORW_EN defaults to 1).
+        """
+        target_system = getattr(msg, "target_system", 0)
+        target_component = getattr(msg, "target_component", 0)
+        if target_system == self.sysid and target_component == self.compid:
+            return
+        self.node.forward(msg, self, target_system, target_component)
+
+    def pass_message(self, msg: Any) -> None:
+        """Send a received message on as it is (its own sysid, compid, sequence and checksum)."""
+        self.stats.tx_forwarded += 1
+        self.link.send(bytes(msg.get_msgbuf()))
 
     def gcs_connected(self) -> bool:
         last = self.last_gcs_heartbeat_us
