@@ -166,9 +166,10 @@ class Endpoint:
             self.receiver.handle(msg, self)
             for handler in self._routes.get(msg_type, ()):
                 handler.handle(msg, self)
-        except Exception:  # a bad message must never stop the vehicle
+        except Exception as err:  # a bad message must never stop the vehicle
             self.stats.handler_errors += 1
-            log.exception("%s link: error handling %s", self.link_name, msg_type)
+            log.error("%s link: error handling %s: %r", self.link_name, msg_type, err,
+                      exc_info=log.isEnabledFor(logging.DEBUG))
         self._forward(msg)
 
     def _forward(self, msg: Any) -> None:
@@ -220,9 +221,10 @@ class Endpoint:
         for handler in self._handlers:
             try:
                 handler.tick(self)
-            except Exception:
+            except Exception as err:
                 self.stats.handler_errors += 1
-                log.exception("%s link: error in %s.tick", self.link_name, type(handler).__name__)
+                log.error("%s link: error in %s.tick: %r", self.link_name, type(handler).__name__, err,
+                          exc_info=log.isEnabledFor(logging.DEBUG))
 
     def restart(self) -> None:
         """After a vehicle reboot: streams restart from time 0 at their current rates; the GCS must be heard again."""

@@ -159,10 +159,10 @@ class Streams:
     def _safe_build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
         try:
             return BUILDERS[msg_id](ctx, snap)
-        except Exception:  # a bad snapshot value must cost one message, not the link
+        except Exception as err:  # a bad snapshot value must cost one message, not the link
             self.build_errors += 1
             if self.build_errors == 1:
-                log.exception("cannot build message %d", msg_id)
+                log.error("cannot build message %d: %r", msg_id, err, exc_info=log.isEnabledFor(logging.DEBUG))
             return None
 
     def send_statustexts(self, ctx: Any, events: Sequence[VehicleEvent]) -> None:
