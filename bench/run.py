@@ -1,0 +1,127 @@
+"""Run the benchmarks and print one figure per line with its unit: `python -m bench [--quick] [--only NAME ...]`.
+
+Figures (targets from issue 4 in brackets):
+  core        simulated seconds per CPU second, one vehicle, fixed manoeuvre, no I/O [>= 1000]; and with I/O
+  serve       `sitl-emu serve` at real time, hovering, default streams on both links: % of one core [<= 3]
+  startup     wall time from process start to the first HEARTBEAT [< 0.5 s] and to health all good
+  flight      reference loopback flight (arm, takeoff, OFFBOARD square, land) by a scripted pymavlink client:
+              in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
+  latency     joyfly joystick event -> setpoint datagram, median and p99 [p99 < 5 ms] (bench/joyfly_latency.py)
+  scale       largest --count N kept on time at real time on one core, hovering, default streams [100]
+Every figure is measured here and now; the machine line says how busy the host was.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import re
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:  # `python bench/run.py`
+    sys.path.insert(0, str(REPO))
+
+from bench import core, scale, serve  # noqa: E402
+
+NAMES = ("core", "serve", "startup", "flight", "latency", "scale")
+
+
+def say(line: str) -> None:
+    print(line, flush=True)
+
+
+def machine() -> None:
+    model = next((ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
+                  if ln.startswith("model name")), platform.processor() or "?")
+    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    say(f"machine: {model}, {os.cpu_count()} CPUs, load average {load}, Python {platform.python_version()}")
+
+
+def bench_core(quick: bool) -> None:
+    speed, sim_s = core.core_speed()
+    say(f"core: {speed:.0f} simulated s per CPU s (one vehicle, {sim_s:.0f} s manoeuvre, no I/O; target >= 1000)")
+    say(f"core with I/O: {core.core_speed_with_io():.0f} simulated s per CPU s "
+        "(same manoeuvre, MAVLink I/O after every step, default streams on both links)")
+
+
+def bench_serve(quick: bool) -> None:
+    seconds = 5.0 if quick else 30.0
+    share = serve.hover_cpu_share(seconds)
+    say(f"serve at real time: {share:.1f} % of one core (hovering {seconds:.0f} s, default streams on both links; "
+        "target <= 3)")
+
+
+def bench_startup(quick: bool) -> None:
+    runs = [serve.startup_times() for _ in range(1 if quick else 3)]
+    first = min(r[0] for r in runs)
+    healthy = min(r[1] for r in runs)
+    say(f"start-up to first HEARTBEAT: {first:.3f} s wall (best of {len(runs)}; target < 0.5)")
+    say(f"start-up to health all good: {healthy:.2f} s wall (includes the 2 s simulated estimator warm-up)")
+
+
+def bench_flight(quick: bool) -> None:
+    reference, wall = serve.lockstep_flight()
+    if not reference.ok:
+        say(f"loopback flight: the lockstep reference flight failed: {reference.error}")
+        return
+    say(f"loopback flight in-process lockstep: {wall:.2f} s wall for {reference.sim_duration_s:.1f} s simulated "
+        f"({reference.sim_duration_s / wall:.0f}x)")
+    speeds = [10.0, 20.0, 40.0] if quick else [5.0, 10.0, 20.0, 30.0, 40.0, 60.0, 80.0]
+    attempts = serve.fastest_flight(speeds, reference)
+    tried = ", ".join(f"x{s:g} {'ok' if ok else 'FAIL'} {w:.1f} s" for s, ok, w, _ in attempts)
+    passed = [(s, w) for s, ok, w, _ in attempts if ok]
+    if passed:
+        best, best_wall = passed[-1]
+        say(f"loopback flight via serve: highest passing speed x{best:g}, {best_wall:.2f} s wall ({tried})")
+    else:
+        say(f"loopback flight via serve: no speed passed ({tried}): {attempts[0][3].error}")
+
+
+def bench_latency(quick: bool) -> None:
+    script = REPO / "bench" / "joyfly_latency.py"
+    out = subprocess.run([sys.executable, str(script), "--events", "100" if quick else "300"], cwd=REPO,
+                         capture_output=True, text=True, timeout=600)
+    m = re.search(r"median ([\d.]+) ms, p99 ([\d.]+) ms", out.stdout)
+    if out.returncode != 0 or m is None:
+        say(f"joyfly latency: not measured ({(out.stderr or out.stdout).strip()[-200:]})")
+        return
+    say(f"joyfly latency median: {m.group(1)} ms (joystick event -> setpoint datagram)")
+    say(f"joyfly latency p99: {m.group(2)} ms (target < 5)")
+
+
+def bench_scale(quick: bool) -> None:
+    cpu = sorted(os.sched_getaffinity(0))[-1]
+    seconds = 3.0 if quick else 8.0
+    best, trials = scale.search(1 if quick else 4, 256, seconds, cpu)
+    tried = ", ".join(f"{n} {'ok' if scale.on_time(r) else 'late'} ({r['cpu_share'] * 100:.0f} % cpu, "
+                      f"lag {r['max_lag_s'] * 1000:.0f} ms)" for n, r in trials)
+    say(f"scale: {best} vehicles on one core at real time (hovering, default streams, {seconds:g} s trials on "
+        f"CPU {cpu}; target 100): {tried}")
+
+
+BENCHES: dict[str, Callable[[bool], None]] = {
+    "core": bench_core, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
+    "latency": bench_latency, "scale": bench_scale,
+}
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="shorter runs (~1 min in all)")
+    parser.add_argument("--only", nargs="+", choices=NAMES, default=list(NAMES), help="run only these")
+    args = parser.parse_args(argv)
+    machine()
+    for name in args.only:
+        try:
+            BENCHES[name](args.quick)
+        except Exception as err:  # one broken benchmark must not hide the others
+            say(f"{name}: failed: {type(err).__name__}: {err}")
+
+
+if __name__ == "__main__":
+    main()

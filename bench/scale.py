@@ -1,0 +1,98 @@
+"""Scale: how many vehicles one process keeps on time at real time on ONE core, default streams on both links.
+
+Each trial runs in a fresh child process pinned to one CPU (`python -m bench.scale N SECONDS`): N vehicles built as
+`sitl-emu serve --count N` builds them (sitl_emu.swarm), all armed and taking off (then hovering), run by the
+SwarmRunner at speed 1. The trial passes when the runner never had to drop time and the slowest vehicle's simulated
+time never lagged the wall clock by more than LAG_LIMIT_S after the first second.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+LAG_LIMIT_S = 0.05
+TAKEOFF_S = 5.0
+
+
+def trial(count: int, seconds: float, cpu: int | None = None) -> dict[str, float]:
+    """Run one trial in a child process; its JSON result."""
+    args = [sys.executable, "-m", "bench.scale", str(count), str(seconds)]
+    if cpu is not None:
+        args.append(str(cpu))
+    out = subprocess.run(args, cwd=REPO, capture_output=True, text=True, timeout=300 + 3 * count,
+                         env={**os.environ, "PYTHONPATH": str(REPO)})
+    if out.returncode != 0:
+        raise RuntimeError(f"scale trial with {count} vehicles failed: {out.stderr.strip()[-300:]}")
+    return dict(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def on_time(result: dict[str, float]) -> bool:
+    return result["dropped_s"] == 0 and result["max_lag_s"] <= LAG_LIMIT_S
+
+
+def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int, list[tuple[int, dict[str, float]]]]:
+    """Double N until a trial fails (or `limit`), then bisect; (largest passing N, all trials)."""
+    trials: list[tuple[int, dict[str, float]]] = []
+    good, bad, n = 0, None, start
+    while n <= limit:
+        result = trial(n, seconds, cpu)
+        trials.append((n, result))
+        if not on_time(result):
+            bad = n
+            break
+        good, n = n, n * 2 if n * 2 <= limit or n == limit else limit
+        if good == limit:
+            break
+    while bad is not None and bad - good > max(1, good // 8):
+        mid = (good + bad) // 2
+        result = trial(mid, seconds, cpu)
+        trials.append((mid, result))
+        good, bad = (mid, bad) if on_time(result) else (good, mid)
+    return good, trials
+
+
+def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
+    from sitl_emu.api import Sim
+    from sitl_emu.swarm import SwarmRunner
+    from sitl_emu.types import VehicleCommand
+
+    if cpu is not None:
+        os.sched_setaffinity(0, {cpu})
+    nan = math.nan
+    with Sim(count=count) as sim:
+        sim.run_for(2.1)  # the simulated estimator warm-up, in lockstep
+        for v in sim.vehicles:
+            v.handle_command(VehicleCommand(400, (1.0,) + (nan,) * 6))
+            v.handle_command(VehicleCommand(22, (nan,) * 7))
+        sim.run_for(TAKEOFF_S)  # climbing in lockstep; the timed part is the climb's end and the hover
+        runner = SwarmRunner(sim.nodes, speed=1.0)
+        t0_sim = min(v.time_us for v in sim.vehicles)
+        lag = {"max": 0.0}
+        t0 = time.monotonic()
+        cpu0 = time.process_time()
+
+        def watch() -> None:
+            elapsed = time.monotonic() - t0
+            if elapsed > 1.0:
+                behind = elapsed - (min(v.time_us for v in sim.vehicles) - t0_sim) / 1e6
+                lag["max"] = max(lag["max"], behind)
+
+        runner.hooks.append(watch)
+        runner.run(duration_s=seconds)
+        wall = time.monotonic() - t0
+        airborne = sum(1 for v in sim.vehicles if v.snapshot().pos_ned_m[2] < -1.0)
+        return {"count": count, "max_lag_s": round(lag["max"], 4), "dropped_s": runner.dropped_us / 1e6,
+                "cpu_share": round((time.process_time() - cpu0) / wall, 3), "airborne": airborne}
+
+
+if __name__ == "__main__":
+    n_arg, s_arg = int(sys.argv[1]), float(sys.argv[2])
+    cpu_arg = int(sys.argv[3]) if len(sys.argv) > 3 else None
+    print(json.dumps(_worker(n_arg, s_arg, cpu_arg)))

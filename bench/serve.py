@@ -1,0 +1,150 @@
+"""`sitl-emu serve` in its own process, measured from outside: start-up, CPU share at real time, fastest flight.
+
+Each measurement starts `python -m sitl_emu serve` on free loopback ports; the API link sends to our scripted client
+(sitl_emu.api_client.FlightClient), the GCS link to a socket nobody reads (the kernel drops what overflows).
+CPU is the server process's own user+system time from /proc, so the client's work is not counted.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import socket
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from sitl_emu.api import ScaledWallClock, Sim
+from sitl_emu.api_client import FlightClient, FlightResult, fly_square
+
+REPO = Path(__file__).resolve().parent.parent
+TICKS_S = os.sysconf("SC_CLK_TCK")
+
+
+@dataclass
+class Server:
+    proc: subprocess.Popen
+    client: FlightClient
+    sink: socket.socket
+    started_wall: float
+
+    def cpu_s(self) -> float:
+        """User + system CPU seconds of the server process so far."""
+        fields = Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / TICKS_S
+
+    def stop(self) -> str:
+        self.client.close()
+        self.proc.terminate()
+        try:
+            _, err = self.proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            _, err = self.proc.communicate()
+        self.sink.close()
+        return err or ""
+
+
+def _free_port() -> int:
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def start_server(speed: float = 1.0, extra: tuple[str, ...] = ()) -> Server:
+    """A server whose API link streams to a fresh FlightClient from boot (PX4's initial remote)."""
+    sink = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sink.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    sink.bind(("127.0.0.1", 0))
+    api, gcs = _free_port(), _free_port()
+    clock = ScaledWallClock(speed)
+    client = FlightClient(("127.0.0.1", api), clock)
+    client_port = client.sock.getsockname()[1]
+    args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs),
+            "--remote", f"127.0.0.1:{client_port}", "--gcs-remote", f"127.0.0.1:{sink.getsockname()[1]}", *extra]
+    started = time.monotonic()
+    proc = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONPATH": str(REPO)})
+    return Server(proc, client, sink, started)
+
+
+def startup_times() -> tuple[float, float]:
+    """Wall seconds from process start to the first HEARTBEAT received, and to health all good."""
+    server = start_server()
+    try:
+        c = server.client
+        c.wait(lambda: c.seen.heartbeat is not None, 10.0, "the first HEARTBEAT")
+        first = time.monotonic() - server.started_wall
+        c.wait(lambda: c.healthy, 20.0, "health all good")
+        healthy = time.monotonic() - server.started_wall
+    finally:
+        server.stop()
+    return first, healthy
+
+
+def hover_cpu_share(seconds: float) -> float:
+    """Percent of one core used by `serve` at real time while hovering in Hold, default streams on both links."""
+    server = start_server()
+    try:
+        c = server.client
+        c.wait(lambda: c.healthy, 20.0, "health all good")
+        if c.command(400, 1) != 0 or c.command(22) != 0:
+            raise RuntimeError("the vehicle refused to arm or take off")
+        c.wait(lambda: c.seen.pos_ned_m is not None and c.seen.pos_ned_m[2] < -2.3, 30.0, "takeoff")
+        c.spin(2.0)
+        cpu0, wall0 = server.cpu_s(), time.monotonic()
+        c.spin(seconds)
+        cpu1, wall1 = server.cpu_s(), time.monotonic()
+        if not c.armed or c.seen.pos_ned_m is None or c.seen.pos_ned_m[2] > -2.0:
+            raise RuntimeError("the vehicle did not keep hovering")
+    finally:
+        server.stop()
+    return 100.0 * (cpu1 - cpu0) / (wall1 - wall0)
+
+
+def lockstep_flight() -> tuple[FlightResult, float]:
+    """The reference square flight in-process in lockstep; (result, wall seconds)."""
+    with Sim() as sim:
+        client = FlightClient(sim.ports(0).api, sim.clock)
+        start = time.perf_counter()
+        result = fly_square(client)
+        wall = time.perf_counter() - start
+        client.close()
+    return result, wall
+
+
+def served_flight(speed: float) -> tuple[FlightResult, float, str]:
+    """The reference square flight against `serve --speed speed`; (result, wall seconds, server stderr)."""
+    server = start_server(speed)
+    start = time.monotonic()
+    try:
+        result = fly_square(server.client)
+    finally:
+        wall = time.monotonic() - start
+        err = server.stop()
+    return result, wall, err
+
+
+def passes(result: FlightResult, reference: FlightResult) -> bool:
+    """Same modes as the lockstep reference and landed within 0.5 m of its landing point."""
+    if not result.ok or result.modes != reference.modes or result.landing_ned_m is None:
+        return False
+    assert reference.landing_ned_m is not None
+    return math.dist(result.landing_ned_m, reference.landing_ned_m) < 0.5
+
+
+def fastest_flight(speeds: list[float], reference: FlightResult) -> list[tuple[float, bool, float, FlightResult]]:
+    """Fly at increasing speeds until one fails; every attempt as (speed, passed, wall s, result)."""
+    attempts = []
+    for speed in speeds:
+        result, wall, _ = served_flight(speed)
+        ok = passes(result, reference)
+        attempts.append((speed, ok, wall, result))
+        if not ok:
+            break
+    return attempts
