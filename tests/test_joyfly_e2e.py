@@ -208,3 +208,26 @@ def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str
         if text in line:
             return seen
     raise AssertionError(f"never saw {text!r}:\n{seen}")
+
+
+def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> None:
+    from pymavlink import mavutil
+
+    host, port = flight.emulator.node.gcs.link.local_address
+    gcs = mavutil.mavlink_connection(f"udpout:127.0.0.1:{port}", source_system=255, source_component=190)
+    try:
+        gcs.mav.heartbeat_send(6, 8, 0, 0, 4)
+        gcs.mav.command_long_send(1, 1, 176, 0, 1 | 128, 4, 3, 0, 0, 0, 0)  # DO_SET_MODE AUTO.LOITER (Hold)
+        flight.wait_for(Phase.PAUSED, 3.0)
+        assert any("left OFFBOARD for AUTO.LOITER" in n.text for n in flight.session.notes)
+        sent = flight.session.setpoints_sent
+        flight.wait(4.0)
+        assert flight.session.setpoints_sent == sent  # no setpoints, so PX4 has no reason to go back
+        assert flight.session.link.state.mode == "AUTO.LOITER"
+        flight.button(5, True)  # the script profile's OFFBOARD button
+        flight.wait(0.5)
+        flight.button(5, False)
+        flight.wait_for(Phase.FLYING, 5.0)
+        assert flight.session.link.state.offboard
+    finally:
+        gcs.close()
