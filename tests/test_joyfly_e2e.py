@@ -213,7 +213,7 @@ def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str
 def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> None:
     from pymavlink import mavutil
 
-    host, port = flight.emulator.node.gcs.link.local_address
+    _host, port = flight.emulator.node.gcs.link.local_address
     gcs = mavutil.mavlink_connection(f"udpout:127.0.0.1:{port}", source_system=255, source_component=190)
     try:
         gcs.mav.heartbeat_send(6, 8, 0, 0, 4)

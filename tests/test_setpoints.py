@@ -124,3 +124,17 @@ def test_yaw_stick_turns_at_the_max_yaw_rate() -> None:
     sp = fly(StickCommand(yaw=1.0), 1.0)
     assert sp.yaw_rad == pytest.approx(VEL.max_yaw_rate_rad_s, rel=1e-6)
     assert fly(StickCommand(yaw=-1.0), 5.0).yaw_rad == pytest.approx(-math.radians(225) + 2 * math.pi)
+
+
+def test_braking_starts_earlier_for_a_vehicle_already_moving_fast() -> None:
+    sp = Setpoint((2.0, 0.0, -3.0), 0.0, (5.0, 0.0, 0.0))
+    still = next_setpoint(sp, StickCommand(forward=1.0), (2.0, 0.0, -3.0), 0.05, VEL, FENCE)
+    moving = next_setpoint(sp, StickCommand(forward=1.0), (2.0, 0.0, -3.0), 0.05, VEL, FENCE, (5.0, 0.0, 0.0))
+    assert still.vel_ned_m_s is not None and moving.vel_ned_m_s is not None
+    assert moving.vel_ned_m_s[0] < still.vel_ned_m_s[0] - 0.5  # predicted 2.5 m on: only 0.5 m of room left
+
+
+def test_hold_brakes_to_the_point_ahead_of_a_moving_vehicle() -> None:
+    hold = hold_setpoint((1.0, 0.0, -3.0), 0.0, FENCE, (2.0, -1.0, 0.0), 0.5)
+    assert hold.pos_ned_m == pytest.approx((2.0, -0.5, -3.0))
+    assert hold.vel_ned_m_s == (0.0, 0.0, 0.0)
