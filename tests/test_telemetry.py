@@ -76,10 +76,10 @@ def test_base_mode_offboard_is_1_without_setpoints_17_with_and_145_armed(h):
 # Rates in Hz per link: PX4 onboard defaults on the API link, normal + SITL overrides on the GCS link.
 API_RATES = {"HEARTBEAT": 1, "ATTITUDE": 100, "ATTITUDE_QUATERNION": 50, "LOCAL_POSITION_NED": 30,
              "GLOBAL_POSITION_INT": 50, "ODOMETRY": 30, "TIMESYNC": 10, "ALTITUDE": 10, "VFR_HUD": 10,
-             "GPS_RAW_INT": 8, "SYS_STATUS": 5, "EXTENDED_SYS_STATE": 5, "SYSTEM_TIME": 1}
+             "GPS_RAW_INT": 8, "SYS_STATUS": 5, "EXTENDED_SYS_STATE": 5, "SYSTEM_TIME": 1, "PING": 1}
 GCS_RATES = {"HEARTBEAT": 1, "ATTITUDE": 50, "ATTITUDE_QUATERNION": 50, "LOCAL_POSITION_NED": 50,
              "GLOBAL_POSITION_INT": 50, "VFR_HUD": 4, "GPS_RAW_INT": 5, "SYS_STATUS": 1, "EXTENDED_SYS_STATE": 1,
-             "ALTITUDE": 1}
+             "ALTITUDE": 1, "PING": 0.1}
 
 
 def test_stream_sets_and_rates_per_link(h):

@@ -36,6 +36,7 @@ BUILDERS: dict[int, tm.Builder] = {
     0: tm.heartbeat,
     1: tm.sys_status,
     2: tm.system_time,
+    4: tm.ping,
     24: tm.gps_raw_int,
     30: tm.attitude,
     31: tm.attitude_quaternion,
@@ -63,12 +64,12 @@ ON_REQUEST: dict[int, tm.Builder] = {
 # Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
 ONBOARD_RATES_HZ: dict[int, float] = {
     111: 10, 32: 30, 30: 100, 141: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5, 245: 5, 33: 50, 24: 8,
-    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10, 105: 50, 29: 1,
+    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10, 105: 50, 29: 1, 4: 1,
 }
 # MAVLINK_MODE_NORMAL with the SITL GCS-link overrides (px4-rc.mavlink: 50 Hz for position/attitude streams)
 NORMAL_RATES_HZ: dict[int, float] = {
     141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 245: 1, 33: 50, 24: 5, 242: 0.5, 32: 50, 85: 50, 1: 1,
-    74: 4, 29: 1,
+    74: 4, 29: 1, 4: 0.1,
 }
 
 

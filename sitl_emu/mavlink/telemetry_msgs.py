@@ -205,6 +205,12 @@ def timesync(ctx: Any, snap: VehicleSnapshot) -> Any:
     return ctx.mav.timesync_encode(0, snap.time_us * 1000)
 
 
+def ping(ctx: Any, snap: VehicleSnapshot) -> Any:
+    """streams/PING.hpp: PX4 pings everyone (target 0/0) with its boot time and a sequence; replies are ignored."""
+    seq = snap.time_us // 100_000  # unique per ping at any rate up to 10 Hz, from simulated time
+    return ctx.mav.ping_encode(snap.time_us, seq & 0xFFFFFFFF, 0, 0)
+
+
 def system_time(ctx: Any, snap: VehicleSnapshot) -> Any:
     return ctx.mav.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
 
