@@ -6,6 +6,7 @@ Errors a user can cause (port in use, bad --param, bad --home) end in one senten
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import signal
 import sys
@@ -88,6 +89,9 @@ def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
 def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int) -> Any:
     from sitl_emu.vehicle import Vehicle
 
+    if "MAV_SYS_ID" in params:  # rcS: param set MAV_SYS_ID $((px4_instance+1))
+        with contextlib.suppress(ValueError):  # ParamError: outside MAV_SYS_ID's range
+            params.set("MAV_SYS_ID", sysid)
     kwargs: dict[str, Any] = {"params": params, "seed": seed, "sysid": sysid}
     if home is not None:
         kwargs["home"] = home

@@ -168,3 +168,11 @@ def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
         proc.terminate()
         proc.communicate(timeout=10)
         conn.close()
+
+
+def test_instance_sets_mav_sys_id_like_rcs():
+    from sitl_emu.cli import build_vehicle
+    from sitl_emu.params import default_registry
+
+    vehicle = build_vehicle(default_registry(), None, 0, 4)
+    assert vehicle.sysid == 4 and vehicle.params.get("MAV_SYS_ID") == 4
