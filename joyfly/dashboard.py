@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import TextIO
 
-from joyfly.flight_session import FlightStats, Note, SessionView
+from joyfly.flight_session import FlightStats, Note, Phase, SessionView
 from joyfly.types import StickCommand
 
 LIVE_PERIOD_S = 0.1
@@ -40,9 +40,13 @@ def stick_line(cmd: StickCommand) -> str:
     return (f"fwd {bar(cmd.forward)} right {bar(cmd.right)} up {bar(up)} yaw {bar(cmd.yaw)}  buttons {pressed}")
 
 
+def _link_word(view: SessionView) -> str:
+    return "ok" if view.link_ok else ("waiting" if view.phase is Phase.CONNECTING else "LOST")
+
+
 def render(view: SessionView) -> list[str]:
     """The live block for one view snapshot."""
-    link = "OK" if view.link_ok else "LOST"
+    link = _link_word(view).upper() if view.link_ok or view.phase is not Phase.CONNECTING else "waiting"
     pos = view.pos_ned_m
     margin = view.fence.margin_m(pos) if pos is not None else math.inf
     sp = view.setpoint
@@ -139,7 +143,7 @@ class PlainLog:
         margin = view.fence.margin_m(pos) if pos is not None else math.inf
         sp = view.setpoint.pos_ned_m if view.setpoint is not None else None
         self.out.write(f"[{view.time_s:7.2f}] {view.phase.value}; {view.mode} {'armed' if view.armed else 'disarmed'}"
-                       f"; link {'ok' if view.link_ok else 'LOST'}; pos {fmt_vec(pos)} sp {fmt_vec(sp)}"
+                       f"; link {_link_word(view)}; pos {fmt_vec(pos)} sp {fmt_vec(sp)}"
                        f"; fence margin {fmt_margin(margin)}\n")
         self.out.flush()
 

@@ -197,11 +197,12 @@ class FlightSession:
 
     def _watch_joystick(self, now: float) -> None:
         change = self._joy.update(self.cmd.connected, now)
-        if change == "lost":
+        if change == "lost" and self.phase is Phase.FLYING:
             self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
                                "unless it comes back.")
-            if self.phase is Phase.FLYING:
-                self.sp = self._hold_here()
+            self.sp = self._hold_here()
+        elif change == "lost":
+            self._note("warn", "Joystick lost.")
         elif change == "back":
             self._note("info", "Joystick back: you have control again.")
         if self._joy.expired(now) and self.phase is Phase.FLYING:
