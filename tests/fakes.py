@@ -165,8 +165,8 @@ class Harness:
         self.gcs.drain()
 
     def run(self, seconds: float, every_step: Callable[[], None] | None = None) -> None:
-        end = self.vehicle.time_us + round(seconds * 1e6)
-        while self.vehicle.time_us < end:
+        """Step for `seconds` of simulated time (counted in steps, so a reboot's time reset cannot stretch it)."""
+        for _ in range(round(seconds * 1e6 / self.vehicle.dt_us)):
             self.vehicle.step()
             if every_step is not None:
                 every_step()
@@ -174,8 +174,7 @@ class Harness:
 
     def run_until(self, predicate: Callable[[], bool], timeout_s: float,
                   every_step: Callable[[], None] | None = None) -> bool:
-        end = self.vehicle.time_us + round(timeout_s * 1e6)
-        while self.vehicle.time_us < end:
+        for _ in range(round(timeout_s * 1e6 / self.vehicle.dt_us)):
             self.vehicle.step()
             if every_step is not None:
                 every_step()

@@ -162,3 +162,17 @@ def test_imu_and_barometer_at_rest_read_gravity_and_isa_pressure(h):
     assert len(h.api.of_type("HIGHRES_IMU")) == pytest.approx(50, abs=2)
     assert not h.gcs.of_type("HIGHRES_IMU"), "not in the normal-mode set"
     assert _last(h.gcs, "SCALED_PRESSURE").press_abs == pytest.approx(imu.abs_pressure)
+
+
+def test_reboot_restarts_simulated_time_and_the_streams_carry_on(h):
+    h.gcs.heartbeat()
+    h.run(3.0)
+    h.gcs.command_long(246, 1)  # PREFLIGHT_REBOOT_SHUTDOWN: reboot autopilot
+    h.run(0.1)
+    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(246, 0)]
+    assert h.vehicle.time_us < 200_000, "time starts again at boot"
+    n_hb = len(h.api.of_type("HEARTBEAT"))
+    h.run(3.0)
+    after = h.api.of_type("HEARTBEAT")[n_hb:]
+    assert len(after) == 3 and after[0].system_status == 0 and after[-1].system_status == 3
+    assert len([m for m in h.api.received[-400:] if m.get_type() == "ATTITUDE"]) > 50
