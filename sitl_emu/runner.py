@@ -51,13 +51,14 @@ class RealTimeRunner:
         start_wall = time.monotonic()
         fds = [fd for node in self.nodes for fd in node.filenos()]
         while not self._stop.is_set():
-            if lead.time_us < start_sim_us:  # rebooted: simulated time restarted at 0
-                start_sim_us, start_wall = int(lead.time_us), time.monotonic()
             target_us = start_sim_us + int((time.monotonic() - start_wall) * 1e6 * self.speed)
             if end_us is not None:
                 target_us = min(target_us, end_us)
             start_sim_us, target_us = self._limit_lag(start_sim_us, target_us, lead)
+            before_us = int(lead.time_us)
             self._advance(target_us, dt_us)
+            if lead.time_us < before_us:  # rebooted: simulated time restarted at 0, so does the wall-clock anchor
+                start_sim_us, start_wall = int(lead.time_us), time.monotonic()
             for hook in self.hooks:
                 hook()
             self.iterations += 1
@@ -82,11 +83,14 @@ class RealTimeRunner:
         stepped = False
         for node in self.nodes:
             vehicle = node.vehicle
-            while vehicle.time_us + dt_us <= target_us:
+            for _ in range(max(0, (target_us - int(vehicle.time_us)) // dt_us)):
+                before_us = vehicle.time_us
                 vehicle.step()
                 node.step_io(vehicle.time_us)
                 self.steps += 1
                 stepped = True
+                if vehicle.time_us < before_us:  # rebooted: time restarted, the caller re-anchors
+                    break
         if not stepped:  # woken by a datagram between steps: answer it now
             for node in self.nodes:
                 node.step_io(node.vehicle.time_us)

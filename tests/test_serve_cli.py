@@ -176,3 +176,28 @@ def test_instance_sets_mav_sys_id_like_rcs():
 
     vehicle = build_vehicle(default_registry(), None, 0, 4)
     assert vehicle.sysid == 4 and vehicle.params.get("MAV_SYS_ID") == 4
+
+
+def test_real_time_runner_follows_the_wall_clock_across_a_reboot():
+    import threading
+
+    from fakes import Harness
+
+    from sitl_emu.runner import RealTimeRunner
+    from sitl_emu.vehicle import Vehicle
+
+    h = Harness(Vehicle())
+    runner = RealTimeRunner([h.node], speed=4.0)
+    thread = threading.Thread(target=runner.run, daemon=True)
+    try:
+        thread.start()
+        time.sleep(0.8)
+        h.gcs.command_long(246, 1)  # reboot: simulated time starts again at 0
+        time.sleep(0.5)
+        after_s = h.vehicle.time_us / 1e6
+    finally:
+        runner.stop()
+        thread.join(timeout=5)
+        h.close()
+    assert 0.5 < after_s < 3.0, f"{after_s:.2f} s simulated in 0.5 s wall at 4x after the reboot"
+    assert runner.dropped_us == 0
