@@ -49,6 +49,7 @@ class Observed:
     home_seen: bool = False
     pos_ned_m: tuple[float, float, float] | None = None
     lat_lon_deg: tuple[float, float] | None = None
+    vehicle_time_s: float = 0.0  # the vehicle's time since boot, from LOCAL_POSITION_NED.time_boot_ms
     acks: list[tuple[int, int]] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
     texts: list[str] = field(default_factory=list)
@@ -108,6 +109,7 @@ class FlightClient:
             self._on_heartbeat(msg)
         elif kind == "LOCAL_POSITION_NED":
             self.seen.pos_ned_m = (msg.x, msg.y, msg.z)
+            self.seen.vehicle_time_s = msg.time_boot_ms / 1000.0
         elif kind == "GLOBAL_POSITION_INT":
             self.seen.lat_lon_deg = (msg.lat * 1e-7, msg.lon * 1e-7)
         elif kind == "SYS_STATUS":
@@ -197,20 +199,24 @@ class FlightResult:
     ok: bool
     modes: tuple[str, ...]
     landing_ned_m: tuple[float, float, float] | None
-    sim_duration_s: float
+    sim_duration_s: float  # on the client's clock
     error: str = ""
+    vehicle_duration_s: float = 0.0  # on the vehicle's clock (LOCAL_POSITION_NED.time_boot_ms)
 
 
 def fly_square(client: FlightClient, side_m: float = 5.0, altitude_m: float = 2.5) -> FlightResult:
     """Arm, take off, fly an OFFBOARD square of `side_m` at the takeoff altitude, land, wait for disarm."""
     start = client.clock.now()
+    client.pump()
+    vehicle_start_s = client.seen.vehicle_time_s
     try:
         _square_steps(client, side_m, altitude_m)
         ok, error = True, ""
     except FlightError as err:
         ok, error = False, str(err)
     client.setpoint_ned_m = None
-    return FlightResult(ok, tuple(client.seen.modes), client.seen.pos_ned_m, client.clock.now() - start, error)
+    return FlightResult(ok, tuple(client.seen.modes), client.seen.pos_ned_m, client.clock.now() - start, error,
+                        client.seen.vehicle_time_s - vehicle_start_s)
 
 
 def _square_steps(c: FlightClient, side_m: float, altitude_m: float) -> None:
