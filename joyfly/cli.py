@@ -37,6 +37,7 @@ def main(verbose: int) -> None:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     if verbose == 0:
         logging.getLogger("joyfly").setLevel(logging.ERROR + 10)  # the live view already says it all
+        logging.getLogger("sitl_emu").setLevel(logging.ERROR)  # the demo's embedded emulator
 
 
 main.add_command(joystick)

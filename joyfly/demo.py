@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -51,6 +52,24 @@ class DemoError(Exception):
     """The demo cannot start; the message says why and what to do."""
 
 
+class VehicleTimeClock:
+    """joyfly's clock = the embedded vehicle's simulated time, so joyfly's rates and timeouts stay in step with the
+    vehicle even when the emulator cannot keep up with its speed factor (a busy machine)."""
+
+    def __init__(self, vehicle: Any, speed: float) -> None:
+        self.vehicle = vehicle
+        self.speed = speed
+
+    def now(self) -> float:
+        return int(self.vehicle.time_us) / 1e6
+
+    def sleep(self, seconds: float) -> None:
+        end = self.now() + seconds
+        give_up = time.monotonic() + 10 * seconds / self.speed + 0.5  # the emulator stopped: do not hang
+        while self.now() < end and time.monotonic() < give_up:
+            time.sleep(min(max((end - self.now()) / self.speed, 0.0002), 0.01))
+
+
 class EmbeddedVehicle:
     """sitl_emu's vehicle node on free loopback ports, run in real time (x speed) in a daemon thread."""
 
@@ -74,6 +93,10 @@ class EmbeddedVehicle:
 
     def start(self) -> None:
         self._thread.start()
+
+    def clock(self) -> VehicleTimeClock:
+        """A clock reading this vehicle's simulated time, for joyfly's session and script in the same process."""
+        return VehicleTimeClock(self.node.vehicle, self.runner.speed)
 
     def stop(self) -> None:
         self.runner.stop()
@@ -102,7 +125,8 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
         transport.remote = emulator.api_address
         transport.description = f"the built-in emulator (UDP {emulator.api_address[1]})"
         emulator.start()
-    clock = ScaledClock(speed)  # with --url, `speed` is the speed that vehicle runs at
+    # with --url, `speed` is the speed that vehicle runs at
+    clock: ScaledClock | VehicleTimeClock = emulator.clock() if emulator is not None else ScaledClock(speed)
     sticks = script_source(script_path, clock)
     view = make_view(out, live)
     out.write(f"joyfly demo: {transport.description}, scripted joystick "

@@ -89,7 +89,8 @@ class FlightSession:
     def _wait_sticks(self, next_tick: float) -> None:
         """Read the sticks until the next tick; a changed stick is sent at once (low latency)."""
         remaining = next_tick - self.clock.now()
-        cmd = self.sticks.poll(max(0.0, remaining))
+        # a device waits in wall seconds, a script on our clock: ask for wall time, sleep the rest on our clock
+        cmd = self.sticks.poll(max(0.0, remaining) / getattr(self.clock, "speed", 1.0))
         changed = replace(cmd, time_s=0.0) != replace(self.cmd, time_s=0.0)
         self._fired |= fired(self.cmd, cmd, self._arm_hold_s)
         self.cmd = cmd
@@ -120,7 +121,12 @@ class FlightSession:
         self._last_tick_s = now
 
     def request_exit(self) -> None:
+        """Perform --on-exit, then finish (the first Ctrl-C)."""
         self.exit_requested = True
+
+    def abort(self) -> None:
+        """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
+        self._set_phase(Phase.DONE)
 
     # --- helpers -------------------------------------------------------------------------------------------------
     def _note(self, level: str, text: str) -> None:
@@ -314,7 +320,9 @@ class FlightSession:
     def _arming(self, now: float) -> None:
         assert self.sp is not None
         self._send(self.sp)
-        if self.link.state.armed:
+        handle = self._retry.handle if self._retry is not None else None
+        if self.link.state.armed or (handle is not None and handle.accepted):
+            # PX4 ACKs ARM_DISARM after the state changed (px4-behaviour.md 11.6); the 1 Hz HEARTBEAT follows later
             self._note("info", "Armed.")
             self._set_phase(Phase.ENTERING)
             return
@@ -331,7 +339,7 @@ class FlightSession:
             self._note("info", "OFFBOARD: you have control.")
             self._set_phase(Phase.FLYING)
             return
-        if not st.armed and now - self._phase_s > 1.0:
+        if not st.armed and now - self._phase_s > 2.5:  # the heartbeat should show the arming within ~1 s
             self._note("warn", "The vehicle disarmed before OFFBOARD was entered.")
             self._set_phase(Phase.GROUNDED)
             return

@@ -10,7 +10,7 @@ import sys
 
 from joyfly.demo import EmbeddedVehicle, run_demo
 
-SPEED = 8.0
+SPEED = 10.0
 
 
 def test_demo_flies_the_script_and_ends_with_a_summary() -> None:
