@@ -274,6 +274,11 @@ class FlightSession:
             if not self.cmd.connected and not self.exit_requested:
                 self._note_once("Waiting for the joystick before taking off (a FIFO needs its writer).")
                 return
+            problems = getattr(self.sticks, "rest_problems", list)()
+            if problems and not self.exit_requested:  # a trigger at full deflection would fly the vehicle away
+                for problem in problems:
+                    self._note_once(f"Not taking off: {problem}")
+                return
             self._linkw.update(True)
             self._on_connected()
         elif now - self._start_s > self.s.connect_timeout_s:

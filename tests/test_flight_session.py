@@ -225,3 +225,15 @@ def test_summary_counts_distance_and_offboard_time() -> None:
     assert stats.distance_m > 3.0 + 3.0  # the climb plus ~4 m north
     assert stats.offboard_time_s == pytest.approx(12.0 - 2.5, abs=1.5)
     assert 0.0 < stats.min_fence_margin_m < 2.0
+
+
+def test_sticks_off_centre_at_start_keep_the_vehicle_on_the_ground() -> None:
+    world = make_world()
+    problems = ["Axis 2 (up) reads +100% with the sticks untouched: centre the sticks."]
+    world.sticks.rest_problems = lambda: problems  # type: ignore[attr-defined]
+    world.run_until(5.0)
+    assert world.session.phase is Phase.CONNECTING and not world.vehicle.received("CMD400")
+    assert "Not taking off: Axis 2 (up) reads +100%" in world.notes()
+    problems.clear()
+    world.run_until(10.0)
+    assert world.session.phase is Phase.FLYING
