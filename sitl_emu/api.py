@@ -12,7 +12,7 @@ script, seed and params give the same trajectory every run. `sim.clock` satisfie
 seconds, sleep(seconds)), so a joyfly FlightSession can fly a Sim vehicle in lockstep.
 
 Clients that keep their own wall-clock timers (MAVSDK, MAVROS) need `sim.start(speed)`, which runs the vehicles in a
-background thread at `speed` x real time (the runner `sitl-emu serve --speed` uses); `stop()` returns to lockstep.
+background thread at `speed` x real time (the runner of `sitl-emu serve --count`); `stop()` returns to lockstep.
 
 Until a client talks, a vehicle sends its telemetry to a private sink socket, so parallel tests never see each
 other's vehicles. Pass `api_remote=("127.0.0.1", 14540)` to send to where PX4 SITL sends instead (port + instance).
@@ -29,8 +29,7 @@ from typing import Any
 
 from sitl_emu.mavlink.link import Address
 from sitl_emu.params import default_registry
-from sitl_emu.runner import RealTimeRunner
-from sitl_emu.server import LinkSettings, VehicleNode
+from sitl_emu.server import IO_BUDGET_DATAGRAMS, LinkSettings, VehicleNode
 from sitl_emu.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner, build_nodes
 from sitl_emu.vehicle import Vehicle
 
@@ -110,11 +109,14 @@ class Sim:
         self._tracks = [_Track() for _ in self.nodes]
         self._time_us = 0
         self.clock = LockstepClock(self)
-        self._runner: RealTimeRunner | None = None
+        self._runner: SwarmRunner | None = None
+        self._background_start_us = 0
         self._thread: threading.Thread | None = None
 
     def _make_vehicle(self, instance: int, home: tuple[float, float, float]) -> Vehicle:
         registry = default_registry()
+        if "MAV_SYS_ID" in registry:  # rcS: param set MAV_SYS_ID $((px4_instance+1))
+            registry.set("MAV_SYS_ID", instance + 1)
         for name, value in self._param_values.items():
             registry.set(name, float(value))
         return Vehicle(params=registry, home=home, seed=self._seed + instance, sysid=instance + 1,
@@ -137,7 +139,7 @@ class Sim:
     def time_us(self) -> int:
         """Simulated time since the Sim started (µs); unlike a vehicle's own time it never restarts."""
         if self._runner is not None:
-            return self._tracks[0].base_us + int(self.nodes[0].vehicle.time_us)
+            return self._background_start_us + self._runner.timeline_us
         return self._time_us
 
     # --- lockstep ----------------------------------------------------------------------------------------------
@@ -176,10 +178,8 @@ class Sim:
         """Run the vehicles at `speed` x wall time in a daemon thread until `stop()`."""
         if self._runner is not None:
             raise RuntimeError("The Sim is already running in the background; call stop() first.")
-        for track, node in zip(self._tracks, self.nodes, strict=True):  # re-anchor vehicle time on Sim time
-            track.base_us = self._time_us - int(node.vehicle.time_us)
-        runner_cls = RealTimeRunner if len(self.nodes) == 1 else SwarmRunner
-        self._runner = runner_cls(self.nodes, speed=speed)
+        self._background_start_us = self._time_us
+        self._runner = SwarmRunner(self.nodes, speed=speed, io_budget=IO_BUDGET_DATAGRAMS)
         self._thread = threading.Thread(target=self._runner.run, name="sitl-emu-sim", daemon=True)
         self._thread.start()
 

@@ -14,12 +14,14 @@ time per pass and never holds back the physics of the others (its datagrams wait
 from __future__ import annotations
 
 import logging
+import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any
 
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.runner import RealTimeRunner
+from sitl_emu.runner import MAX_LAG_US, RealTimeRunner, _wait_readable
 from sitl_emu.server import LinkSettings, VehicleNode
 
 log = logging.getLogger(__name__)
@@ -65,12 +67,13 @@ def _offset(settings: LinkSettings, instance: int) -> LinkSettings:
 
 
 class SwarmRunner(RealTimeRunner):
-    """A RealTimeRunner for many nodes: all vehicles advance tick by tick together, I/O after each tick.
+    """A real-time runner for many nodes on one timeline: all vehicles advance tick by tick together.
 
     Tick k of every vehicle runs before tick k+1 of any, so the vehicles stay within one tick of each other however
     far the runner has to catch up, and after each tick every node does its I/O (streams keep their rates). Reads
     per node are capped at `io_budget` datagrams per link per tick, so a flood costs that node a bounded time and
-    the other vehicles' physics are not held back.
+    the other vehicles' physics are not held back. A vehicle that reboots (its time restarts at 0) keeps its place
+    on the shared timeline, so neither it nor the others race or stall.
     """
 
     def __init__(self, nodes: Sequence[Any], speed: float = 1.0, hooks: Sequence[Callable[[], None]] = (),
@@ -78,23 +81,59 @@ class SwarmRunner(RealTimeRunner):
         super().__init__(nodes, speed, hooks)
         for node in self.nodes:
             node.io_budget = io_budget
+        self._offsets_us = [-int(node.vehicle.time_us) for node in self.nodes]
+        self.timeline_us = 0  # simulated time since this runner was created, the same for every vehicle
+        self._last_warning_s = -math.inf
+
+    def run(self, duration_s: float | None = None) -> None:
+        """Run until stopped, or for `duration_s` more of simulated time."""
+        dt_us = int(self.nodes[0].vehicle.dt_us)
+        end_us = None if duration_s is None else self.timeline_us + round(duration_s * 1e6)
+        anchor_us, start_wall = self.timeline_us, time.monotonic()
+        fds = [fd for node in self.nodes for fd in node.filenos()]
+        while not self._stop.is_set():
+            target_us = anchor_us + int((time.monotonic() - start_wall) * 1e6 * self.speed)
+            if end_us is not None:
+                target_us = min(target_us, end_us)
+            lag_us = target_us - self.timeline_us
+            if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
+                anchor_us -= lag_us - MAX_LAG_US
+                target_us -= lag_us - MAX_LAG_US
+                self.dropped_us += lag_us - MAX_LAG_US
+                self._warn_lag(lag_us)
+            self._advance(target_us, dt_us)
+            for hook in self.hooks:
+                hook()
+            self.iterations += 1
+            if end_us is not None and self.timeline_us >= end_us:
+                break
+            next_wall = start_wall + (self.timeline_us + dt_us - anchor_us) / 1e6 / self.speed
+            timeout = next_wall - time.monotonic()
+            if timeout > 0:
+                _wait_readable(fds, timeout)
 
     def _advance(self, target_us: int, dt_us: int) -> None:
-        stepped = True
-        any_stepped = False
-        while stepped:
-            stepped = False
-            for node in self.nodes:
+        stepped_any = False
+        while self.timeline_us + dt_us <= target_us:
+            for i, node in enumerate(self.nodes):
                 vehicle = node.vehicle
-                if vehicle.time_us + dt_us <= target_us:
-                    vehicle.step()
-                    stepped = any_stepped = True
-                    self.steps += 1
-            if stepped:
-                self._io_pass()
-        if not any_stepped:
-            self._io_pass()
+                before_us = int(vehicle.time_us)
+                if before_us + self._offsets_us[i] + dt_us > target_us:
+                    continue
+                vehicle.step()
+                if vehicle.time_us < before_us:  # rebooted: its clock restarts at 0, its place on the timeline stays
+                    self._offsets_us[i] += before_us
+                node.step_io(vehicle.time_us)
+                self.steps += 1
+                stepped_any = True
+            self.timeline_us += dt_us
+        if not stepped_any:  # woken by a datagram between ticks: answer it now
+            for node in self.nodes:
+                node.step_io(node.vehicle.time_us)
 
-    def _io_pass(self) -> None:
-        for node in self.nodes:
-            node.step_io(node.vehicle.time_us)
+    def _warn_lag(self, lag_us: int) -> None:
+        now = time.monotonic()
+        if now - self._last_warning_s > 10.0:
+            self._last_warning_s = now
+            log.warning("%d vehicles fell %.1f s behind real time x%g; dropping the lost time (too many vehicles "
+                        "or too high a speed for this CPU)", len(self.nodes), lag_us / 1e6, self.speed)

@@ -108,3 +108,20 @@ def test_a_flood_on_one_vehicle_is_read_in_bounded_slices_while_all_vehicles_kee
         read = sim.nodes[0].api.link.stats.rx_datagrams
     assert times == [100_000] * 3
     assert 0 < read <= 25 * SWARM_IO_BUDGET + SWARM_IO_BUDGET  # the rest waits in vehicle 1's socket buffer
+
+
+def test_a_vehicle_that_reboots_keeps_its_place_and_the_others_keep_stepping():
+    from sitl_emu.api import Sim
+    from sitl_emu.swarm import SwarmRunner
+    from sitl_emu.types import VehicleCommand
+
+    with Sim(count=2) as sim:
+        runner = SwarmRunner(sim.nodes, speed=1000.0)
+        runner.run(duration_s=0.5)
+        ack = sim.vehicle(0).handle_command(VehicleCommand(246, (1.0,) + (math.nan,) * 6))  # reboot autopilot
+        runner.run(duration_s=0.5)
+        times = [v.time_us for v in sim.vehicles]
+    assert ack is not None and ack.result == 0
+    assert runner.timeline_us == 1_000_000
+    assert times[1] == 1_000_000
+    assert 490_000 <= times[0] <= 500_000  # restarted at 0 half a second ago (the reboot itself takes a tick)
