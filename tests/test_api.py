@@ -131,3 +131,29 @@ def test_background_real_time_then_back_to_lockstep():
         assert sim.time_us == reached + 1_000_000
         assert sim.vehicle(0).snapshot().nav_state == NavState.AUTO_LOITER
         sock.close()
+
+
+def test_a_plain_pymavlink_connection_talks_to_a_lockstep_vehicle():
+    from pymavlink import mavutil
+
+    with Sim() as sim:
+        host, port = sim.ports(0).api
+        conn = mavutil.mavlink_connection(f"udpout:{host}:{port}", source_system=255, source_component=190)
+        try:
+            conn.mav.heartbeat_send(6, 8, 0, 0, 4)  # talk first: the API link latches us as its partner
+            msgs = []
+            for _ in range(25):  # 2.5 s, reading as we go (the socket buffer holds well under a second of streams)
+                sim.run_for(0.1)
+                while (msg := conn.recv_match(blocking=False)) is not None:
+                    msgs.append(msg)
+            conn.mav.command_long_send(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0)  # arm
+            sim.run_for(0.1)
+            while (msg := conn.recv_match(blocking=False)) is not None:
+                msgs.append(msg)
+        finally:
+            conn.close()
+    kinds = {m.get_type() for m in msgs}
+    assert {"HEARTBEAT", "ATTITUDE", "LOCAL_POSITION_NED", "COMMAND_ACK"} <= kinds
+    ack = next(m for m in msgs if m.get_type() == "COMMAND_ACK")
+    assert (ack.command, ack.result) == (400, 0)
+    assert sim.vehicle(0).snapshot().armed
