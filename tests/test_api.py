@@ -17,9 +17,9 @@ from sitl_emu.api_client import FlightClient, fly_square
 from sitl_emu.px4 import NavState
 
 
-def _fly(seed: int = 0, **params: float) -> tuple[object, list[tuple[float, ...]], float, Sim]:
+def _fly(seed: int = 0, noise_m: float = 0.0, **params: float) -> tuple[object, list[tuple[float, ...]], float, Sim]:
     """Fly the reference square; returns the result, the vehicle's trace (every 0.5 s) and the wall time."""
-    sim = Sim(seed=seed, params=params)
+    sim = Sim(seed=seed, params=params, vehicle_options={"position_noise_m": noise_m})
     client = FlightClient(sim.ports(0).api, sim.clock)
     trace: list[tuple[float, ...]] = []
     original = sim.advance_to
@@ -53,17 +53,19 @@ def test_scripted_flight_over_loopback_udp_takes_a_small_fraction_of_its_simulat
 
 
 def test_same_script_seed_and_params_give_the_same_trajectory_every_run():
-    first, trace_a, _, sim_a = _fly(seed=7)
-    second, trace_b, _, sim_b = _fly(seed=7)
+    first, trace_a, _, sim_a = _fly(seed=7, noise_m=0.02)
+    second, trace_b, _, sim_b = _fly(seed=7, noise_m=0.02)
+    other, trace_c, _, sim_c = _fly(seed=8, noise_m=0.02)
     events_a = [(e.time_us, e.text) for e in sim_a.vehicle(0).events_after(0)]
     events_b = [(e.time_us, e.text) for e in sim_b.vehicle(0).events_after(0)]
-    sim_a.close()
-    sim_b.close()
-    assert first.ok and second.ok
+    for sim in (sim_a, sim_b, sim_c):
+        sim.close()
+    assert first.ok and second.ok and other.ok
     assert len(trace_a) > 40
-    assert trace_a == trace_b  # bit for bit, every 0.5 s of the flight
+    assert trace_a == trace_b  # bit for bit, every 0.5 s of the flight, seeded position noise included
     assert events_a == events_b
     assert first.landing_ned_m == second.landing_ned_m
+    assert trace_c != trace_a  # the seed does reach the noise
 
 
 def test_params_change_the_flight():
