@@ -36,6 +36,7 @@ __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "
 
 MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
+MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second
 
 log = logging.getLogger(__name__)
 
@@ -70,6 +71,8 @@ class FlightSession:
         self.setpoints_sent = 0
         self.on_setpoint: list[Callable[[Setpoint], None]] = []
         self._exit: ExitPlan | None = None
+        self._dirty = False  # the sticks changed since the last setpoint was sent
+        self._next_tick_s = self._start_s
 
     # --- the loop ----------------------------------------------------------------------------------------------
     @property
@@ -77,28 +80,36 @@ class FlightSession:
         return self.phase in (Phase.DONE, Phase.FAILED)
 
     def run(self, on_view: Callable[[SessionView], None] | None = None) -> None:
-        next_tick = self.clock.now()
+        """Fly until done (or failed): a tick every 1/rate s, the sticks read in between."""
         while not self.finished:
-            if self.clock.now() >= next_tick - 1e-6:
-                self.tick()
-                if on_view is not None:
-                    on_view(self.view())
-                next_tick = max(next_tick + self._period_s, self.clock.now() - self._period_s)
-            self._wait_sticks(next_tick)
+            self.run_once(on_view)
+
+    def run_once(self, on_view: Callable[[SessionView], None] | None = None) -> None:
+        """One loop iteration: the tick if it is due, then read the sticks until the next one."""
+        if self.clock.now() >= self._next_tick_s - 1e-6:
+            self.tick()
+            if on_view is not None:
+                on_view(self.view())
+            self._next_tick_s = max(self._next_tick_s + self._period_s, self.clock.now() - self._period_s)
+        self._wait_sticks(self._next_tick_s)
 
     def _wait_sticks(self, next_tick: float) -> None:
         """Read the sticks until the next tick; a changed stick is sent at once (low latency)."""
         remaining = next_tick - self.clock.now()
         # a device waits in wall seconds, a script on our clock: ask for wall time, sleep the rest on our clock
         cmd = self.sticks.poll(max(0.0, remaining) / getattr(self.clock, "speed", 1.0))
-        changed = replace(cmd, time_s=0.0) != replace(self.cmd, time_s=0.0)
+        self._dirty |= replace(cmd, time_s=0.0) != replace(self.cmd, time_s=0.0)
         self._fired |= fired(self.cmd, cmd, self._arm_hold_s)
         self.cmd = cmd
-        if changed and self.phase is Phase.FLYING and self._streaming_allowed():
-            self._send_flight_setpoint()
-            return
-        remaining = next_tick - self.clock.now()
-        if remaining > 1e-6 and not changed:
+        now = self.clock.now()
+        remaining = next_tick - now
+        if self._dirty and self.phase is Phase.FLYING and self._streaming_allowed():
+            gap = self._last_sp_s + MIN_SEND_GAP_S - now  # a jittery axis must not flood the link
+            if gap <= 0:
+                self._send_flight_setpoint()
+            else:
+                self.clock.sleep(min(gap, max(remaining, 0.0)))
+        elif remaining > 1e-6:
             self.clock.sleep(remaining)
 
     def tick(self) -> None:
@@ -109,6 +120,7 @@ class FlightSession:
         for text in self.link.take_new_statustexts():
             self._note("warn" if text.severity <= 4 else "info", f"Vehicle: {text.text}")
         self._update_stats(now)
+        self._last_tick_s = now
         if self.exit_requested and self.phase not in (Phase.EXITING, Phase.DONE, Phase.FAILED):
             self._begin_exit()
         if self.phase is not Phase.CONNECTING and not self._watch_link(now):
@@ -118,7 +130,6 @@ class FlightSession:
         if self.phase not in (Phase.EXITING, Phase.CONNECTING):
             self._handle_buttons()
         _PHASE_HANDLERS[self.phase](self, now)
-        self._last_tick_s = now
 
     def request_exit(self) -> None:
         """Perform --on-exit, then finish (the first Ctrl-C)."""
@@ -154,6 +165,7 @@ class FlightSession:
 
     def _send(self, sp: Setpoint) -> None:
         self.sp = sp
+        self._dirty = False
         self._last_sp_s = self.clock.now()
         self.link.send_setpoint(sp)
         self.setpoints_sent += 1
