@@ -36,7 +36,7 @@ __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "
 
 MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
-MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second
+MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
 
 log = logging.getLogger(__name__)
 
@@ -73,6 +73,7 @@ class FlightSession:
         self._exit: ExitPlan | None = None
         self._dirty = False  # the sticks changed since the last setpoint was sent
         self._next_tick_s = self._start_s
+        self._last_immediate_s = -MIN_SEND_GAP_S
 
     # --- the loop ----------------------------------------------------------------------------------------------
     @property
@@ -94,23 +95,31 @@ class FlightSession:
         self._wait_sticks(self._next_tick_s)
 
     def _wait_sticks(self, next_tick: float) -> None:
-        """Read the sticks until the next tick; a changed stick is sent at once (low latency)."""
-        remaining = next_tick - self.clock.now()
+        """Read the sticks until the next tick; a changed stick is sent at once (low latency), such extra sends at
+        most every MIN_SEND_GAP_S (a jittery axis must not flood the link)."""
+        wait = max(0.0, next_tick - self.clock.now())
+        if self._send_now_possible():
+            wait = min(wait, max(0.0, self._last_immediate_s + MIN_SEND_GAP_S - self.clock.now()))
         # a device waits in wall seconds, a script on our clock: ask for wall time, sleep the rest on our clock
-        cmd = self.sticks.poll(max(0.0, remaining) / getattr(self.clock, "speed", 1.0))
+        cmd = self.sticks.poll(wait / getattr(self.clock, "speed", 1.0))
         self._dirty |= replace(cmd, time_s=0.0) != replace(self.cmd, time_s=0.0)
         self._fired |= fired(self.cmd, cmd, self._arm_hold_s)
         self.cmd = cmd
         now = self.clock.now()
-        remaining = next_tick - now
-        if self._dirty and self.phase is Phase.FLYING and self._streaming_allowed():
-            gap = self._last_sp_s + MIN_SEND_GAP_S - now  # a jittery axis must not flood the link
+        if self._send_now_possible():
+            gap = self._last_immediate_s + MIN_SEND_GAP_S - now
             if gap <= 0:
+                self._last_immediate_s = now
                 self._send_flight_setpoint()
-            else:
-                self.clock.sleep(min(gap, max(remaining, 0.0)))
-        elif remaining > 1e-6:
-            self.clock.sleep(remaining)
+                return
+            wait = min(gap, next_tick - now)
+        else:
+            wait = next_tick - now
+        if wait > 1e-6:
+            self.clock.sleep(wait)
+
+    def _send_now_possible(self) -> bool:
+        return self._dirty and self.phase is Phase.FLYING and self._streaming_allowed()
 
     def tick(self) -> None:
         """One period: read telemetry, run the watchdogs and the phase, stream a setpoint if the phase does."""
@@ -286,7 +295,7 @@ class FlightSession:
             if not self.cmd.connected and not self.exit_requested:
                 self._note_once("Waiting for the joystick before taking off (a FIFO needs its writer).")
                 return
-            problems = getattr(self.sticks, "rest_problems", list)()
+            problems: list[str] = getattr(self.sticks, "rest_problems", list)()
             if problems and not self.exit_requested:  # a trigger at full deflection would fly the vehicle away
                 for problem in problems:
                     self._note_once(f"Not taking off: {problem}")
