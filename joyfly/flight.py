@@ -27,7 +27,7 @@ from joyfly.flight_session import (
     no_vehicle_message,
     update_stats,
 )
-from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, VehicleLink
+from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, CommandHandle, VehicleLink
 from joyfly.mapping import fired
 from joyfly.setpoints import Fence, Setpoint, hold_setpoint, initial_setpoint, next_setpoint
 from joyfly.types import Action, Clock, StickCommand
@@ -36,6 +36,8 @@ __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "
 
 MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
+# modes in PX4's mode_req_prevent_arming (ModeUtil/mode_requirements.cpp; px4-behaviour.md 3.2)
+NO_ARMING_MODES = ("AUTO.RTL", "AUTO.LAND", "AUTO.DESCEND", "AUTO.PRECLAND", "AUTO.FOLLOW_TARGET", "TERMINATION")
 MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
 
 log = logging.getLogger(__name__)
@@ -74,6 +76,7 @@ class FlightSession:
         self._dirty = False  # the sticks changed since the last setpoint was sent
         self._next_tick_s = self._start_s
         self._last_immediate_s = -MIN_SEND_GAP_S
+        self._mode_handle: CommandHandle | None = None
 
     # --- the loop ----------------------------------------------------------------------------------------------
     @property
@@ -352,10 +355,20 @@ class FlightSession:
             self._note("info", "Armed.")
             self._set_phase(Phase.ENTERING)
             return
+        if self.link.state.mode in NO_ARMING_MODES:
+            self._leave_no_arming_mode()
+            return
         if self._retry is None:
             self._retry = Retry("Arming", self.s.arm_attempts, now)
         outcome = self._retry.update(now, self.link, self.link.arm, lambda: self.link.state.armed)
         self._report_retry(outcome)
+
+    def _leave_no_arming_mode(self) -> None:
+        """PX4 refuses to arm in Return, Land, Descend... (mode_requirements.cpp prevent_arming): ask for Hold first,
+        as MAVSDK's arm() does."""
+        if self._mode_handle is None or self._mode_handle.done:
+            self._note("info", f"Switching the vehicle from {self.link.state.mode} to Hold: PX4 cannot arm in it.")
+            self._mode_handle = self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
 
     def _entering(self, now: float) -> None:
         assert self.sp is not None

@@ -129,6 +129,10 @@ class FakeVehicle:
             self.armed = not self.landed and self.armed
             self._ack(msg, 0 if not self.armed else 1)
             return
+        if self.custom_mode in (RTL, LAND):
+            self._text(2, "Arming denied: mode not armable")
+            self._ack(msg, 1)
+            return
         if self.refuse_arm_reason or (self.custom_mode == OFFBOARD and not self._fresh_setpoint()):
             self._text(2, self.refuse_arm_reason or "Arming denied: no offboard signal")
             self._ack(msg, 1)

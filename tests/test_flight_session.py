@@ -258,3 +258,13 @@ def test_a_jittery_axis_does_not_flood_the_vehicle_with_setpoints() -> None:
     assert session.phase is Phase.FLYING
     rate = sum(1 for t, _ in vehicle.received("SETPOINT") if t > 8.0) / (end - 8.0)
     assert 50 <= rate <= 121  # stick changes go out at once, at most 100 times a second, plus the 20 Hz stream
+
+
+def test_a_vehicle_left_in_return_mode_is_switched_to_hold_before_arming() -> None:
+    world = make_world()
+    world.vehicle.custom_mode = world.vehicle.intention = RTL
+    world.run_until(8.0)
+    assert world.session.phase is Phase.FLYING, world.notes()
+    assert "from AUTO.RTL to Hold" in world.notes()
+    hold = [m for _, m in world.vehicle.received("CMD176") if (m.param2, m.param3) == (4, 3)]
+    assert hold and hold[0] is world.vehicle.received("CMD176")[0][1]
