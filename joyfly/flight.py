@@ -14,23 +14,24 @@ import logging
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
+from joyfly.failsafes import ExitPlan, Retry
 from joyfly.flight_session import (
+    MIN_SEND_GAP_S,
     STREAMING_PHASES,
     FlightStats,
     Note,
     Phase,
+    SessionCore,
     SessionSettings,
     SessionView,
     StickSource,
     left_offboard_message,
     no_vehicle_message,
-    update_stats,
 )
-from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, CommandHandle, VehicleLink
+from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER
 from joyfly.mapping import fired
-from joyfly.setpoints import Fence, Setpoint, hold_setpoint, initial_setpoint, next_setpoint
-from joyfly.types import Action, Clock, StickCommand
+from joyfly.setpoints import initial_setpoint, next_setpoint
+from joyfly.types import Action
 
 __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "SessionView", "StickSource"]
 
@@ -38,50 +39,14 @@ MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
 # modes in PX4's mode_req_prevent_arming (ModeUtil/mode_requirements.cpp; px4-behaviour.md 3.2)
 NO_ARMING_MODES = ("AUTO.RTL", "AUTO.LAND", "AUTO.DESCEND", "AUTO.PRECLAND", "AUTO.FOLLOW_TARGET", "TERMINATION")
-MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
 
 log = logging.getLogger(__name__)
 
 
-class FlightSession:
+class FlightSession(SessionCore):
     """Run with `run()`; `request_exit()` (e.g. from SIGINT) performs the --on-exit action and finishes."""
 
-    def __init__(self, link: VehicleLink, sticks: StickSource, clock: Clock, settings: SessionSettings,
-                 on_note: Callable[[Note], None] | None = None) -> None:
-        self.link, self.sticks, self.clock, self.s = link, sticks, clock, settings
-        self.on_note = on_note
-        self.phase = Phase.CONNECTING
-        self.fence = Fence((0.0, 0.0, 0.0), settings.fence_m, settings.min_alt_m, settings.max_alt_m)
-        self.sp: Setpoint | None = None
-        self.cmd = StickCommand()
-        self.stats = FlightStats()
-        self.notes: list[Note] = []
-        self.exit_requested = False
-        self.error: str | None = None
-        self._start_s = clock.now()
-        self._phase_s = self._start_s
-        self._period_s = 1.0 / max(settings.rate_hz, 1.0)
-        self._last_sp_s = self._start_s
-        self._last_tick_s = self._start_s
-        self._prestreamed = 0
-        self._retry: Retry | None = None
-        self._joy = JoystickWatch(settings.joy_timeout_s)
-        self._linkw = LinkWatch()
-        self._fired: frozenset[Action] = frozenset()
-        self._arm_hold_s = float(getattr(getattr(sticks, "profile", None), "arm_hold_s", 1.0))
-        self._last_pos: tuple[float, float, float] | None = None
-        self.setpoints_sent = 0
-        self.on_setpoint: list[Callable[[Setpoint], None]] = []
-        self._exit: ExitPlan | None = None
-        self._dirty = False  # the sticks changed since the last setpoint was sent
-        self._next_tick_s = self._start_s
-        self._last_immediate_s = -MIN_SEND_GAP_S
-        self._mode_handle: CommandHandle | None = None
-
     # --- the loop ----------------------------------------------------------------------------------------------
-    @property
-    def finished(self) -> bool:
-        return self.phase in (Phase.DONE, Phase.FAILED)
 
     def run(self, on_view: Callable[[SessionView], None] | None = None) -> None:
         """Fly until done (or failed): a tick every 1/rate s, the sticks read in between."""
@@ -143,54 +108,7 @@ class FlightSession:
             self._handle_buttons()
         _PHASE_HANDLERS[self.phase](self, now)
 
-    def request_exit(self) -> None:
-        """Perform --on-exit, then finish (the first Ctrl-C)."""
-        self.exit_requested = True
-
-    def abort(self) -> None:
-        """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
-        self._set_phase(Phase.DONE)
-
     # --- helpers -------------------------------------------------------------------------------------------------
-    def _note(self, level: str, text: str) -> None:
-        note = Note(self.clock.now(), level, text)
-        self.notes.append(note)
-        del self.notes[:-20]
-        getattr(log, {"info": "info", "warn": "warning"}.get(level, "error"))(text)
-        if self.on_note is not None:
-            self.on_note(note)
-
-    def _set_phase(self, phase: Phase) -> None:
-        if phase is not self.phase:
-            log.debug("phase %s -> %s", self.phase.name, phase.name)
-            self.phase = phase
-            self._phase_s = self.clock.now()
-            self._retry = None
-
-    def _fail(self, text: str) -> None:
-        self.error = text
-        self._note("error", text)
-        self._set_phase(Phase.FAILED)
-
-    def _streaming_allowed(self) -> bool:
-        return self.phase in STREAMING_PHASES and self._linkw.ok
-
-    def _send(self, sp: Setpoint) -> None:
-        self.sp = sp
-        self._dirty = False
-        self._last_sp_s = self.clock.now()
-        self.link.send_setpoint(sp)
-        self.setpoints_sent += 1
-        for observer in self.on_setpoint:
-            observer(sp)
-
-    def _vehicle_pos(self) -> tuple[float, float, float]:
-        pos = self.link.state.pos_ned_m
-        return pos if pos is not None else (0.0, 0.0, 0.0)
-
-    def _hold_here(self) -> Setpoint:
-        st = self.link.state
-        return hold_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, st.vel_ned_m_s, self.s.limits.lag_s)
 
     def _send_flight_setpoint(self) -> None:
         now = self.clock.now()
@@ -204,6 +122,7 @@ class FlightSession:
         self._send(sp)
 
     # --- watchdogs -------------------------------------------------------------------------------------------
+
     def _watch_link(self, now: float) -> bool:
         change = self._linkw.update(self.link.state.link_ok(now))
         if change == "lost":
@@ -240,12 +159,8 @@ class FlightSession:
             self.link.land()
             self._set_phase(Phase.LANDING)
 
-    def _update_stats(self, now: float) -> None:
-        st = self.link.state
-        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s)
-        self._last_pos = st.pos_ned_m
-
     # --- buttons -----------------------------------------------------------------------------------------------
+
     def _handle_buttons(self) -> None:
         """Act on the buttons that fired since the last tick (ARM after its hold, the others on the press)."""
         new, self._fired = self._fired, frozenset()
@@ -292,6 +207,7 @@ class FlightSession:
         self.fence = replace(self.fence, home_ned_m=home)
 
     # --- phases --------------------------------------------------------------------------------------------------
+
     def _connecting(self, now: float) -> None:
         st = self.link.state
         if st.link_ok(now) and st.pos_ned_m is not None:
@@ -309,10 +225,6 @@ class FlightSession:
             st = self.link.state
             self._fail(no_vehicle_message(self.link.transport.description, st.last_heartbeat_s is not None,
                                           self.s.connect_timeout_s))
-
-    def _note_once(self, text: str) -> None:
-        if not any(n.text == text for n in self.notes):
-            self._note("info", text)
 
     def _on_connected(self) -> None:
         st = self.link.state
@@ -433,6 +345,7 @@ class FlightSession:
             self._set_phase(Phase.DONE)
 
     # --- exit ----------------------------------------------------------------------------------------------------
+
     def _begin_exit(self) -> None:
         st = self.link.state
         if self.phase is Phase.CONNECTING or not st.armed:
@@ -462,15 +375,6 @@ class FlightSession:
             self._set_phase(Phase.DONE)
 
     # --- view ------------------------------------------------------------------------------------------------
-    def view(self) -> SessionView:
-        st = self.link.state
-        now = self.clock.now()
-        return SessionView(
-            time_s=now - self._start_s, phase=self.phase, link_ok=st.link_ok(now), mode=st.mode, armed=st.armed,
-            landed_state=st.landed_state, pos_ned_m=st.pos_ned_m, setpoint=self.sp,
-            streaming=self._streaming_allowed(), stick=self.cmd, joystick_ok=not self._joy.holding,
-            fence=self.fence, stats=self.stats, statustexts=tuple(t.text for t in list(self.link.statustexts)[-5:]),
-            notes=tuple(self.notes[-5:]), link_description=self.link.transport.description)
 
 
 _PHASE_HANDLERS: dict[Phase, Callable[[FlightSession, float], None]] = {

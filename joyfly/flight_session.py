@@ -1,16 +1,24 @@
-"""The flight session's vocabulary: phases, settings, notes to the user, flight statistics and the view snapshot the
-live view draws. Plain data and one pure statistics update; the session itself is joyfly/flight.py."""
+"""The flight session's vocabulary and state: phases, settings, notes to the user, flight statistics, the view
+snapshot the live view draws, and `SessionCore`, the session's state with its small helpers. The behaviour (loop,
+watchdogs, buttons, phases) is `FlightSession` in joyfly/flight.py."""
 
 from __future__ import annotations
 
+import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Protocol
 
-from joyfly.link import VehicleState
-from joyfly.setpoints import Fence, Limits, Setpoint
-from joyfly.types import StickCommand
+from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
+from joyfly.link import CommandHandle, VehicleLink, VehicleState
+from joyfly.setpoints import Fence, Limits, Setpoint, hold_setpoint
+from joyfly.types import Action, Clock, StickCommand
+
+log = logging.getLogger("joyfly.flight")
+
+MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
 
 
 class Phase(Enum):
@@ -119,3 +127,110 @@ def left_offboard_message(mode: str, recent_texts: list[str]) -> str:
     why = f" ({recent_texts[-1]})" if recent_texts else ""
     return (f"The vehicle left OFFBOARD for {mode}{why}: joyfly stopped sending setpoints and will not fight it; "
             "press OFFBOARD to take control again.")
+
+
+class SessionCore:
+    """The flight session's state and helpers (notes, phase changes, sending, the view)."""
+
+    def __init__(self, link: VehicleLink, sticks: StickSource, clock: Clock, settings: SessionSettings,
+                 on_note: Callable[[Note], None] | None = None) -> None:
+        self.link, self.sticks, self.clock, self.s = link, sticks, clock, settings
+        self.on_note = on_note
+        self.phase = Phase.CONNECTING
+        self.fence = Fence((0.0, 0.0, 0.0), settings.fence_m, settings.min_alt_m, settings.max_alt_m)
+        self.sp: Setpoint | None = None
+        self.cmd = StickCommand()
+        self.stats = FlightStats()
+        self.notes: list[Note] = []
+        self.exit_requested = False
+        self.error: str | None = None
+        self._start_s = clock.now()
+        self._phase_s = self._start_s
+        self._period_s = 1.0 / max(settings.rate_hz, 1.0)
+        self._last_sp_s = self._start_s
+        self._last_tick_s = self._start_s
+        self._prestreamed = 0
+        self._retry: Retry | None = None
+        self._joy = JoystickWatch(settings.joy_timeout_s)
+        self._linkw = LinkWatch()
+        self._fired: frozenset[Action] = frozenset()
+        self._arm_hold_s = float(getattr(getattr(sticks, "profile", None), "arm_hold_s", 1.0))
+        self._last_pos: tuple[float, float, float] | None = None
+        self.setpoints_sent = 0
+        self.on_setpoint: list[Callable[[Setpoint], None]] = []
+        self._exit: ExitPlan | None = None
+        self._dirty = False  # the sticks changed since the last setpoint was sent
+        self._next_tick_s = self._start_s
+        self._last_immediate_s = -MIN_SEND_GAP_S
+        self._mode_handle: CommandHandle | None = None
+
+    @property
+    def finished(self) -> bool:
+        return self.phase in (Phase.DONE, Phase.FAILED)
+
+    def request_exit(self) -> None:
+        """Perform --on-exit, then finish (the first Ctrl-C)."""
+        self.exit_requested = True
+
+    def abort(self) -> None:
+        """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
+        self._set_phase(Phase.DONE)
+
+    def _note(self, level: str, text: str) -> None:
+        note = Note(self.clock.now(), level, text)
+        self.notes.append(note)
+        del self.notes[:-20]
+        getattr(log, {"info": "info", "warn": "warning"}.get(level, "error"))(text)
+        if self.on_note is not None:
+            self.on_note(note)
+
+    def _set_phase(self, phase: Phase) -> None:
+        if phase is not self.phase:
+            log.debug("phase %s -> %s", self.phase.name, phase.name)
+            self.phase = phase
+            self._phase_s = self.clock.now()
+            self._retry = None
+
+    def _fail(self, text: str) -> None:
+        self.error = text
+        self._note("error", text)
+        self._set_phase(Phase.FAILED)
+
+    def _streaming_allowed(self) -> bool:
+        return self.phase in STREAMING_PHASES and self._linkw.ok
+
+    def _send(self, sp: Setpoint) -> None:
+        self.sp = sp
+        self._dirty = False
+        self._last_sp_s = self.clock.now()
+        self.link.send_setpoint(sp)
+        self.setpoints_sent += 1
+        for observer in self.on_setpoint:
+            observer(sp)
+
+    def _vehicle_pos(self) -> tuple[float, float, float]:
+        pos = self.link.state.pos_ned_m
+        return pos if pos is not None else (0.0, 0.0, 0.0)
+
+    def _hold_here(self) -> Setpoint:
+        st = self.link.state
+        return hold_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, st.vel_ned_m_s, self.s.limits.lag_s)
+
+    def _update_stats(self, now: float) -> None:
+        st = self.link.state
+        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s)
+        self._last_pos = st.pos_ned_m
+
+    def _note_once(self, text: str) -> None:
+        if not any(n.text == text for n in self.notes):
+            self._note("info", text)
+
+    def view(self) -> SessionView:
+        st = self.link.state
+        now = self.clock.now()
+        return SessionView(
+            time_s=now - self._start_s, phase=self.phase, link_ok=st.link_ok(now), mode=st.mode, armed=st.armed,
+            landed_state=st.landed_state, pos_ned_m=st.pos_ned_m, setpoint=self.sp,
+            streaming=self._streaming_allowed(), stick=self.cmd, joystick_ok=not self._joy.holding,
+            fence=self.fence, stats=self.stats, statustexts=tuple(t.text for t in list(self.link.statustexts)[-5:]),
+            notes=tuple(self.notes[-5:]), link_description=self.link.transport.description)
