@@ -37,8 +37,9 @@ __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "
 
 MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
-# modes in PX4's mode_req_prevent_arming (ModeUtil/mode_requirements.cpp; px4-behaviour.md 3.2)
-NO_ARMING_MODES = ("AUTO.RTL", "AUTO.LAND", "AUTO.DESCEND", "AUTO.PRECLAND", "AUTO.FOLLOW_TARGET", "TERMINATION")
+# Arm only in Hold or OFFBOARD: PX4 refuses to arm in Return, Land, Descend... (mode_req_prevent_arming,
+# ModeUtil/mode_requirements.cpp) and in the manual modes without RC (px4-behaviour.md 3.2)
+ARMABLE_MODES = ("AUTO.LOITER", "OFFBOARD")
 
 log = logging.getLogger(__name__)
 
@@ -267,20 +268,22 @@ class FlightSession(SessionCore):
             self._note("info", "Armed.")
             self._set_phase(Phase.ENTERING)
             return
-        if self.link.state.mode in NO_ARMING_MODES:
-            self._leave_no_arming_mode()
+        if self.link.state.mode not in ARMABLE_MODES and self._hold_requests < 2:
+            self._switch_to_hold_first(now)
             return
         if self._retry is None:
             self._retry = Retry("Arming", self.s.arm_attempts, now)
         outcome = self._retry.update(now, self.link, self.link.arm, lambda: self.link.state.armed)
         self._report_retry(outcome)
 
-    def _leave_no_arming_mode(self) -> None:
-        """PX4 refuses to arm in Return, Land, Descend... (mode_requirements.cpp prevent_arming): ask for Hold first,
-        as MAVSDK's arm() does."""
-        if self._mode_handle is None or self._mode_handle.done:
-            self._note("info", f"Switching the vehicle from {self.link.state.mode} to Hold: PX4 cannot arm in it.")
-            self._mode_handle = self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+    def _switch_to_hold_first(self, now: float) -> None:
+        """Ask for Hold (as MAVSDK's arm() does from Mission/Return), twice at most, then arm anyway and let the
+        vehicle's refusal explain."""
+        if now - self._hold_sent_s > 1.5:  # the 1 Hz HEARTBEAT shows the new mode within about a second
+            self._note("info", f"Switching the vehicle from {self.link.state.mode} to Hold before arming.")
+            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self._hold_sent_s = now
+            self._hold_requests += 1
 
     def _entering(self, now: float) -> None:
         assert self.sp is not None

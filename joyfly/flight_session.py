@@ -12,7 +12,7 @@ from enum import Enum
 from typing import Protocol
 
 from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
-from joyfly.link import CommandHandle, VehicleLink, VehicleState
+from joyfly.link import VehicleLink, VehicleState
 from joyfly.setpoints import Fence, Limits, Setpoint, hold_setpoint
 from joyfly.types import Action, Clock, StickCommand
 
@@ -162,7 +162,8 @@ class SessionCore:
         self._dirty = False  # the sticks changed since the last setpoint was sent
         self._next_tick_s = self._start_s
         self._last_immediate_s = -MIN_SEND_GAP_S
-        self._mode_handle: CommandHandle | None = None
+        self._hold_requests = 0
+        self._hold_sent_s = -math.inf
 
     @property
     def finished(self) -> bool:

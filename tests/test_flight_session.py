@@ -265,6 +265,16 @@ def test_a_vehicle_left_in_return_mode_is_switched_to_hold_before_arming() -> No
     world.vehicle.custom_mode = world.vehicle.intention = RTL
     world.run_until(8.0)
     assert world.session.phase is Phase.FLYING, world.notes()
-    assert "from AUTO.RTL to Hold" in world.notes()
+    assert "from AUTO.RTL to Hold before arming" in world.notes()
     hold = [m for _, m in world.vehicle.received("CMD176") if (m.param2, m.param3) == (4, 3)]
     assert hold and hold[0] is world.vehicle.received("CMD176")[0][1]
+
+
+def test_a_vehicle_that_will_not_hold_is_still_asked_to_arm_and_its_refusal_shown() -> None:
+    world = make_world()
+    world.vehicle.custom_mode = world.vehicle.intention = LAND
+    world.vehicle._set_mode = lambda msg, mode: world.vehicle._ack(msg, 1)  # type: ignore[method-assign]
+    world.run_until(15.0)
+    assert len([m for _, m in world.vehicle.received("CMD176")]) == 2
+    assert world.session.phase is Phase.FAILED
+    assert "Arming denied: mode not armable" in (world.session.error or "")
