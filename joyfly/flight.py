@@ -200,6 +200,7 @@ class FlightSession(SessionCore):
             self._reset_home()
             self.sp = initial_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, self.s.alt_m)
         self._prestreamed = 0
+        self._hold_requests = 0
         self._set_phase(Phase.PRESTREAM)
 
     def _reset_home(self) -> None:
@@ -248,6 +249,10 @@ class FlightSession(SessionCore):
         assert self.sp is not None
         self._send(self.sp)
         self._prestreamed += 1
+        st = self.link.state
+        if not st.armed and st.mode not in ARMABLE_MODES and self._hold_requests < 2:
+            self._switch_to_hold_first(now)  # before the readiness wait: PX4 reports ready for the current mode
+            return
         if self._prestreamed >= self.s.prestream_count and self._vehicle_ready(now):
             self._set_phase(Phase.ENTERING if self.link.state.armed else Phase.ARMING)
 
