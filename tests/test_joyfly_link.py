@@ -147,3 +147,26 @@ def test_other_ground_stations_are_not_mistaken_for_the_vehicle() -> None:
     theirs.write(qgc.heartbeat_encode(6, 8, 0, 0, 4).pack(qgc))
     link.poll(0.0)
     assert link.state.sysid is None and not link.state.link_ok(clock.now())
+
+
+def test_tcp_urls_go_through_pymavlink() -> None:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(1)
+        server.settimeout(5.0)
+        port = server.getsockname()[1]
+        transport = open_transport(f"tcp://127.0.0.1:{port}")
+        try:
+            conn, _ = server.accept()
+            with conn:
+                conn.settimeout(5.0)
+                conn.sendall(b"from vehicle")
+                got = b""
+                end = time.monotonic() + 3.0
+                while len(got) < 12 and time.monotonic() < end:
+                    got += transport.read(0.1)
+                assert got == b"from vehicle"
+                transport.write(b"from joyfly")
+                assert conn.recv(100) == b"from joyfly"
+        finally:
+            transport.close()
