@@ -65,6 +65,7 @@ def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any
 @_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
 @_opt("--record", str, "Record the joystick's events with timestamps to this file (replay with --joy replay:FILE).")
 @_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
+@_opt("--connect-timeout", float, "Seconds to wait for the vehicle's first HEARTBEAT and position.")
 @_opt("--speed", float, "The emulator's speed factor (sitl-emu serve --speed N): joyfly's clock runs as fast.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 def fly(config_path: str | None, **cli_options: Any) -> None:

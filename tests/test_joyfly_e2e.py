@@ -16,6 +16,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -167,10 +168,9 @@ def _free_udp_port() -> int:
         return int(sock.getsockname()[1])
 
 
-def test_sigint_lands_disarms_and_exits_0(tmp_path: Path) -> None:
-    """Two programs as a user runs them: `sitl-emu serve` and `joyfly fly`, then Ctrl-C to joyfly."""
+def _start_pair(tmp_path: Path, speed: str = "4") -> tuple[subprocess.Popen[bytes], subprocess.Popen[str], str]:
+    """`sitl-emu serve` and `joyfly fly` (hovering on a script joystick) as a user runs them, flying in OFFBOARD."""
     joy_port, emu_port, gcs_port = _free_udp_port(), _free_udp_port(), _free_udp_port()
-    speed = "4"
     emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
                             f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -181,18 +181,47 @@ def test_sigint_lands_disarms_and_exits_0(tmp_path: Path) -> None:
                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         out = _read_until(joy, "OFFBOARD: you have control", 30.0)
+    except BaseException:
+        _kill(joy, emu)
+        raise
+    return emu, joy, out
+
+
+def _kill(*procs: subprocess.Popen[Any]) -> None:
+    for proc in procs:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_sigint_lands_disarms_and_exits_0(tmp_path: Path) -> None:
+    """Ctrl-C to joyfly: it performs --on-exit land, waits until landed and disarmed, exits 0."""
+    emu, joy, out = _start_pair(tmp_path)
+    try:
         time.sleep(1.0)
         joy.send_signal(signal.SIGINT)
         stdout, stderr = joy.communicate(timeout=40.0)
     finally:
-        for proc in (joy, emu):
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
+        _kill(joy, emu)
     out += stdout
     assert joy.returncode == 0, out + stderr
     assert "Exiting: land" in out and "Landed and disarmed" in out
     assert "Traceback" not in stderr
+
+
+def test_second_sigint_quits_at_once(tmp_path: Path) -> None:
+    emu, joy, _ = _start_pair(tmp_path)
+    try:
+        joy.send_signal(signal.SIGINT)
+        time.sleep(0.2)
+        start = time.monotonic()
+        joy.send_signal(signal.SIGINT)
+        stdout, stderr = joy.communicate(timeout=10.0)
+        quit_s = time.monotonic() - start
+    finally:
+        _kill(joy, emu)
+    assert joy.returncode == 130 and quit_s < 2.0
+    assert "interrupted twice" in stdout and "Traceback" not in stderr
 
 
 def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str:
@@ -230,3 +259,14 @@ def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> N
         assert flight.session.link.state.offboard
     finally:
         gcs.close()
+
+
+def test_no_vehicle_exits_with_a_clear_message() -> None:
+    port = _free_udp_port()
+    proc = subprocess.run([sys.executable, "-m", "joyfly", "fly", "--joy", "script:examples/joystick_script.txt",
+                           "--url", f"udp://127.0.0.1:{port}@127.0.0.1:{_free_udp_port()}", "--connect-timeout", "1"],
+                          stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=30,
+                          cwd=Path(__file__).resolve().parent.parent)
+    assert proc.returncode == 1
+    assert f"No HEARTBEAT from a vehicle on UDP 127.0.0.1:{port}" in proc.stderr
+    assert "sitl-emu serve" in proc.stderr and "Traceback" not in proc.stderr
