@@ -106,8 +106,10 @@ def bench_scale(quick: bool) -> None:
     best, trials = scale.search(1 if quick else 4, 256, seconds, cpu)
     tried = ", ".join(f"{n} {'ok' if scale.on_time(r) else 'late'} ({r['cpu_share'] * 100:.0f} % cpu, "
                       f"lag {r['max_lag_s'] * 1000:.0f} ms)" for n, r in trials)
+    ok = [(n, r) for n, r in trials if scale.on_time(r) and r["cpu_share"] > 0]
+    estimate = f"; CPU-bound estimate {max(n / r['cpu_share'] for n, r in ok):.0f}" if ok else ""
     say(f"scale: {best} vehicles on one core at real time (hovering, default streams, {seconds:g} s trials on "
-        f"CPU {cpu}; target 100): {tried}")
+        f"CPU {cpu}; target 100{estimate}): {tried}")
 
 
 BENCHES: dict[str, Callable[[bool], None]] = {
