@@ -269,8 +269,7 @@ class VehicleLink:
         """Send a COMMAND_LONG (unused params 0, which PX4 accepts in every version) and track its ACK."""
         full = tuple(params) + (0.0,) * (7 - len(params))
         handle = CommandHandle(command, full, self._clock.now())
-        self._pending = [h for h in self._pending if h.command != command]
-        self._pending.append(handle)
+        self._pending.append(handle)  # an ACK answers every pending handle of its command
         self._send_command(command, full)
         return handle
 
