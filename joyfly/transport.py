@@ -145,7 +145,7 @@ def _host_port(text: str, default_host: str, what: str) -> tuple[str, int]:
 
 def parse_udp_url(url: str) -> tuple[tuple[str, int], tuple[str, int] | None]:
     """`udp://[bind_host]:bind_port@[remote_host][:remote_port]` -> (bind address, remote address or None)."""
-    body = url[len("udp://"):]
+    body = url[len("udp://"):].split("/?", 1)[0]  # MAVROS's "/?ids=sysid,compid" names MAVROS itself: ignored
     local, _, remote = body.partition("@")
     bind = _host_port(local, "0.0.0.0", "listen address")
     if not remote:

@@ -20,6 +20,7 @@ def test_mavros_style_url_gives_bind_and_remote() -> None:
     assert parse_udp_url("udp://:14540@127.0.0.1:14557") == (("0.0.0.0", 14540), ("127.0.0.1", 14557))
     assert parse_udp_url("udp://127.0.0.1:0@") == (("127.0.0.1", 0), None)
     assert parse_udp_url("udp://:14540@10.0.0.2") == (("0.0.0.0", 14540), ("10.0.0.2", 14555))
+    assert parse_udp_url("udp://:14540@127.0.0.1:14580/?ids=255,240") == (("0.0.0.0", 14540), ("127.0.0.1", 14580))
 
 
 @pytest.mark.parametrize("url", ["bogus://x", "udp://:notaport@", "zmq:1234"])
