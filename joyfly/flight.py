@@ -335,6 +335,10 @@ class FlightSession(SessionCore):
             self._note("warn", left_offboard_message(st.mode, recent))
             self._set_phase(Phase.PAUSED if st.armed else Phase.GROUNDED)
             return
+        if not st.armed:  # killed, or disarmed by another ground station
+            self._note("warn", "The vehicle disarmed: joyfly stopped sending setpoints; press ARM or TAKEOFF to fly.")
+            self._set_phase(Phase.GROUNDED)
+            return
         self._send_flight_setpoint()
 
     def _paused(self, now: float) -> None:

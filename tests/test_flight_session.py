@@ -278,3 +278,13 @@ def test_a_vehicle_that_will_not_hold_is_still_asked_to_arm_and_its_refusal_show
     assert len([m for _, m in world.vehicle.received("CMD176")]) == 2
     assert world.session.phase is Phase.FAILED
     assert "Arming denied: mode not armable" in (world.session.error or "")
+
+
+def test_a_vehicle_disarmed_under_us_stops_the_stream() -> None:
+    world = airborne()
+    world.vehicle.armed = False  # a kill switch from another ground station; PX4 stays in OFFBOARD
+    world.run_until(8.0)
+    assert world.session.phase is Phase.GROUNDED and "The vehicle disarmed" in world.notes()
+    sent = len(world.vehicle.received("SETPOINT"))
+    world.run_until(10.0)
+    assert len(world.vehicle.received("SETPOINT")) == sent
