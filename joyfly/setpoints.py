@@ -79,7 +79,8 @@ class Limits:
     max_yaw_rate_rad_s: float = math.radians(45.0)
     leash_m: float = 1.0  # velocity mode: how far the setpoint may run ahead of the vehicle
     brake_acc_m_s2: float = 2.0  # velocity mode: planned deceleration towards the fence
-    lag_s: float = 0.5  # velocity mode: how far ahead to predict the vehicle (its velocity lags the demand)
+    lag_s: float = 0.5  # how far the vehicle runs on after a stop demand (its velocity lags): hold point, leash
+    brake_lookahead_s: float = 0.7  # velocity mode: brake for the fence from where the vehicle will be by then
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,13 +139,13 @@ def next_setpoint(
 ) -> Setpoint:
     """The setpoint after `dt_s` of stick `cmd`, starting from `prev`, clamped by the fence.
 
-    Velocity mode brakes towards a fence side from where the vehicle will be `lag_s` from now (its position plus
-    velocity x lag), so a vehicle that lags its demand still stops at the side, not beyond it."""
+    Velocity mode brakes towards a fence side from where the vehicle will be `brake_lookahead_s` from now (position
+    plus velocity x lookahead), so a vehicle that lags its demand still stops at the side, not beyond it."""
     yaw = wrap_pi(prev.yaw_rad + cmd.yaw * limits.max_yaw_rate_rad_s * dt_s)
     z = _next_z(prev.pos_ned_m[2], climb_demand(cmd), vehicle_ned_m[2], dt_s, limits)
     if limits.control == "step":
         return _step_xy(prev, cmd, vehicle_ned_m, z, yaw, limits, fence)
-    ahead = tuple(p + v * limits.lag_s for p, v in zip(vehicle_ned_m, vehicle_vel_ned_m_s, strict=True))
+    ahead = tuple(p + v * limits.brake_lookahead_s for p, v in zip(vehicle_ned_m, vehicle_vel_ned_m_s, strict=True))
     sp = _velocity_xy(prev, cmd, vehicle_ned_m, (ahead[0], ahead[1]), z, yaw, dt_s, limits, fence)
     return _with_climb_feedforward(sp, z, fence.clamp(sp.pos_ned_m)[2], climb_demand(cmd) * limits.max_climb_m_s)
 

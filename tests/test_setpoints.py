@@ -131,7 +131,7 @@ def test_braking_starts_earlier_for_a_vehicle_already_moving_fast() -> None:
     still = next_setpoint(sp, StickCommand(forward=1.0), (2.0, 0.0, -3.0), 0.05, VEL, FENCE)
     moving = next_setpoint(sp, StickCommand(forward=1.0), (2.0, 0.0, -3.0), 0.05, VEL, FENCE, (5.0, 0.0, 0.0))
     assert still.vel_ned_m_s is not None and moving.vel_ned_m_s is not None
-    assert moving.vel_ned_m_s[0] < still.vel_ned_m_s[0] - 0.5  # predicted 2.5 m on: only 0.5 m of room left
+    assert moving.vel_ned_m_s[0] < still.vel_ned_m_s[0] - 0.5  # predicted at the fence already: no room left
 
 
 def test_hold_brakes_to_the_point_ahead_of_a_moving_vehicle() -> None:
