@@ -87,9 +87,9 @@ def startup_times() -> tuple[float, float]:
     return first, healthy
 
 
-def hover_cpu_share(seconds: float) -> float:
+def hover_cpu_share(seconds: float, extra: tuple[str, ...] = ()) -> float:
     """Percent of one core used by `serve` at real time while hovering in Hold, default streams on both links."""
-    server = start_server()
+    server = start_server(extra=extra)
     try:
         c = server.client
         c.wait(lambda: c.healthy, 20.0, "health all good")

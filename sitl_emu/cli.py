@@ -131,6 +131,8 @@ def main(verbose: int) -> None:
               help="Simulation speed factor.")
 @click.option("--count", type=click.IntRange(1, 250), default=1, show_default=True,
               help="Number of vehicles: instances --instance.., sysids and ports offset per vehicle, homes 3 m apart.")
+@click.option("--batch-ms", type=click.FloatRange(0, 100), default=0.0, show_default=True,
+              help="Wake at most every N ms and run the ticks due in one batch: less CPU, telemetry in bursts.")
 @click.option("--home", default=None, help="Home as LAT,LON,ALT (deg, deg, m AMSL).")
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
@@ -138,8 +140,8 @@ def main(verbose: int) -> None:
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed for sensor noise.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
-          count: int, home: str | None, assignments: tuple[str, ...], params_file: Path | None, seed: int,
-          no_console: bool) -> None:
+          count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
+          seed: int, no_console: bool) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
@@ -155,6 +157,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         click.echo(f"sitl-emu: {err}", err=True)
         sys.exit(2)
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
+    runner.min_wake_s = batch_ms / 1000.0
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()

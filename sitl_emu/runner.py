@@ -34,6 +34,10 @@ class RealTimeRunner:
         self.iterations = 0
         self.steps = 0
         self.dropped_us = 0
+        # Sleep at least this long between wake-ups (0: wake for every tick). Longer batches of ticks cost less CPU
+        # per tick (measured: 12.8 % -> 8.7 % at 16 ms -> 6.3 % at 40 ms of a core for one hovering vehicle);
+        # telemetry then leaves in bursts (each message still stamped at its own tick); input wakes us at once.
+        self.min_wake_s = 0.0
 
     def stop(self) -> None:
         self._stop.set()
@@ -67,7 +71,7 @@ class RealTimeRunner:
             next_wall = start_wall + (lead.time_us + dt_us - start_sim_us) / 1e6 / self.speed
             timeout = max(0.0, next_wall - time.monotonic())
             if timeout > 0:
-                _wait_readable(fds, timeout)
+                _wait_readable(fds, max(timeout, self.min_wake_s))
 
     def _limit_lag(self, start_sim_us: int, target_us: int, lead: Any) -> tuple[int, int]:
         lag = target_us - int(lead.time_us)

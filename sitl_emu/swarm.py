@@ -110,7 +110,7 @@ class SwarmRunner(RealTimeRunner):
             next_wall = start_wall + (self.timeline_us + dt_us - anchor_us) / 1e6 / self.speed
             timeout = next_wall - time.monotonic()
             if timeout > 0:
-                _wait_readable(fds, timeout)
+                _wait_readable(fds, max(timeout, self.min_wake_s))
 
     def _advance(self, target_us: int, dt_us: int) -> None:
         stepped_any = False

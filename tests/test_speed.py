@@ -3,7 +3,7 @@
 The speed-1 flight would take ~35 s of wall time, so the comparison is in-process lockstep (as fast as the CPU
 allows) against `serve --speed 20` in another process, flown by the same scripted pymavlink client (its clock is the
 Sim clock in lockstep, wall time x 20 against the server). Heartbeats and stream rates are checked per simulated
-second at --speed 10.
+second at --speed 10, waking for every tick and with --batch-ms 40 (0.4 s of simulated ticks per wake-up).
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.api import ScaledWallClock, Sim
@@ -37,9 +38,9 @@ def _free_ports(n: int) -> list[int]:
     return ports
 
 
-def _serve(speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int) -> subprocess.Popen:
+def _serve(speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int, *extra: str) -> subprocess.Popen:
     args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs), "--remote", f"127.0.0.1:{api_remote}",
-            "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
+            "--gcs-remote", f"127.0.0.1:{gcs_remote}", *extra]
     return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
@@ -73,13 +74,14 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
     assert math.dist(fast.landing_ned_m, lockstep.landing_ned_m) < 0.25
 
 
-def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10():
+@pytest.mark.parametrize("batch", [(), ("--batch-ms", "40")], ids=["every-tick", "batch-40ms"])
+def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10(batch):
     api, gcs, listen, gcs_sink = _free_ports(4)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
     sock.bind(("127.0.0.1", listen))
     sock.settimeout(5.0)
-    proc = _serve(10.0, api, gcs, listen, gcs_sink)  # the API link streams to us from boot (PX4 SITL: initial remote)
+    proc = _serve(10.0, api, gcs, listen, gcs_sink, *batch)  # the API link streams to us from boot (initial remote)
     parser = dialect.MAVLink(None)
     beats, attitude_ms = 0, []
     try:
