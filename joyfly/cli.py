@@ -21,6 +21,7 @@ from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view, summary_lines
 from joyfly.flight import FlightSession, Phase
+from joyfly.flight_session import FlightStats
 from joyfly.joystick import JoystickError
 from joyfly.link import VehicleLink
 from joyfly.mapping import open_sticks
@@ -110,8 +111,10 @@ def fly_session(session: FlightSession, view: Any, out: Any) -> int:
         view.close()
         session.link.close()
         session.sticks.close()
-    for line in summary_lines(session.stats):
-        out.write(line + "\n")
+    flew = session.stats != FlightStats()  # a session that never flew (no vehicle, refused) has nothing to sum up
+    if flew or session.phase is not Phase.FAILED:
+        for line in summary_lines(session.stats):
+            out.write(line + "\n")
     if session.phase is Phase.FAILED:
         click.echo(f"joyfly: {session.error}", err=True)
         return 1
