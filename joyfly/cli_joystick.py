@@ -24,6 +24,7 @@ from joyfly.joystick import (
 )
 from joyfly.mapping import StickMapper
 from joyfly.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
 from joyfly.virtual import TimedSource, record_to
 
@@ -187,7 +188,7 @@ class LiveView:
 
     def __init__(self, out: TextIO) -> None:
         self.out = out
-        self._lines = 0
+        self._block = LiveBlock(out)
         self._next_draw_s = 0.0
         self._connected = True
 
@@ -195,7 +196,7 @@ class LiveView:
         self.out.write(f"{source.name} ({source.path}), profile {profile.name}; Ctrl-C to quit\n")
 
     def note(self, text: str) -> None:
-        self._erase()
+        self._block.erase()
         self.out.write(text + "\n")
 
     def show(self, state: JoyState, cmd: StickCommand, start_s: float, error: str) -> None:
@@ -206,20 +207,9 @@ class LiveView:
         axes = " ".join(f"{i}:{v / 32767:+.2f}" for i, v in enumerate(state.axes)) or "(none yet)"
         buttons = " ".join(f"{i}:{v}" for i, v in enumerate(state.buttons)) or "(none yet)"
         status = "connected" if state.connected else f"DISCONNECTED {error}".rstrip()
-        self._draw([f"t={state.time_s - start_s:7.2f}  {status}", f"axes     {axes}", f"buttons  {buttons}",
+        self._block.draw([f"t={state.time_s - start_s:7.2f}  {status}", f"axes     {axes}", f"buttons  {buttons}",
                     f"flying   {_sticks(cmd)}", f"pressed  {_pressed(cmd)}"])
 
     def close(self) -> None:
         self.out.write("\n")
         self.out.flush()
-
-    def _erase(self) -> None:
-        if self._lines:
-            self.out.write(f"\x1b[{self._lines}F\x1b[J")
-            self._lines = 0
-
-    def _draw(self, lines: list[str]) -> None:
-        self._erase()
-        self.out.write("\n".join(lines) + "\n")
-        self.out.flush()
-        self._lines = len(lines)

@@ -9,6 +9,7 @@ import math
 from typing import TextIO
 
 from joyfly.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.term import LiveBlock
 from joyfly.types import StickCommand
 
 LIVE_PERIOD_S = 0.1
@@ -82,39 +83,28 @@ class LiveDashboard:
 
     def __init__(self, out: TextIO) -> None:
         self.out = out
-        self._lines = 0
+        self._block = LiveBlock(out)
         self._next_s = -math.inf
         self._last: SessionView | None = None
 
     def note(self, note: Note) -> None:
-        self._erase()
+        self._block.erase()
         mark = {"warn": "! ", "error": "!! "}.get(note.level, "")
         self.out.write(f"{mark}{note.text}\n")
         if self._last is not None:
-            self._draw(render(self._last))
+            self._block.draw(render(self._last))
 
     def show(self, view: SessionView) -> None:
         self._last = view
         if view.time_s < self._next_s:
             return
         self._next_s = view.time_s + LIVE_PERIOD_S
-        self._draw(render(view))
+        self._block.draw(render(view))
 
     def close(self) -> None:
         if self._last is not None:
-            self._draw(render(self._last))
+            self._block.draw(render(self._last))
         self.out.flush()
-
-    def _erase(self) -> None:
-        if self._lines:
-            self.out.write(f"\x1b[{self._lines}F\x1b[J")
-            self._lines = 0
-
-    def _draw(self, lines: list[str]) -> None:
-        self._erase()
-        self.out.write("\n".join(lines) + "\n")
-        self.out.flush()
-        self._lines = len(lines)
 
 
 class PlainLog:
