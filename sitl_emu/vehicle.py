@@ -15,6 +15,7 @@ on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the 
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 
@@ -164,7 +165,10 @@ class Vehicle:
     # ---- outputs ------------------------------------------------------------------------------------------------
     def events_after(self, seq: int) -> list[VehicleEvent]:
         """Events with seq > `seq` still in the history (the last ~1000)."""
-        return [e for e in self._events if e.seq > seq]
+        if seq >= self._seq or not self._events:
+            return []  # the common case: a link polls every tick and nothing new happened
+        start = max(0, seq + 1 - self._events[0].seq)  # seqs are consecutive, so this is the index
+        return list(itertools.islice(self._events, start, None))
 
     @property
     def last_event_seq(self) -> int:

@@ -324,3 +324,17 @@ def test_change_altitude_in_hold() -> None:
     assert _alt(s) == pytest.approx(6.0, abs=0.15) and math.hypot(s.pos_ned_m[0], s.pos_ned_m[1]) < 0.3
     f.set_mode(NavState.AUTO_RTL)
     assert f.cmd(186, 490.0, 0.0) == MavResult.DENIED  # only in Hold
+
+
+def test_events_after_returns_the_newer_events_of_the_kept_history() -> None:
+    from sitl_emu.px4 import Severity
+
+    v = Vehicle()
+    first = v.last_event_seq
+    for i in range(1100):
+        v.report(Severity.INFO, "test", f"event {i}")
+    last = v.last_event_seq
+    kept = v.events_after(first)
+    assert len(kept) == 1000 and kept[-1].text == "event 1099" and kept[0].seq == last - 999
+    assert [e.text for e in v.events_after(last - 2)] == ["event 1098", "event 1099"]
+    assert v.events_after(last) == [] and v.events_after(last + 5) == []
