@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from ports import free_udp_port, free_udp_ports
 
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
 from joyfly.flight import FlightSession, Phase, SessionSettings
@@ -160,17 +161,11 @@ def test_closing_the_fifo_holds_then_lands_after_the_timeout(flight: Flight) -> 
     assert not flight.session.link.state.armed
 
 
-def _free_udp_port() -> int:
-    import socket
-
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
 
 
 def _start_pair(tmp_path: Path, speed: str = "4") -> tuple[subprocess.Popen[bytes], subprocess.Popen[str], str]:
     """`sitl-emu serve` and `joyfly fly` (hovering on a script joystick) as a user runs them, flying in OFFBOARD."""
-    joy_port, emu_port, gcs_port = _free_udp_port(), _free_udp_port(), _free_udp_port()
+    joy_port, emu_port, gcs_port = free_udp_ports(3)
     emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
                             f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
@@ -262,9 +257,9 @@ def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> N
 
 
 def test_no_vehicle_exits_with_a_clear_message() -> None:
-    port = _free_udp_port()
+    port = free_udp_port()
     proc = subprocess.run([sys.executable, "-m", "joyfly", "fly", "--joy", "script:examples/joystick_script.txt",
-                           "--url", f"udp://127.0.0.1:{port}@127.0.0.1:{_free_udp_port()}", "--connect-timeout", "1"],
+                           "--url", f"udp://127.0.0.1:{port}@127.0.0.1:{free_udp_port()}", "--connect-timeout", "1"],
                           stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=30,
                           cwd=Path(__file__).resolve().parent.parent)
     assert proc.returncode == 1

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import asyncio
 import math
-import socket
 import subprocess
 import sys
 import time
@@ -21,16 +20,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from ports import free_udp_ports
 
 REPO = Path(__file__).resolve().parent.parent
 SPEED = 4.0  # simulated seconds per wall second
 CALL_TIMEOUT_S = 15.0  # no single MAVSDK call may hang the test
 
 
-def _free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 def _load_mavsdk() -> Any:
@@ -44,10 +40,10 @@ def _load_mavsdk() -> Any:
 @pytest.fixture()
 def server(tmp_path: Path):
     """`sitl-emu serve` on free ports; yields the UDP port MAVSDK must listen on (the API link's remote)."""
-    client_port = _free_udp_port()
+    client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
     args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
-            "--port", str(_free_udp_port()), "--remote", f"127.0.0.1:{client_port}",
-            "--gcs-port", str(_free_udp_port()), "--gcs-remote", f"127.0.0.1:{_free_udp_port()}"]
+            "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
+            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
     log_path = tmp_path / "serve.log"
     with log_path.open("w") as log_file:
         proc = subprocess.Popen(args, cwd=REPO, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)

@@ -11,21 +11,12 @@ import time
 from pathlib import Path
 
 import pytest
+from ports import free_udp_ports
 from pymavlink.dialects.v20 import development as dialect
 
 REPO = Path(__file__).resolve().parent.parent
 
 
-def _free_ports(n: int) -> list[int]:
-    socks = []
-    for _ in range(n):
-        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        s.bind(("127.0.0.1", 0))
-        socks.append(s)
-    ports = [s.getsockname()[1] for s in socks]
-    for s in socks:
-        s.close()
-    return ports
 
 
 def _serve(*args: str) -> subprocess.Popen:
@@ -50,7 +41,7 @@ def _first_message(sock: socket.socket) -> object:
 
 
 def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigterm():
-    api_port, gcs_port, api_remote, gcs_remote = _free_ports(4)
+    api_port, gcs_port, api_remote, gcs_remote = free_udp_ports(4)
     with _listener(api_remote) as api_sock, _listener(gcs_remote) as gcs_sock:
         proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{api_remote}",
                       "--gcs-remote", f"127.0.0.1:{gcs_remote}")
@@ -70,7 +61,7 @@ def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigter
 
 
 def test_ctrl_c_exits_without_traceback():
-    api_port, gcs_port, remote = _free_ports(3)
+    api_port, gcs_port, remote = free_udp_ports(3)
     proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}")
     try:
         assert proc.stdout is not None
@@ -84,7 +75,7 @@ def test_ctrl_c_exits_without_traceback():
 
 
 def test_instance_gives_sysid_and_offset_ports():
-    base_api, base_gcs, remote = _free_ports(3)
+    base_api, base_gcs, remote = free_udp_ports(3)
     with _listener(remote + 3) if remote + 3 < 65536 else pytest.skip("no room for the offset port") as sock:
         proc = _serve("--instance", "3", "--port", str(base_api - 3), "--gcs-port", str(base_gcs - 3),
                       "--remote", f"127.0.0.1:{remote}")
@@ -102,7 +93,7 @@ def test_port_in_use_is_one_sentence_and_status_2():
     holder.bind(("127.0.0.1", 0))
     port = holder.getsockname()[1]
     try:
-        (gcs_port,) = _free_ports(1)
+        (gcs_port,) = free_udp_ports(1)
         proc = _serve("--port", str(port), "--gcs-port", str(gcs_port))
         _out, err = proc.communicate(timeout=10)
     finally:
@@ -120,7 +111,7 @@ def test_port_in_use_is_one_sentence_and_status_2():
     (("--remote", "nowhere"), "HOST:PORT"),
 ])
 def test_bad_options_are_one_sentence_and_status_2(args, words):
-    api_port, gcs_port = _free_ports(2)
+    api_port, gcs_port = free_udp_ports(2)
     proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), *args)
     _out, err = proc.communicate(timeout=10)
     assert proc.returncode == 2
@@ -142,7 +133,7 @@ def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
     """mavutil's own PX4 mode map and arm helper against the real process (run at 5x real time)."""
     from pymavlink import mavutil
 
-    api_port, gcs_port, remote = _free_ports(3)
+    api_port, gcs_port, remote = free_udp_ports(3)
     conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{remote}", source_system=255, source_component=190)
     proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}",
                   "--speed", "5")

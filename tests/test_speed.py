@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
+from ports import free_udp_ports
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.api import ScaledWallClock, Sim
@@ -26,16 +27,6 @@ from sitl_emu.api_client import FlightClient, fly_square
 REPO = Path(__file__).resolve().parent.parent
 
 
-def _free_ports(n: int) -> list[int]:
-    socks = []
-    for _ in range(n):
-        s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        s.bind(("127.0.0.1", 0))
-        socks.append(s)
-    ports = [s.getsockname()[1] for s in socks]
-    for s in socks:
-        s.close()
-    return ports
 
 
 def _serve(speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int, *extra: str) -> subprocess.Popen:
@@ -57,7 +48,7 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
         client = FlightClient(sim.ports(0).api, sim.clock)
         lockstep = fly_square(client)
         client.close()
-    api, gcs, sink = _free_ports(3)
+    api, gcs, sink = free_udp_ports(3)
     proc = _serve(20.0, api, gcs, sink, sink)
     try:
         assert proc.stdout is not None
@@ -76,7 +67,7 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
 
 @pytest.mark.parametrize("batch", [(), ("--batch-ms", "40")], ids=["every-tick", "batch-40ms"])
 def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10(batch):
-    api, gcs, listen, gcs_sink = _free_ports(4)
+    api, gcs, listen, gcs_sink = free_udp_ports(4)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
     sock.bind(("127.0.0.1", listen))
