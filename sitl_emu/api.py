@@ -61,7 +61,10 @@ class LockstepClock:
 
 
 class ScaledWallClock:
-    """Wall time x `speed`, for a client in another thread or process paired with a vehicle run at that speed."""
+    """Wall time x `speed`, for a client in another thread or process paired with a vehicle run at that speed.
+
+    joyfly.clock.ScaledClock is its twin on purpose: sitl_emu and joyfly never import each other (DESIGN.md).
+    """
 
     def __init__(self, speed: float = 1.0) -> None:
         self.speed = float(speed)

@@ -15,6 +15,7 @@ import math
 import socket
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
@@ -147,6 +148,9 @@ class FlightClient:
             self.pump()
             self.clock.sleep(min(POLL_S, end - self.clock.now()))
 
+    def _acked(self, command: int, since: int) -> bool:
+        return any(c == command for c, _ in self.seen.acks[since:])
+
     def command(self, command: int, *params: float, timeout_s: float = 1.0, tries: int = 3) -> int:
         """COMMAND_LONG, resent up to `tries` times (confirmation counts up, as MAVSDK does); the ACK result."""
         p = [*params, *([NAN] * (7 - len(params)))]
@@ -154,7 +158,7 @@ class FlightClient:
             n = len(self.seen.acks)
             self.send(self.mav.command_long_encode(*self.target, command, confirmation, *p))
             try:
-                self.wait(lambda n=n: any(c == command for c, _ in self.seen.acks[n:]), timeout_s, f"ACK {command}")
+                self.wait(partial(self._acked, command, n), timeout_s, f"ACK {command}")
             except FlightError:
                 continue
             return next(r for c, r in self.seen.acks[n:] if c == command)
@@ -232,7 +236,7 @@ def _square_steps(c: FlightClient, side_m: float, altitude_m: float) -> None:
     _expect(c.set_mode(NavState.OFFBOARD), "OFFBOARD")
     for north, east in ((side_m, 0.0), (side_m, side_m), (0.0, side_m), (0.0, 0.0)):
         c.setpoint_ned_m = (north, east, z)
-        c.wait(lambda n=north, e=east: _near(c, n, e, 0.3), 20.0, f"corner ({north:g}, {east:g})")
+        c.wait(partial(_near, c, north, east, 0.3), 20.0, f"corner ({north:g}, {east:g})")
     c.spin(1.0)
     _expect(c.command(21), "land")
     c.setpoint_ned_m = None
