@@ -17,6 +17,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/mypy sitl_emu joyfly
 	$(BIN)/python -m pytest -q
 
 lint: $(STAMP)
