@@ -208,16 +208,6 @@ SHELL_MODE_NAMES: dict[str, NavState] = {
     "auto:precland": NavState.AUTO_PRECLAND,
 }
 
-# Modes that need a manual control input (RC or MAVLink joystick), none in SITL without a joystick.
-MANUAL_INPUT_MODES = frozenset(
-    {NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ACRO,
-     NavState.STAB, NavState.ALTITUDE_CRUISE}
-)
-# mode_req_prevent_arming (ModeUtil/mode_requirements.cpp)
-ARMING_PREVENTING_MODES = frozenset(
-    {NavState.AUTO_RTL, NavState.AUTO_LAND, NavState.DESCEND, NavState.TERMINATION,
-     NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND, NavState.ORBIT}
-)
 AUTO_MODES = frozenset(
     {NavState.AUTO_MISSION, NavState.AUTO_LOITER, NavState.AUTO_RTL, NavState.AUTO_TAKEOFF,
      NavState.AUTO_LAND, NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND,

@@ -18,7 +18,7 @@ from typing import Any
 
 from sitl_emu.mavlink import setpoints
 from sitl_emu.mavlink.commands import ANY_COMPONENT
-from sitl_emu.px4 import MavResult, Severity
+from sitl_emu.px4 import MavResult, Severity, decode_custom_mode
 from sitl_emu.types import VehicleCommand
 
 log = logging.getLogger(__name__)
@@ -100,7 +100,7 @@ class Receiver:
         """SET_MODE -> DO_SET_MODE(base_mode, main, sub); the ACK is for command 176 (reference 3.4)."""
         if msg.target_system != ctx.sysid:  # commander only takes DO_SET_MODE meant exactly for this system
             return
-        main, sub = (msg.custom_mode >> 16) & 0xFF, (msg.custom_mode >> 24) & 0xFF
+        main, sub = decode_custom_mode(msg.custom_mode)
         cmd = VehicleCommand(CMD_DO_SET_MODE, (float(msg.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0),
                              msg.get_srcSystem(), msg.get_srcComponent(), True)
         ctx.commands.execute(cmd, ctx)
