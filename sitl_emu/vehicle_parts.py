@@ -37,9 +37,11 @@ class Parts:
         self.executor = ModeExecutor(params)
         self._detector = LandDetector(params)
         self.ground_contact = False
-        self._ld_last_us: int | None = None
-        self._ld_armed = False
-        self._ld_out = (True, True)
+        # the land detector runs when now_us >= ld_next_us (every LAND_DETECTOR_PERIOD_US) or when arming changed
+        # (armed != ld_armed); Vehicle.step checks this itself to skip the call, land() checks it again
+        self.ld_next_us = -(1 << 62)
+        self.ld_armed = False
+        self.ld_out = (True, True)
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
         """What the navigator task sees (tasks_core.NavInput)."""
@@ -61,10 +63,9 @@ class Parts:
 
         `climb_rate_controlled` is PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard
         position/velocity/acceleration (not offboard attitude/rates, not manual modes)."""
-        if self._ld_last_us is not None and now_us - self._ld_last_us < LAND_DETECTOR_PERIOD_US \
-                and c.armed == self._ld_armed:
-            return self._ld_out
-        self._ld_last_us, self._ld_armed = now_us, c.armed
+        if now_us < self.ld_next_us and c.armed == self.ld_armed:
+            return self.ld_out
+        self.ld_next_us, self.ld_armed = now_us + LAND_DETECTOR_PERIOD_US, c.armed
         f = est.specific_force_frd
         out = self._detector.update(LandDetectorInput(
             time_us=now_us, armed=c.armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
@@ -72,8 +73,8 @@ class Parts:
             thrust_setpoint=self.control.thrust_setpoint, hover_thrust=self.control.hover_thrust,
             setpoint_vz_m_s=descent_vz(self.control.local_setpoint), in_descent_mode=climb_rate_controlled))
         self.ground_contact = bool(out.ground_contact)
-        self._ld_out = (out.landed, out.maybe_landed)
-        return self._ld_out
+        self.ld_out = (out.landed, out.maybe_landed)
+        return self.ld_out
 
 
 def descent_vz(sp: TrajectorySetpoint | None) -> float:

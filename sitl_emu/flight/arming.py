@@ -125,3 +125,35 @@ def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> 
 
 def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
     return arming_failure(nav_state, c, armed) is None
+
+
+# can_run() without building a CheckInputs (the commander asks every cycle): the requirements not met by the
+# estimator, home or offboard signal. Same answer as can_run(nav_state, CheckInputs(...)) with no manual control
+# and no mission.
+_RUN_NEEDS: dict[NavState, int] = {m: r & ~Req.PREVENT_ARMING for m, r in _REQUIREMENTS.items()}
+_ESTIMATOR_BITS = Req.ATTITUDE | Req.POSITION
+
+
+def can_run_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool) -> bool:
+    """can_run(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal)), without the allocation."""
+    need = _RUN_NEEDS.get(nav_state, 0)
+    if estimator_ready:
+        need &= ~_ESTIMATOR_BITS
+    if home_valid:
+        need &= ~Req.HOME
+    if offboard_signal:
+        need &= ~Req.OFFBOARD
+    return not need
+
+
+_CAN_ARM_MEMO: dict[tuple[NavState, bool, bool, bool, bool], bool] = {}
+
+
+def can_arm_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool,
+                armed: bool) -> bool:
+    """can_arm(nav_state, CheckInputs(...), armed), memoised (a pure function of a few booleans and the mode)."""
+    key = (nav_state, estimator_ready, home_valid, offboard_signal, armed)
+    ok = _CAN_ARM_MEMO.get(key)
+    if ok is None:
+        ok = _CAN_ARM_MEMO[key] = can_arm(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal), armed)
+    return ok

@@ -93,7 +93,11 @@ class Commander:
         self.maybe_landed = True
         self.nav_commands: list[NavCommand] = []
         self.reboot_requested = False
-        self._obs = Observation(0, False, None)
+        # the latest Observation, kept as plain attributes (Vehicle.step sets them every cycle via observe_state)
+        self._now_us = 0
+        self._ready = False
+        self._here_src: HomePosition | Callable[[], HomePosition | None] | None = None
+        self._task_finished = False
         self._ready_announced = False
         self._armed_at_us = 0
         self._landed_since_us: int | None = None
@@ -110,19 +114,27 @@ class Commander:
 
     # ---- inputs -------------------------------------------------------------------------------------------------
     def observe(self, obs: Observation) -> None:
-        self._obs = obs
+        self.observe_state(obs.now_us, obs.estimator_ready, obs.here, obs.task_finished)
+
+    def observe_state(self, now_us: int, estimator_ready: bool,
+                      here: HomePosition | Callable[[], HomePosition | None] | None, task_finished: bool) -> None:
+        """observe() without building an Observation (the vehicle calls this every cycle)."""
+        self._now_us = now_us
+        self._ready = estimator_ready
+        self._here_src = here
+        self._task_finished = task_finished
 
     def _here(self) -> HomePosition | None:
-        here = self._obs.here
+        here = self._here_src
         return here() if callable(here) else here
 
     @property
     def now_us(self) -> int:
-        return self._obs.now_us
+        return self._now_us
 
     @property
     def estimator_ready(self) -> bool:
-        return self._obs.estimator_ready
+        return self._ready
 
     def offboard_signal(self, now_us: int, mode: OffboardControlMode) -> None:
         """An offboard_control_mode arrived (any mode): refresh the COM_OF_LOSS_T watchdog."""
@@ -151,15 +163,18 @@ class Commander:
 
     def pre_flight_checks_pass(self) -> bool:
         """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed)."""
-        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed)
+        return arming.can_arm_now(self.nav_state, self._ready, self.home is not None,
+                                  self.offboard_fresh(self._now_us), self.armed)
 
-    def system_status(self) -> MavState:
-        """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
+    def system_status(self, pre_flight_checks_pass: bool | None = None) -> MavState:
+        """HEARTBEAT.system_status (HEARTBEAT.hpp); pass pre_flight_checks_pass() if you already have it."""
         if self.nav_state == NavState.TERMINATION and self.armed:
             return MavState.FLIGHT_TERMINATION
         if self.armed:
             return MavState.CRITICAL if self.failsafe else MavState.ACTIVE
-        return MavState.STANDBY if self.pre_flight_checks_pass() else MavState.UNINIT
+        if pre_flight_checks_pass is None:
+            pre_flight_checks_pass = self.pre_flight_checks_pass()
+        return MavState.STANDBY if pre_flight_checks_pass else MavState.UNINIT
 
     # ---- texts --------------------------------------------------------------------------------------------------
     def say(self, severity: Severity, text: str, is_event: bool = True, statustext: bool = True,
@@ -223,6 +238,15 @@ class Commander:
         return ok
 
     def _apply_mode(self, now_us: int) -> None:
+        user = self.intention.user_intended
+        armed = self.armed
+        if not armed or (not self.terminated and arming.can_run_now(
+                user, self._ready, self.home is not None, self.offboard_fresh(now_us))):
+            # the common case, decided without allocations: Failsafe.update would return Decision(user, False)
+            self._failsafe.active = False
+            self.nav_state = NavState.TERMINATION if armed and self.nav_state == NavState.TERMINATION else user
+            self.failsafe = False
+            return
         inputs = self.check_inputs(now_us)
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
                                          can_run=lambda m: arming.can_run(m, inputs),
@@ -274,7 +298,7 @@ class Commander:
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
         if (self.armed and not self.landed and self.nav_state == NavState.AUTO_TAKEOFF
-                and self._obs.task_finished):
+                and self._task_finished):
             self.change_mode(NavState.AUTO_LOITER)
 
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:

@@ -13,7 +13,7 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from sitl_emu.flight import tasks
@@ -35,8 +35,11 @@ class ExecutorOutput:
     attitude: AttitudeSetpoint | None
     setpoint_type: str  # "idle" | "position" | "takeoff" | "land" | "offboard" | "none"
     task_finished: bool
-    messages: list[tuple[Severity, str]]
+    messages: Sequence[tuple[Severity, str]]
     want_takeoff: bool | None = None  # the task's vehicle_constraints.want_takeoff; None: from the setpoint
+
+
+_NO_SETPOINT = ExecutorOutput(None, None, "none", False, ())
 
 
 class ModeExecutor:
@@ -52,6 +55,7 @@ class ModeExecutor:
         self._offboard_att: AttitudeSetpoint | None = None
         self._held: ExecutorOutput | None = None  # the last task output, reused until TASK_PERIOD_US has passed
         self._last_us = 0
+        self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -60,22 +64,31 @@ class ModeExecutor:
             self._offboard_traj = trajectory
         if attitude is not None:
             self._offboard_att = attitude
+        self._offboard_out = None
 
     def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
                commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
-        new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
+        mode = self._task_mode  # None exactly when no task runs
+        if commands or self._pending_takeoff is not None or (
+                (not armed or nav_state != mode) if mode is not None else (armed and nav_state in _TASK_MODES)):
+            new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
+        else:
+            new_task = False  # no command and the task (or its absence) still fits: _select_task changes nothing
         if nav_state == NavState.OFFBOARD:
-            return self._offboard_output()
+            out = self._offboard_out
+            if out is None:
+                out = self._offboard_out = self._offboard_output()
+            return out
         if self.task is None:
-            return ExecutorOutput(None, None, "none", False, [])
+            return _NO_SETPOINT
         if not new_task and self._held is not None and now_us - self._last_us < TASK_PERIOD_US:
             return self._held
         dt = dt_s if new_task or self._held is None else (now_us - self._last_us) * 1e-6
         sp = self.task.update(nav_fn(), dt)
         out = ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
                              self.task.want_takeoff)
-        self._held = ExecutorOutput(sp, None, out.setpoint_type, out.task_finished, [], out.want_takeoff)
+        self._held = ExecutorOutput(sp, None, out.setpoint_type, out.task_finished, (), out.want_takeoff)
         self._last_us = now_us
         return out
 
@@ -83,8 +96,8 @@ class ModeExecutor:
         kind = self._offboard_kind
         use_traj = kind is not None and (kind.position or kind.velocity or kind.acceleration)
         if use_traj or self._offboard_att is None:
-            return ExecutorOutput(self._offboard_traj, None, "offboard", False, [])
-        return ExecutorOutput(None, self._offboard_att, "offboard", False, [])
+            return ExecutorOutput(self._offboard_traj, None, "offboard", False, ())
+        return ExecutorOutput(None, self._offboard_att, "offboard", False, ())
 
     # ---- task selection -----------------------------------------------------------------------------------------
     def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], tasks.NavInput],
