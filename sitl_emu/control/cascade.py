@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from math import isfinite
 
 from sitl_emu.control.attitude import AttitudeControl, AttitudeControlSettings
 from sitl_emu.control.hover import HoverThrustEstimator, HoverThrustSettings
@@ -17,7 +18,6 @@ from sitl_emu.control.mixer import mix
 from sitl_emu.control.position import (
     PositionControl,
     PositionControlSettings,
-    PositionLimits,
     PositionOutput,
 )
 from sitl_emu.control.qmath import q_normalized, yaw_from_q
@@ -33,6 +33,7 @@ ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 # mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
 # Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
 POSITION_PERIOD_US = 8000
+_FLIGHT, _RAMPUP = TakeoffState.FLIGHT, TakeoffState.RAMPUP
 
 
 @dataclass(frozen=True, slots=True)
@@ -69,7 +70,10 @@ class MulticopterControl:
     # --- telemetry -------------------------------------------------------------------------------------------
     @property
     def local_setpoint(self) -> TrajectorySetpoint | None:
-        return self._local_setpoint
+        ls = self._local_setpoint
+        if ls is None and self._local_out is not None:  # built on first read after a position-control cycle
+            ls = self._local_setpoint = self._local_out.local_setpoint
+        return ls
 
     @property
     def attitude_setpoint_q_wxyz(self) -> Vec4 | None:
@@ -109,6 +113,7 @@ class MulticopterControl:
         self._hte_in_air = False
         self.rate.reset()
         self._local_setpoint: TrajectorySetpoint | None = None
+        self._local_out: PositionOutput | None = None  # the local setpoint's source, until it is built
         self._q_sp: Vec4 | None = None
         self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
         self._thrust = 0.0
@@ -129,7 +134,8 @@ class MulticopterControl:
         horizontal speed limits and `want_takeoff`; by default want_takeoff is computed from the setpoint as
         MulticopterPositionControl does in offboard (section 4.6): a setpoint above the vehicle, or climbing.
         """
-        self._refresh()
+        if self._registry.version != self._version:
+            self._refresh()
         if not armed:
             return self._disarmed(now_us)
         if self._flying_reset:
@@ -140,13 +146,18 @@ class MulticopterControl:
         if attitude_sp is not None:
             self.takeoff.update_state(armed, landed, False, now_us, skip_takeoff=True)
             q_sp, rates_sp, thrust = self._attitude_mode(state, attitude_sp)
-            self._local_setpoint = None
+            self._local_setpoint = self._local_out = None
         elif setpoint is not None:
             out = self._pos_out
             if out is None or now_us - self._pos_last_us >= POSITION_PERIOD_US - dt_s * 0.5e6:
-                pos_dt = dt_s if out is None else min(0.04, max(0.002, (now_us - self._pos_last_us) * 1e-6))
+                if out is None:
+                    pos_dt = dt_s
+                else:  # min(0.04, max(0.002, elapsed)), min/max as the exactly equivalent conditionals
+                    pos_dt = (now_us - self._pos_last_us) * 1e-6
+                    pos_dt = pos_dt if pos_dt > 0.002 else 0.002
+                    pos_dt = pos_dt if pos_dt < 0.04 else 0.04
                 out = self._position_mode(state, setpoint, landed, ground_contact, now_us, pos_dt,
-                                          (speed_up_m_s, speed_down_m_s, speed_xy_m_s), want_takeoff)
+                                          speed_up_m_s, speed_down_m_s, speed_xy_m_s, want_takeoff)
                 self._pos_out, self._pos_last_us = out, now_us
             q_sp, thrust = out.q_sp, out.collective
             rates_sp = self.attitude.update(state.q_wxyz, q_sp, out.yawspeed_sp_rad_s)
@@ -155,10 +166,6 @@ class MulticopterControl:
             self._idle()
             return ZERO4
         self._q_sp, self._rates_sp, self._thrust = q_sp, rates_sp, thrust
-        return self._rates_to_motors(state, rates_sp, thrust, landed, dt_s)
-
-    def _rates_to_motors(self, state: RigidBodyState, rates_sp: Vec3, thrust: float, landed: bool,
-                         dt_s: float) -> Vec4:
         torque = self.rate.update(state.rates_frd_rad_s, rates_sp, dt_s, landed, self._sat_pos, self._sat_neg)
         motors, self._sat_pos, self._sat_neg = mix(torque, thrust)
         return motors
@@ -173,6 +180,7 @@ class MulticopterControl:
         self.position.reset_integral()
         self.rate.reset()
         self._local_setpoint, self._q_sp, self._rates_sp, self._thrust = None, None, (0.0, 0.0, 0.0), 0.0
+        self._local_out = None
 
     def _attitude_mode(self, state: RigidBodyState, sp: AttitudeSetpoint) -> tuple[Vec4 | None, Vec3, float]:
         thrust = -sp.thrust_body[2] if math.isfinite(sp.thrust_body[2]) else 0.0
@@ -187,31 +195,41 @@ class MulticopterControl:
         return None, rates, thrust
 
     def _position_mode(self, state: RigidBodyState, sp: TrajectorySetpoint, landed: bool, ground_contact: bool,
-                       now_us: int, dt_s: float, speeds: Vec3, want_takeoff: bool | None) -> PositionOutput:
+                       now_us: int, dt_s: float, speed_up: float, speed_dn: float, speed_xy: float,
+                       want_takeoff: bool | None) -> PositionOutput:
+        """One position-control cycle (MulticopterPositionControl::Run). min/max of two floats are written as the
+        exactly equivalent conditionals (min(a, b) is `b if b < a else a`, max(a, b) is `b if b > a else a`)."""
         s = self.settings.position
         if want_takeoff is None:
             want_takeoff = landed and _setpoint_wants_takeoff(sp, state.pos_ned_m[2])
         tko = self.takeoff.update_state(True, landed, want_takeoff, now_us)
-        flying = tko >= TakeoffState.FLIGHT
+        flying = tko >= _FLIGHT
         if not flying:
             sp = _without_acc_z(sp)
             self.position.set_hover_thrust(s.thr_hover)
-        if tko < TakeoffState.RAMPUP or (flying and ground_contact):
+        if tko < _RAMPUP or (flying and ground_contact):
             sp = IDLE_SETPOINT
             self.position.reset_integral()
-        target = s.tilt_max_lnd_rad if tko < TakeoffState.FLIGHT else s.tilt_max_air_rad
+        target = s.tilt_max_lnd_rad if tko < _FLIGHT else s.tilt_max_air_rad
         step = TILT_SLEW_RAD_S * dt_s
-        self._tilt_limit = max(self._tilt_limit - step, min(self._tilt_limit + step, target))
-        up, dn, xy = (v if math.isfinite(v) else d for v, d in zip(speeds, (s.vel_max_up, s.vel_max_dn, s.vel_max_xy),
-                                                                    strict=True))
-        limits = PositionLimits(vel_xy=min(max(xy, 0.0), s.vel_max_xy),
-                                vel_up=min(self.takeoff.update_ramp(dt_s, min(up, s.vel_max_up)), s.vel_max_up),
-                                vel_dn=max(dn, 0.0), tilt_rad=self._tilt_limit,
-                                thr_min=s.thr_min if flying else 0.0, thr_max=s.thr_max)
+        tilt = self._tilt_limit
+        hi, lo = tilt + step, tilt - step
+        tilt = target if target < hi else hi  # min(tilt + step, target)
+        tilt = self._tilt_limit = tilt if tilt > lo else lo  # max(tilt - step, ...)
+        v_up, v_dn, v_xy = s.vel_max_up, s.vel_max_dn, s.vel_max_xy
+        up = speed_up if isfinite(speed_up) else v_up
+        dn = speed_dn if isfinite(speed_dn) else v_dn
+        xy = speed_xy if isfinite(speed_xy) else v_xy
+        xy = 0.0 if xy < 0.0 else xy  # max(xy, 0)
+        vel_xy = v_xy if v_xy < xy else xy  # min(..., MPC_XY_VEL_MAX)
+        ramp = self.takeoff.update_ramp(dt_s, v_up if v_up < up else up)
+        vel_up = v_up if v_up < ramp else ramp
+        vel_dn = 0.0 if dn < 0.0 else dn
         yaw = yaw_from_q(state.q_wxyz)
-        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw, sp, limits, dt_s, now_us)
+        out = self.position.update_with(state.pos_ned_m, state.vel_ned_m_s, yaw, sp, dt_s, now_us, vel_xy, vel_up,
+                                        vel_dn, tilt, s.thr_min if flying else 0.0, s.thr_max)
         self._in_failsafe = out.in_failsafe
-        self._local_setpoint = out.local_setpoint
+        self._local_setpoint, self._local_out = None, out
         self._update_hover_thrust(state, out, landed, dt_s, now_us)
         return out
 
@@ -227,7 +245,7 @@ class MulticopterControl:
             return
         valid = self.hte.update(-out.thrust_ned[2], -state.acc_ned_m_s2[2], state.vel_ned_m_s, dt_s, now_us)
         if valid and self.settings.position.use_hte:
-            self.position.update_hover_thrust(self.hte.estimate, out.local_setpoint.acceleration_ned_m_s2[2])
+            self.position.update_hover_thrust(self.hte.estimate, out.acceleration_sp_ned_m_s2[2])
 
     def _refresh(self) -> None:
         if self._registry.version == self._version:

@@ -14,14 +14,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from math import acos, cos, hypot, isfinite, sin, sqrt
+from typing import NamedTuple
 
-from sitl_emu.control.qmath import constrain, cross, normalized, q_from_dcm_columns
+from sitl_emu.control.qmath import constrain, normalized, q_from_dcm_columns
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import NAN, NAN3, TrajectorySetpoint, Vec3, Vec4
 
 G = 9.80665  # CONSTANTS_ONE_G
 INVALID_HOLD_US = 200_000  # MulticopterPositionControl LOITER_TIME_BEFORE_DESCEND hysteresis
-_isfinite = math.isfinite
+_TWO_PI = 2.0 * math.pi  # (2 pi) fc dt, multiplied left to right as before
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,24 +73,36 @@ class PositionLimits:
     thr_max: float = 1.0
 
 
-@dataclass(frozen=True, slots=True)
-class PositionOutput:
+class PositionOutput(NamedTuple):
+    """One position-control cycle's result (a NamedTuple: built on every cycle, so it must be cheap)."""
+
     thrust_ned: Vec3  # normalised thrust vector (z < 0 is up)
     q_sp: Vec4
     collective: float  # |thrust|, 0..1
     yaw_sp_rad: float
     yawspeed_sp_rad_s: float
-    local_setpoint: TrajectorySetpoint  # what the controller used, incl. P-corrections (POSITION_TARGET_LOCAL_NED)
     in_failsafe: bool
+    position_sp_ned_m: Vec3  # the position setpoint used
+    velocity_sp_ned_m_s: Vec3  # incl. the P-correction
+    acceleration_sp_ned_m_s2: Vec3
+
+    @property
+    def local_setpoint(self) -> TrajectorySetpoint:
+        """What the controller used, incl. P-corrections (POSITION_TARGET_LOCAL_NED); built on demand."""
+        return TrajectorySetpoint(self.position_sp_ned_m, self.velocity_sp_ned_m_s, self.acceleration_sp_ned_m_s2,
+                                  self.yaw_sp_rad, self.yawspeed_sp_rad_s)
 
 
 def input_valid(sp: TrajectorySetpoint) -> bool:
     """PX4 PositionControl::_inputValid (the estimate is always valid here)."""
-    p, v, a = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
-    for i in range(3):
-        if not (_isfinite(p[i]) or _isfinite(v[i]) or _isfinite(a[i])):
-            return False
-    return all(_isfinite(k[0]) == _isfinite(k[1]) for k in (p, v, a))
+    p0, p1, p2 = sp.position_ned_m
+    v0, v1, v2 = sp.velocity_ned_m_s
+    a0, a1, a2 = sp.acceleration_ned_m_s2
+    fp0, fv0, fa0 = isfinite(p0), isfinite(v0), isfinite(a0)
+    fp1, fv1, fa1 = isfinite(p1), isfinite(v1), isfinite(a1)
+    if not (fp0 or fv0 or fa0) or not (fp1 or fv1 or fa1) or not (isfinite(p2) or isfinite(v2) or isfinite(a2)):
+        return False
+    return fp0 == fp1 and fv0 == fv1 and fa0 == fa1
 
 
 def failsafe_setpoint() -> TrajectorySetpoint:
@@ -96,58 +110,57 @@ def failsafe_setpoint() -> TrajectorySetpoint:
     return TrajectorySetpoint(velocity_ned_m_s=(0.0, 0.0, 0.0))
 
 
-def _add_if_not_nan(sp: float, add: float) -> float:
-    """ControlMath::addIfNotNan."""
-    if _isfinite(sp):
-        return sp + add if _isfinite(add) else sp
-    return add
-
-
 def constrain_xy(v0x: float, v0y: float, v1x: float, v1y: float, vmax: float) -> tuple[float, float]:
     """ControlMath::constrainXY: limit |v0 + v1| to vmax, keeping as much of v0 as possible."""
     sx, sy = v0x + v1x, v0y + v1y
-    if math.hypot(sx, sy) <= vmax:
+    if hypot(sx, sy) <= vmax:
         return sx, sy
-    n0 = math.hypot(v0x, v0y)
+    n0 = hypot(v0x, v0y)
     if n0 >= vmax:
         return (v0x / n0 * vmax, v0y / n0 * vmax) if n0 > 0.0 else (0.0, 0.0)
-    if math.hypot(v1x - v0x, v1y - v0y) < 0.001:
+    if hypot(v1x - v0x, v1y - v0y) < 0.001:
         return v0x / n0 * vmax, v0y / n0 * vmax
-    n1 = math.hypot(v1x, v1y)
+    n1 = hypot(v1x, v1y)
     if n0 < 0.001:
         return v1x / n1 * vmax, v1y / n1 * vmax
     ux, uy = v1x / n1, v1y / n1
     m = ux * v0x + uy * v0y
     c = v0x * v0x + v0y * v0y - vmax * vmax
-    s = -m + math.sqrt(m * m - c)
+    s = -m + sqrt(m * m - c)
     return v0x + ux * s, v0y + uy * s
 
 
 def limit_tilt(bz: Vec3, max_angle_rad: float) -> Vec3:
     """ControlMath::limitTilt against the world z axis (0, 0, 1)."""
     d = constrain(bz[2], -1.0, 1.0)
-    angle = min(math.acos(d), max_angle_rad)
+    angle = acos(d)
+    angle = max_angle_rad if max_angle_rad < angle else angle  # min(acos(d), max_angle_rad)
     rx, ry = bz[0], bz[1]
-    rn = math.hypot(rx, ry)
+    rn = hypot(rx, ry)
     if rn * rn < 1.2e-7:  # FLT_EPSILON
         rx, ry, rn = 1.0, 0.0, 1.0
-    s = math.sin(angle)
-    return s * rx / rn, s * ry / rn, math.cos(angle)
+    s = sin(angle)
+    return s * rx / rn, s * ry / rn, cos(angle)
 
 
 def bodyz_to_attitude(bz: Vec3, yaw_rad: float) -> Vec4:
-    """ControlMath::bodyzToAttitude: attitude with body z along bz (world frame) and the given heading."""
-    if bz[0] * bz[0] + bz[1] * bz[1] + bz[2] * bz[2] < 1.2e-7:
-        bz = (0.0, 0.0, 1.0)
-    bz = normalized(bz)
-    y_c = (-math.sin(yaw_rad), math.cos(yaw_rad), 0.0)
-    bx = cross(y_c, bz)
-    if bz[2] < 0.0:
-        bx = (-bx[0], -bx[1], -bx[2])
-    if abs(bz[2]) < 1e-6:
-        bx = (0.0, 0.0, 1.0)
-    bx = normalized(bx)
-    return q_from_dcm_columns(bx, cross(bz, bx), bz)
+    """ControlMath::bodyzToAttitude: attitude with body z along bz (world frame) and the given heading.
+
+    Written on scalars (qmath's normalized and cross inlined in their operation order, zero components kept)."""
+    z0, z1, z2 = bz
+    if z0 * z0 + z1 * z1 + z2 * z2 < 1.2e-7:
+        z0, z1, z2 = 0.0, 0.0, 1.0
+    n = sqrt(z0 * z0 + z1 * z1 + z2 * z2)
+    z0, z1, z2 = (z0 / n, z1 / n, z2 / n) if n > 0.0 else (0.0, 0.0, 0.0)
+    y0, y1, y2 = -sin(yaw_rad), cos(yaw_rad), 0.0
+    x0, x1, x2 = y1 * z2 - y2 * z1, y2 * z0 - y0 * z2, y0 * z1 - y1 * z0  # cross(y_c, bz)
+    if z2 < 0.0:
+        x0, x1, x2 = -x0, -x1, -x2
+    if abs(z2) < 1e-6:
+        x0, x1, x2 = 0.0, 0.0, 1.0
+    n = sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+    x0, x1, x2 = (x0 / n, x1 / n, x2 / n) if n > 0.0 else (0.0, 0.0, 0.0)
+    return q_from_dcm_columns((x0, x1, x2), (z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0), (z0, z1, z2))
 
 
 class VelocityDerivative:
@@ -165,10 +178,13 @@ class VelocityDerivative:
         if self._prev is None or dt_s <= 0.0:
             self._prev = vel
             return self._out
-        b = 2.0 * math.pi * cutoff_hz * dt_s
+        b = _TWO_PI * cutoff_hz * dt_s
         a = b / (1.0 + b) if cutoff_hz > 0.0 else 1.0
-        o, p = self._out, self._prev
-        self._out = tuple(o[i] + a * ((vel[i] - p[i]) / dt_s - o[i]) for i in range(3))  # type: ignore[assignment]
+        o0, o1, o2 = self._out
+        p0, p1, p2 = self._prev
+        v0, v1, v2 = vel
+        self._out = (o0 + a * ((v0 - p0) / dt_s - o0), o1 + a * ((v1 - p1) / dt_s - o1),
+                     o2 + a * ((v2 - p2) / dt_s - o2))
         self._prev = vel
         return self._out
 
@@ -204,7 +220,7 @@ class PositionControl:
 
     def select_setpoint(self, sp: TrajectorySetpoint, now_us: int) -> tuple[TrajectorySetpoint, bool]:
         """The setpoint to fly: sp if valid, else the last valid one for 200 ms, else the failsafe setpoint."""
-        if input_valid(sp):
+        if sp is self._last_valid or input_valid(sp):  # the last valid setpoint (immutable) is still valid
             self._last_valid, self._invalid_since_us = sp, None
             return sp, False
         if self._invalid_since_us is None:
@@ -215,67 +231,100 @@ class PositionControl:
 
     def update(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, limits: PositionLimits,
                dt_s: float, now_us: int) -> PositionOutput:
+        return self.update_with(pos, vel, yaw_rad, sp, dt_s, now_us, limits.vel_xy, limits.vel_up, limits.vel_dn,
+                                limits.tilt_rad, limits.thr_min, limits.thr_max)
+
+    def update_with(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, dt_s: float, now_us: int,
+                    vel_xy: float, vel_up: float, vel_dn: float, tilt_rad: float, thr_min: float,
+                    thr_max: float) -> PositionOutput:
+        """`update` with the PositionLimits fields passed as floats (the cascade's path: no limits object)."""
         vel_dot = self._deriv.update(vel, dt_s, self.settings.veld_lp_hz)
         sp, in_failsafe = self.select_setpoint(sp, now_us)
-        vel_sp = self._position_control(pos, sp, limits)
-        acc_sp, thr = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, limits, dt_s)
-        yaw_sp = sp.yaw_rad if _isfinite(sp.yaw_rad) else yaw_rad
-        yawspeed = sp.yawspeed_rad_s if _isfinite(sp.yawspeed_rad_s) else 0.0
-        collective = math.sqrt(thr[0] * thr[0] + thr[1] * thr[1] + thr[2] * thr[2])
-        q_sp = bodyz_to_attitude((-thr[0], -thr[1], -thr[2]), yaw_sp)
-        local = TrajectorySetpoint(sp.position_ned_m, vel_sp, acc_sp, yaw_sp, yawspeed)
-        return PositionOutput(thr, q_sp, collective, yaw_sp, yawspeed, local, in_failsafe)
+        vel_sp = self._position_control(pos, sp, vel_xy, vel_up, vel_dn)
+        acc_sp, thr = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, tilt_rad, thr_min,
+                                             thr_max, dt_s)
+        yaw_sp = sp.yaw_rad if isfinite(sp.yaw_rad) else yaw_rad
+        yawspeed = sp.yawspeed_rad_s if isfinite(sp.yawspeed_rad_s) else 0.0
+        t0, t1, t2 = thr
+        collective = sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        q_sp = bodyz_to_attitude((-t0, -t1, -t2), yaw_sp)
+        return PositionOutput(thr, q_sp, collective, yaw_sp, yawspeed, in_failsafe, sp.position_ned_m, vel_sp, acc_sp)
 
-    def _position_control(self, pos: Vec3, sp: TrajectorySetpoint, lim: PositionLimits) -> Vec3:
-        kp = self.settings.pos_p
-        psp, vff = sp.position_ned_m, sp.velocity_ned_m_s
-        vpos = [(psp[i] - pos[i]) * kp[i] for i in range(3)]  # NaN where not controlled
-        vsp = [_add_if_not_nan(vff[i], vpos[i]) for i in range(3)]
-        vpos = [v if _isfinite(v) else 0.0 for v in vpos]
-        vx, vy = constrain_xy(vpos[0], vpos[1], vsp[0] - vpos[0], vsp[1] - vpos[1], lim.vel_xy)
-        return vx, vy, constrain(vsp[2], -lim.vel_up, lim.vel_dn)
+    def _position_control(self, pos: Vec3, sp: TrajectorySetpoint, vel_xy: float, vel_up: float,
+                          vel_dn: float) -> Vec3:
+        k0, k1, k2 = self.settings.pos_p
+        p0, p1, p2 = sp.position_ned_m
+        f0, f1, f2 = sp.velocity_ned_m_s
+        x0, x1, x2 = pos
+        v0, v1, v2 = (p0 - x0) * k0, (p1 - x1) * k1, (p2 - x2) * k2  # NaN where not controlled
+        # ControlMath::addIfNotNan(feed-forward, P term)
+        s0 = (f0 + v0 if isfinite(v0) else f0) if isfinite(f0) else v0
+        s1 = (f1 + v1 if isfinite(v1) else f1) if isfinite(f1) else v1
+        s2 = (f2 + v2 if isfinite(v2) else f2) if isfinite(f2) else v2
+        v0 = v0 if isfinite(v0) else 0.0
+        v1 = v1 if isfinite(v1) else 0.0
+        vx, vy = constrain_xy(v0, v1, s0 - v0, s1 - v1, vel_xy)
+        lo = -vel_up
+        return vx, vy, lo if s2 < lo else (vel_dn if s2 > vel_dn else s2)
 
-    def _velocity_control(self, vel: Vec3, vel_dot: Vec3, vel_sp: Vec3, acc_ff: Vec3, lim: PositionLimits,
-                          dt_s: float) -> tuple[Vec3, Vec3]:
+    def _velocity_control(self, vel: Vec3, vel_dot: Vec3, vel_sp: Vec3, acc_ff: Vec3, tilt_rad: float,
+                          thr_min: float, thr_max: float, dt_s: float) -> tuple[Vec3, Vec3]:
+        """Velocity PID -> acceleration -> thrust, with the anti-windups; flat on scalars (the hot path)."""
         s = self.settings
-        err = [vel_sp[i] - vel[i] for i in range(3)]
-        acc = tuple(_add_if_not_nan(acc_ff[i], err[i] * s.vel_p[i] + self._vel_int[i] - vel_dot[i] * s.vel_d[i])
-                    for i in range(3))
-        thr = self._acceleration_control(acc, lim)  # type: ignore[arg-type]
-        thr_min = max(lim.thr_min, 10e-4)
-        if (thr[2] >= -thr_min and err[2] >= 0.0) or (thr[2] <= -lim.thr_max and err[2] <= 0.0):
-            err[2] = 0.0  # vertical anti-windup
-        thr = self._saturate_thrust(thr, lim.thr_max)
-        # horizontal tracking anti-windup: feed back the part of the demand the thrust could not produce
-        k = G / self.hover_thrust
-        prod_x, prod_y = thr[0] * k, thr[1] * k
-        if acc[0] * acc[0] + acc[1] * acc[1] > prod_x * prod_x + prod_y * prod_y:
-            arw = 2.0 / s.vel_p[0]
-            err[0] -= arw * (acc[0] - prod_x)
-            err[1] -= arw * (acc[1] - prod_y)
-        for i in range(3):
-            if _isfinite(err[i]):
-                self._vel_int[i] += err[i] * s.vel_i[i] * dt_s
-        self._vel_int[2] = constrain(self._vel_int[2], -G, G)
-        return acc, thr  # type: ignore[return-value]
-
-    def _acceleration_control(self, acc: Vec3, lim: PositionLimits) -> Vec3:
-        bz = limit_tilt(normalized((-acc[0], -acc[1], G)), lim.tilt_rad)
+        kp0, kp1, kp2 = s.vel_p
+        kd0, kd1, kd2 = s.vel_d
+        integ = self._vel_int
+        e0, e1, e2 = vel_sp[0] - vel[0], vel_sp[1] - vel[1], vel_sp[2] - vel[2]
+        f0, f1, f2 = acc_ff
+        a0 = e0 * kp0 + integ[0] - vel_dot[0] * kd0
+        a1 = e1 * kp1 + integ[1] - vel_dot[1] * kd1
+        a2 = e2 * kp2 + integ[2] - vel_dot[2] * kd2
+        a0 = (f0 + a0 if isfinite(a0) else f0) if isfinite(f0) else a0  # addIfNotNan(feed-forward, PID)
+        a1 = (f1 + a1 if isfinite(a1) else f1) if isfinite(f1) else a1
+        a2 = (f2 + a2 if isfinite(a2) else f2) if isfinite(f2) else a2
+        # acceleration -> thrust: tilt-limited body z, collective from the hover thrust, at least the minimum
+        z0, z1, z2 = limit_tilt(normalized((-a0, -a1, G)), tilt_rad)
         h = self.hover_thrust
-        collective = (acc[2] * (h / G) - h) / bz[2]
-        collective = min(collective, -max(lim.thr_min, 10e-4))
-        return bz[0] * collective, bz[1] * collective, bz[2] * collective
+        c = (a2 * (h / G) - h) / z2
+        tmin = 10e-4 if thr_min < 10e-4 else thr_min  # max(thr_min, 10e-4)
+        c = -tmin if -tmin < c else c  # min(c, -tmin)
+        t0, t1, t2 = z0 * c, z1 * c, z2 * c
+        if (t2 >= -tmin and e2 >= 0.0) or (t2 <= -thr_max and e2 <= 0.0):
+            e2 = 0.0  # vertical anti-windup
+        t0, t1, t2 = self._saturate_thrust(t0, t1, t2, thr_max)
+        # horizontal tracking anti-windup: feed back the part of the demand the thrust could not produce
+        k = G / h
+        prod_x, prod_y = t0 * k, t1 * k
+        if a0 * a0 + a1 * a1 > prod_x * prod_x + prod_y * prod_y:
+            arw = 2.0 / kp0
+            e0 -= arw * (a0 - prod_x)
+            e1 -= arw * (a1 - prod_y)
+        ki0, ki1, ki2 = s.vel_i
+        if isfinite(e0):
+            integ[0] += e0 * ki0 * dt_s
+        if isfinite(e1):
+            integ[1] += e1 * ki1 * dt_s
+        if isfinite(e2):
+            integ[2] += e2 * ki2 * dt_s
+        i2 = integ[2]
+        integ[2] = -G if i2 < -G else (G if i2 > G else i2)
+        return (a0, a1, a2), (t0, t1, t2)
 
-    def _saturate_thrust(self, thr: Vec3, thr_max: float) -> Vec3:
-        """Prioritise vertical thrust but keep MPC_THR_XY_MARG for horizontal control."""
-        xy = math.hypot(thr[0], thr[1])
+    def _saturate_thrust(self, t0: float, t1: float, t2: float, thr_max: float) -> Vec3:
+        """Prioritise vertical thrust but keep MPC_THR_XY_MARG for horizontal control (min/max as exact
+        conditionals: min(a, b) is `b if b < a else a`)."""
+        xy = hypot(t0, t1)
         tmax2 = thr_max * thr_max
-        allocated_xy = min(xy, self.settings.thr_xy_margin)
-        tz = max(thr[2], -math.sqrt(max(tmax2 - allocated_xy * allocated_xy, 0.0)))
-        xy_max = math.sqrt(max(tmax2 - tz * tz, 0.0))
+        margin = self.settings.thr_xy_margin
+        allocated_xy = margin if margin < xy else xy
+        rem = tmax2 - allocated_xy * allocated_xy
+        lo = -sqrt(0.0 if rem < 0.0 else rem)  # -sqrt(max(rem, 0))
+        tz = lo if lo > t2 else t2  # max(t2, lo)
+        rem = tmax2 - tz * tz
+        xy_max = sqrt(0.0 if rem < 0.0 else rem)
         if xy > xy_max:
-            return thr[0] / xy * xy_max, thr[1] / xy * xy_max, tz
-        return thr[0], thr[1], tz
+            return t0 / xy * xy_max, t1 / xy * xy_max, tz
+        return t0, t1, tz
 
 
 __all__ = ["NAN", "NAN3", "PositionControl", "PositionControlSettings", "PositionLimits", "PositionOutput"]

@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from math import isfinite
 
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 
 DGYRO_CUTOFF_HZ = 30.0  # IMU_DGYRO_CUTOFF default
 _I_FACTOR_RATE = math.radians(400.0)
+_DGYRO_W = 2.0 * math.pi * DGYRO_CUTOFF_HZ  # the (2 pi fc) of the derivative low-pass; `* dt` comes after, as before
+_NO_SAT = (False, False, False)
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,48 +61,66 @@ class RateControl:
         self._yaw_torque = 0.0
 
     @property
+    def settings(self) -> RateControlSettings:
+        return self._settings
+
+    @settings.setter
+    def settings(self, s: RateControlSettings) -> None:
+        self._settings = s
+        self._yaw_tau_s = 1.0 / (2.0 * math.pi * s.yaw_tq_cutoff_hz) if s.yaw_tq_cutoff_hz > 0.0 else 0.0
+
+    @property
     def integrator(self) -> Vec3:
         return self._int[0], self._int[1], self._int[2]
 
     def update(self, rates: Vec3, rates_sp: Vec3, dt_s: float, landed: bool,
-               sat_pos: tuple[bool, bool, bool] = (False, False, False),
-               sat_neg: tuple[bool, bool, bool] = (False, False, False)) -> Vec3:
-        """Normalised torque (roll, pitch, yaw) for the mixer."""
-        s = self.settings
-        a0, a1, a2 = self._angular_accel(rates, dt_s)
+               sat_pos: tuple[bool, bool, bool] = _NO_SAT, sat_neg: tuple[bool, bool, bool] = _NO_SAT) -> Vec3:
+        """Normalised torque (roll, pitch, yaw) for the mixer.
+
+        Runs every physics tick, so the gyro derivative and the integrator are inlined here on scalars (same
+        operation order as the plain formulas in the docstrings of this module; min/max written as the exactly
+        equivalent conditional expressions).
+        """
+        s = self._settings
+        w0, w1, w2 = rates
+        prev, self._prev_rates = self._prev_rates, rates
+        acc = self._accel
+        if prev is not None and dt_s > 0.0:  # gyro derivative through the IMU_DGYRO_CUTOFF low-pass
+            b = _DGYRO_W * dt_s
+            a = b / (1.0 + b)
+            a0, a1, a2 = acc
+            acc = self._accel = [a0 + a * ((w0 - prev[0]) / dt_s - a0), a1 + a * ((w1 - prev[1]) / dt_s - a1),
+                                 a2 + a * ((w2 - prev[2]) / dt_s - a2)]
+        a0, a1, a2 = acc
         p, i, d, ff = s.gain_p, self._int, s.gain_d, s.gain_ff
-        e0, e1, e2 = rates_sp[0] - rates[0], rates_sp[1] - rates[1], rates_sp[2] - rates[2]
-        tr = p[0] * e0 + i[0] - d[0] * a0 + ff[0] * rates_sp[0]
-        tp = p[1] * e1 + i[1] - d[1] * a1 + ff[1] * rates_sp[1]
-        ty = p[2] * e2 + i[2] - d[2] * a2 + ff[2] * rates_sp[2]
+        sp0, sp1, sp2 = rates_sp
+        e0, e1, e2 = sp0 - w0, sp1 - w1, sp2 - w2
+        tr = p[0] * e0 + i[0] - d[0] * a0 + ff[0] * sp0
+        tp = p[1] * e1 + i[1] - d[1] * a1 + ff[1] * sp1
+        ty = p[2] * e2 + i[2] - d[2] * a2 + ff[2] * sp2
         if not landed:
-            self._update_integral([e0, e1, e2], dt_s, sat_pos, sat_neg)
+            self._integrate(e0, e1, e2, dt_s, sat_pos, sat_neg)
         if s.yaw_tq_cutoff_hz > 0.0 and dt_s > 0.0:  # AlphaFilter: alpha = dt / (dt + 1 / (2 pi fc))
-            alpha = dt_s / (dt_s + 1.0 / (2.0 * math.pi * s.yaw_tq_cutoff_hz))
+            alpha = dt_s / (dt_s + self._yaw_tau_s)
             self._yaw_torque += alpha * (ty - self._yaw_torque)
             ty = self._yaw_torque
         return tr, tp, ty
 
-    def _angular_accel(self, rates: Vec3, dt_s: float) -> list[float]:
-        prev, self._prev_rates = self._prev_rates, rates
-        if prev is None or dt_s <= 0.0:
-            return self._accel
-        b = 2.0 * math.pi * DGYRO_CUTOFF_HZ * dt_s
-        a = b / (1.0 + b)
-        self._accel = [self._accel[i] + a * ((rates[i] - prev[i]) / dt_s - self._accel[i]) for i in range(3)]
-        return self._accel
-
-    def _update_integral(self, err: list[float], dt_s: float, sat_pos: tuple[bool, bool, bool],
-                         sat_neg: tuple[bool, bool, bool]) -> None:
-        s = self.settings
-        for i in range(3):
-            e = err[i]
-            if sat_pos[i]:
-                e = min(e, 0.0)
-            if sat_neg[i]:
-                e = max(e, 0.0)
+    def _integrate(self, e0: float, e1: float, e2: float, dt_s: float, sat_pos: tuple[bool, bool, bool],
+                   sat_neg: tuple[bool, bool, bool]) -> None:
+        """The integrator of the three axes (see the module docstring); min(e, 0) is `0 if e > 0 else e` exactly."""
+        s = self._settings
+        gi, lim, integ = s.gain_i, s.int_lim, self._int
+        for k, e in ((0, e0), (1, e1), (2, e2)):
+            if sat_pos[k]:
+                e = 0.0 if e > 0.0 else e
+            if sat_neg[k]:
+                e = 0.0 if e < 0.0 else e
             f = e / _I_FACTOR_RATE
-            i_factor = max(0.0, 1.0 - f * f)
-            v = self._int[i] + i_factor * s.gain_i[i] * e * dt_s
-            if math.isfinite(v):
-                self._int[i] = max(-s.int_lim[i], min(s.int_lim[i], v))
+            i_factor = 1.0 - f * f
+            i_factor = i_factor if i_factor > 0.0 else 0.0  # max(0.0, 1 - f^2)
+            v = integ[k] + i_factor * gi[k] * e * dt_s
+            if isfinite(v):
+                hi = lim[k]
+                v = v if v < hi else hi  # min(hi, v) is `v if v < hi else hi`
+                integ[k] = v if v > -hi else -hi  # max(-hi, v)
