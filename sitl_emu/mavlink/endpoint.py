@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.mavlink.commands import CommandHandler
+from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.telemetry import StreamMode, Streams
@@ -104,7 +105,10 @@ class Endpoint:
         self.node = node
         self.sysid = node.sysid
         self.compid = COMPID
+        # pymavlink's encoder: handlers build messages with it; its `seq` is this link's sequence number, which
+        # send() continues (one sequence per link, whichever way a message was built)
         self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
+        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/fastpack.py): same calls, cheaper messages
         self._parser = _new_parser()
         self.stats = EndpointStats()
         self.streams = Streams(mode)
@@ -131,12 +135,17 @@ class Endpoint:
         return self._now_us
 
     def send(self, msg: Any) -> None:
+        """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
+        mav = self.mav
         try:
-            self.mav.send(msg)
+            data = frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent)
         except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
             self.stats.tx_pack_errors += 1
             if self.stats.tx_pack_errors == 1:
                 log.error("%s link: cannot send %s: %s", self.link_name, msg.get_type(), err)
+            return
+        self.link.send(data)
+        mav.seq = (mav.seq + 1) % 256
 
     def broadcast(self, msg: Any) -> None:
         self.node.broadcast(msg)

@@ -172,7 +172,7 @@ class Streams:
             if not ev.statustext or ctx.now_us - ev.time_us > STATUSTEXT_MAX_AGE_US:
                 continue
             for chunk_seq, chunk in enumerate(statustext_chunks(ev.statustext_text)):
-                ctx.send(ctx.mav.statustext_encode(int(ev.severity), chunk, self._statustext_id, chunk_seq))
+                ctx.send(ctx.encoder.statustext_encode(int(ev.severity), chunk, self._statustext_id, chunk_seq))
             self._statustext_id = (self._statustext_id + 1) & 0xFFFF
 
 

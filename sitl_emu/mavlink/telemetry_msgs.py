@@ -69,7 +69,7 @@ def system_status(snap: VehicleSnapshot) -> int:
 
 
 def heartbeat(ctx: Any, snap: VehicleSnapshot) -> Any:
-    return ctx.mav.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
+    return ctx.encoder.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
                                     px4.custom_mode(snap.nav_state), system_status(snap), 3)
 
 
@@ -83,30 +83,30 @@ def sys_status(ctx: Any, snap: VehicleSnapshot) -> Any:
     enabled = _PRESENT | (_PRESENT & ~health)
     voltage_mv = int(min(max(snap.battery_voltage_v * 1000.0, 0.0), UINT16_MAX - 1))
     remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
-    return ctx.mav.sys_status_encode(_PRESENT | S_PREARM_CHECK, enabled | S_PREARM_CHECK, health, 0, voltage_mv, -1,
+    return ctx.encoder.sys_status_encode(_PRESENT | S_PREARM_CHECK, enabled | S_PREARM_CHECK, health, 0, voltage_mv, -1,
                                      remaining, 0, 0, 0, 0, 0, 0)
 
 
 def extended_sys_state(ctx: Any, snap: VehicleSnapshot) -> Any:
-    return ctx.mav.extended_sys_state_encode(0, int(snap.landed_state))
+    return ctx.encoder.extended_sys_state_encode(0, int(snap.landed_state))
 
 
 def attitude(ctx: Any, snap: VehicleSnapshot) -> Any:
     r, p, y = snap.euler_rad
     wx, wy, wz = snap.rates_frd_rad_s
-    return ctx.mav.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
+    return ctx.encoder.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
 
 
 def attitude_quaternion(ctx: Any, snap: VehicleSnapshot) -> Any:
     w, x, y, z = snap.q_wxyz
     wx, wy, wz = snap.rates_frd_rad_s
-    return ctx.mav.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
+    return ctx.encoder.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
 
 
 def local_position_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
     x, y, z = snap.pos_ned_m
     vx, vy, vz = snap.vel_ned_m_s
-    return ctx.mav.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
+    return ctx.encoder.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
 
 
 def global_position_int(ctx: Any, snap: VehicleSnapshot) -> Any:
@@ -116,7 +116,7 @@ def global_position_int(ctx: Any, snap: VehicleSnapshot) -> Any:
     vx, vy, vz = snap.vel_ned_m_s
     rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else snap.alt_amsl_m
     hdg_cdeg = _iround(math.degrees(_wrap_2pi(snap.euler_rad[2])) * 100.0) % 36000
-    return ctx.mav.global_position_int_encode(
+    return ctx.encoder.global_position_int_encode(
         _ms(snap), _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m), _mm(rel_m),
         _cm_s(vx), _cm_s(vy), _cm_s(vz), hdg_cdeg)
 
@@ -135,7 +135,7 @@ def position_target_local_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
         mask |= 1024
     if not math.isfinite(sp.yawspeed_rad_s):
         mask |= 2048
-    return ctx.mav.position_target_local_ned_encode(_ms(snap), MAV_FRAME_LOCAL_NED, mask, *values, sp.yaw_rad,
+    return ctx.encoder.position_target_local_ned_encode(_ms(snap), MAV_FRAME_LOCAL_NED, mask, *values, sp.yaw_rad,
                                                     sp.yawspeed_rad_s)
 
 
@@ -144,7 +144,7 @@ def attitude_target(ctx: Any, snap: VehicleSnapshot) -> Any:
     if q is None:
         return None
     wx, wy, wz = snap.rates_setpoint_rad_s
-    return ctx.mav.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
+    return ctx.encoder.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
 
 
 def home_position(ctx: Any, snap: VehicleSnapshot) -> Any:
@@ -155,7 +155,7 @@ def home_position(ctx: Any, snap: VehicleSnapshot) -> Any:
     half = home.yaw_rad / 2.0 if math.isfinite(home.yaw_rad) else NAN
     q = (math.cos(half), 0.0, 0.0, math.sin(half))
     x, y, z = home.pos_ned_m
-    return ctx.mav.home_position_encode(_e7(home.lat_deg), _e7(home.lon_deg), _mm(home.alt_amsl_m), x, y, z, q,
+    return ctx.encoder.home_position_encode(_e7(home.lat_deg), _e7(home.lon_deg), _mm(home.alt_amsl_m), x, y, z, q,
                                         0.0, 0.0, 0.0, snap.time_us)
 
 
@@ -164,7 +164,7 @@ def gps_raw_int(ctx: Any, snap: VehicleSnapshot) -> Any:
     vn, ve, _ = snap.vel_ned_m_s
     vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
     cog = _iround(math.degrees(_wrap_2pi(math.atan2(ve, vn))) * 100.0) % 36000 if vel_cm_s > 0 else 0
-    return ctx.mav.gps_raw_int_encode(snap.time_us, 3, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
+    return ctx.encoder.gps_raw_int_encode(snap.time_us, 3, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
                                       50, 80, vel_cm_s, cog, 10, _mm(snap.alt_amsl_m), 500, 800, 200, 0, 0)
 
 
@@ -173,7 +173,7 @@ def battery_status(ctx: Any, snap: VehicleSnapshot) -> Any:
     cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
     voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
     remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
-    return ctx.mav.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, 1, [0, 0, 0, 0],
+    return ctx.encoder.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, 1, [0, 0, 0, 0],
                                          0, 0)
 
 
@@ -182,13 +182,13 @@ def vfr_hud(ctx: Any, snap: VehicleSnapshot) -> Any:
     vn, ve, vd = snap.vel_ned_m_s
     heading_deg = int(math.degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
     throttle = _iround(min(max(snap.thrust_setpoint, 0.0), 1.0) * 100.0) if snap.armed else 0
-    return ctx.mav.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
+    return ctx.encoder.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
 
 
 def altitude(ctx: Any, snap: VehicleSnapshot) -> Any:
     rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else NAN
     local_m = -snap.pos_ned_m[2]
-    return ctx.mav.altitude_encode(snap.time_us, snap.alt_amsl_m, snap.alt_amsl_m, local_m, rel_m, NAN,
+    return ctx.encoder.altitude_encode(snap.time_us, snap.alt_amsl_m, snap.alt_amsl_m, local_m, rel_m, NAN,
                                    max(local_m, 0.0))
 
 
@@ -196,23 +196,23 @@ def odometry(ctx: Any, snap: VehicleSnapshot) -> Any:
     """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
     v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
     cov = [NAN] + [0.0] * 20
-    return ctx.mav.odometry_encode(snap.time_us, MAV_FRAME_LOCAL_NED, MAV_FRAME_BODY_FRD, *snap.pos_ned_m,
+    return ctx.encoder.odometry_encode(snap.time_us, MAV_FRAME_LOCAL_NED, MAV_FRAME_BODY_FRD, *snap.pos_ned_m,
                                    snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
 
 
 def timesync(ctx: Any, snap: VehicleSnapshot) -> Any:
     """streams/TIMESYNC.hpp: PX4's own sync request, tc1=0, ts1=boot time in ns."""
-    return ctx.mav.timesync_encode(0, snap.time_us * 1000)
+    return ctx.encoder.timesync_encode(0, snap.time_us * 1000)
 
 
 def ping(ctx: Any, snap: VehicleSnapshot) -> Any:
     """streams/PING.hpp: PX4 pings everyone (target 0/0) with its boot time and a sequence; replies are ignored."""
     seq = snap.time_us // 100_000  # unique per ping at any rate up to 10 Hz, from simulated time
-    return ctx.mav.ping_encode(snap.time_us, seq & 0xFFFFFFFF, 0, 0)
+    return ctx.encoder.ping_encode(snap.time_us, seq & 0xFFFFFFFF, 0, 0)
 
 
 def system_time(ctx: Any, snap: VehicleSnapshot) -> Any:
-    return ctx.mav.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
+    return ctx.encoder.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
 
 
 # CURRENT_MODE.standard_mode (src/lib/modes/standard_modes.hpp); everything else NON_STANDARD (0).
@@ -221,7 +221,7 @@ _STANDARD_MODE = {NavState.POSCTL: 1, NavState.ORBIT: 2, NavState.ALTCTL: 4, Nav
 
 
 def current_mode(ctx: Any, snap: VehicleSnapshot) -> Any:
-    return ctx.mav.current_mode_encode(_STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
+    return ctx.encoder.current_mode_encode(_STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
                                        px4.custom_mode(snap.user_intended_nav_state))
 
 

@@ -35,7 +35,7 @@ def highres_imu(ctx: Any, snap: VehicleSnapshot) -> Any:
     acc = specific_force_frd(snap)
     mag = rotate_ned_to_body(snap.q_wxyz, MAG_NED_GAUSS)
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
-    return ctx.mav.highres_imu_encode(snap.time_us, *acc, *snap.rates_frd_rad_s, *mag, pressure, 0.0,
+    return ctx.encoder.highres_imu_encode(snap.time_us, *acc, *snap.rates_frd_rad_s, *mag, pressure, 0.0,
                                       snap.alt_amsl_m, TEMPERATURE_C, HIGHRES_FIELDS_ALL, 0)
 
 
@@ -43,5 +43,5 @@ def scaled_pressure(ctx: Any, snap: VehicleSnapshot) -> Any:
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
     if not math.isfinite(pressure):
         return None
-    return ctx.mav.scaled_pressure_encode((snap.time_us // 1000) & 0xFFFFFFFF, pressure, 0.0,
+    return ctx.encoder.scaled_pressure_encode((snap.time_us // 1000) & 0xFFFFFFFF, pressure, 0.0,
                                           round(TEMPERATURE_C * 100), 0)

@@ -1,0 +1,182 @@
+"""MAVLink 2 frames for what the vehicle sends: the bytes pymavlink's `msg.pack(mav)` makes, at a fraction of the cost.
+
+pymavlink builds a message object, a header object and a bytearray per message and checksums through two wrapper
+objects; at ~700 messages per simulated second per vehicle that was most of the cost of the link. Here:
+- `ENCODER.<name>_encode(...)` takes the same arguments (and defaults) as pymavlink's `MAVLink.<name>_encode` and
+  returns a `Packed`: the message's spec and its field values in wire order, packed when sent (as pymavlink packs a
+  message object when it is sent, so a value out of its wire range fails at the same place).
+- `payload_of(msg)` gives the payload of a pymavlink message object (what handlers build with `ctx.mav`).
+- `frame(...)` wraps a payload into a MAVLink 2 frame: trailing zero bytes of the payload cut (at least one byte
+  kept), incompat/compat flags 0, X.25 (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra.
+  No signing: PX4 SITL does not sign (MAV_SIGN_CFG 0), nor do we.
+
+The field order, struct layout and crc_extra come from the pymavlink message classes themselves, so the wire format is
+theirs. Each class gets two small functions generated from that metadata, mirroring pymavlink's own generated
+`pack()` expression term by term (arrays indexed element by element, char arrays passed whole), so bad values fail
+the same way (struct.error, IndexError...). tests/test_mavlink_fastpack.py checks the bytes against pymavlink for
+every message type the emulator sends.
+"""
+
+from __future__ import annotations
+
+import binascii
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from pymavlink.dialects.v20 import development as dialect
+
+_mcrf4xx: Callable[[bytes, int], int] | None
+try:  # pymavlink's own CRC dependency (a C extension); the stdlib fallback below gives the same numbers
+    from fastcrc.crc16 import mcrf4xx as _mcrf4xx
+except ImportError:  # pragma: no cover - depends on the installed pymavlink
+    _mcrf4xx = None
+
+MAGIC_V2 = b"\xfd"
+_HEADER = struct.Struct("<BBBBBBHB")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit), after the magic
+_CRC = struct.Struct("<H")
+_BITREV = bytes(int(f"{i:08b}"[::-1], 2) for i in range(256))
+
+
+def _crc_hqx_reflected(data: bytes, crc: int = 0xFFFF) -> int:
+    """CRC-16/MCRF4XX from the stdlib: binascii.crc_hqx is the same polynomial unreflected, so reflect in and out."""
+    rev = _BITREV
+    crc = binascii.crc_hqx(data.translate(rev), rev[crc >> 8] | (rev[crc & 0xFF] << 8))
+    return rev[crc >> 8] | (rev[crc & 0xFF] << 8)
+
+
+x25_crc: Callable[[bytes, int], int] = _mcrf4xx if _mcrf4xx is not None else _crc_hqx_reflected
+
+
+@dataclass(frozen=True, slots=True)
+class MessageSpec:
+    msg_id: int
+    name: str
+    crc_extra: bytes  # one byte, appended to the checksummed data
+    pack: Callable[..., bytes]  # the class's struct: wire-ordered values -> whole payload
+    encode: Callable[..., Packed]  # pymavlink's <name>_encode signature
+    payload_of: Callable[[Any], bytes]  # payload of a pymavlink message object of this class
+
+
+class Packed:
+    """A message as the fast encoder returns it: its spec and its field values in wire order (arrays flattened).
+
+    Endpoint.send() frames it directly. It also packs like a pymavlink message, so a plain pymavlink
+    `MAVLink.send()` (test contexts) can send it too.
+    """
+
+    __slots__ = ("spec", "values")
+
+    def __init__(self, spec: MessageSpec, values: tuple[Any, ...]) -> None:
+        self.spec = spec
+        self.values = values
+
+    def get_type(self) -> str:
+        return self.spec.name
+
+    def get_msgId(self) -> int:  # pymavlink's name
+        return self.spec.msg_id
+
+    def get_payload(self) -> bytes:
+        """The whole payload, before MAVLink 2's zero truncation."""
+        return self.spec.pack(*self.values)
+
+    def pack(self, mav: Any, force_mavlink1: bool = False) -> bytes:
+        if force_mavlink1:
+            raise ValueError("Packed messages are MAVLink 2 only")
+        spec = self.spec
+        return frame(spec.msg_id, spec.crc_extra, spec.pack(*self.values), mav.seq, mav.srcSystem, mav.srcComponent)
+
+
+def frame(msg_id: int, crc_extra: bytes, payload: bytes, seq: int, sysid: int, compid: int) -> bytes:
+    """One MAVLink 2 frame, exactly as pymavlink's MAVLink_message._pack builds it (unsigned)."""
+    body = payload.rstrip(b"\0") or payload[:1]
+    head = _HEADER.pack(len(body), 0, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
+    return MAGIC_V2 + head + _CRC.pack(x25_crc(head + crc_extra, 0xFFFF))
+
+
+def frame_message(msg: Any, seq: int, sysid: int, compid: int) -> bytes:
+    """The frame of a Packed or of any pymavlink message object (a struct.error etc. for a value out of range)."""
+    if type(msg) is Packed:
+        spec = msg.spec
+        return frame(spec.msg_id, spec.crc_extra, spec.pack(*msg.values), seq, sysid, compid)
+    spec = _SPECS_BY_CLASS.get(type(msg)) or spec_for_class(type(msg))
+    return frame(spec.msg_id, spec.crc_extra, spec.payload_of(msg), seq, sysid, compid)
+
+
+# --- per-class specs -------------------------------------------------------------------------------------------------
+_SPECS_BY_CLASS: dict[type, MessageSpec] = {}
+
+
+def spec_for_class(cls: type) -> MessageSpec:
+    """The spec of a pymavlink message class (built once, then cached)."""
+    spec = _SPECS_BY_CLASS.get(cls)
+    if spec is None:
+        spec = _build_spec(cls)
+        _SPECS_BY_CLASS[cls] = spec
+    return spec
+
+
+def _wire_terms(cls: Any, of_object: bool) -> list[str]:
+    """The arguments pymavlink's generated pack() passes to the class's struct, in wire order.
+
+    Of an object, a char array is read from `_<name>_raw` where the class keeps the bytes given to it there (newer
+    pymavlink decodes the public attribute to str).
+    """
+    types = dict(zip(cls.fieldnames, cls.fieldtypes, strict=True))
+    stored = cls.__init__.__code__.co_names
+    terms: list[str] = []
+    for name, length in zip(cls.ordered_fieldnames, cls.array_lengths, strict=True):
+        if length and types[name] != "char":
+            terms.extend(f"{name}[{i}]" for i in range(length))
+        elif of_object and f"_{name}_raw" in stored:
+            terms.append(f"_{name}_raw")
+        else:
+            terms.append(name)
+    return terms
+
+
+def _build_spec(cls: Any) -> MessageSpec:
+    fields = list(cls.fieldnames)
+    if {"_pk", "_mk", "_spec", "_m"} & set(fields):
+        raise ValueError(f"{cls.msgname}: a field name collides with the generated code")
+    namespace: dict[str, Any] = {"_pk": cls.unpacker.pack, "_mk": Packed}
+    # Generated from pymavlink's own metadata: the same expressions its generated pack() evaluates. A trailing comma
+    # keeps a one-term tuple a tuple.
+    source = (
+        f"def encode({', '.join(fields)}):\n"
+        f"    return _mk(_spec, ({', '.join(_wire_terms(cls, False))},))\n"
+        f"def payload_of(_m):\n"
+        f"    return _pk({', '.join('_m.' + t for t in _wire_terms(cls, True))})\n"
+    )
+    exec(compile(source, f"<fastpack {cls.msgname}>", "exec"), namespace)
+    encode = namespace["encode"]
+    encode.__defaults__ = _encode_defaults(cls)
+    spec = MessageSpec(cls.id, cls.msgname, bytes((cls.crc_extra,)), cls.unpacker.pack, encode,
+                       namespace["payload_of"])
+    namespace["_spec"] = spec
+    return spec
+
+
+def _encode_defaults(cls: Any) -> tuple[Any, ...] | None:
+    method = getattr(dialect.MAVLink, f"{cls.msgname.lower()}_encode", None)
+    source = method if method is not None else cls.__init__
+    return source.__defaults__
+
+
+class _Encoder:
+    """`ENCODER.attitude_encode(...)` -> Packed, the same call as pymavlink's `mav.attitude_encode(...)`."""
+
+    def __getattr__(self, attr: str) -> Callable[..., Packed]:
+        if not attr.endswith("_encode"):
+            raise AttributeError(attr)
+        cls = dialect.__dict__.get(f"MAVLink_{attr[:-len('_encode')]}_message")
+        if cls is None:
+            raise AttributeError(attr)
+        encode = spec_for_class(cls).encode
+        setattr(self, attr, encode)  # later look-ups are plain attribute hits
+        return encode
+
+
+ENCODER: Any = _Encoder()
