@@ -85,12 +85,14 @@ class ModeExecutor:
         if not new_task and self._held is not None and now_us - self._last_us < TASK_PERIOD_US:
             return self._held
         dt = dt_s if new_task or self._held is None else (now_us - self._last_us) * 1e-6
-        sp = self.task.update(nav_fn(), dt)
-        out = ExecutorOutput(sp, None, self.task.setpoint_type, self.task.finished, self.task.drain_messages(),
-                             self.task.want_takeoff)
-        self._held = ExecutorOutput(sp, None, out.setpoint_type, out.task_finished, (), out.want_takeoff)
+        task = self.task
+        sp = task.update(nav_fn(), dt)
+        held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
         self._last_us = now_us
-        return out
+        messages = task.drain_messages()
+        if not messages:
+            return held
+        return ExecutorOutput(sp, None, held.setpoint_type, held.task_finished, messages, held.want_takeoff)
 
     def _offboard_output(self) -> ExecutorOutput:
         kind = self._offboard_kind

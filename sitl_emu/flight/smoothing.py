@@ -241,10 +241,10 @@ class PositionSmoother:
             axis.reset(accel[i], vel[i], pos[i])
 
     def set_limits(self, jerk: float, accel_xy: float, accel_z: float, vel_xy: float, vel_z: float) -> None:
-        for i, axis in enumerate(self.axes):
-            axis.max_jerk = jerk
-            axis.max_accel = accel_xy if i < 2 else accel_z
-            axis.max_vel = vel_xy if i < 2 else vel_z
+        ax, ay, az = self.axes
+        ax.max_jerk, ax.max_accel, ax.max_vel = jerk, accel_xy, vel_xy
+        ay.max_jerk, ay.max_accel, ay.max_vel = jerk, accel_xy, vel_xy
+        az.max_jerk, az.max_accel, az.max_vel = jerk, accel_z, vel_z
 
     @property
     def position(self) -> Vec3:

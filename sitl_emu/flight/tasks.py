@@ -37,6 +37,10 @@ class TakeoffTask(Task):
         # mission_block.cpp: reached when within the altitude acceptance radius (half the climb if that is smaller)
         self._alt_acceptance_m = min(self._settings.nav_mc_alt_rad, 0.5 * (target_alt_up_m - current_up))
         self._finished = False
+        # the three waypoints this task can give (frozen, so built once)
+        self._wp_climb = Waypoint("takeoff", self._target)
+        self._wp_idle = Waypoint("idle", self._target)
+        self._wp_hold = Waypoint("position", self._target)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -51,8 +55,8 @@ class TakeoffTask(Task):
         if not self._finished and -nav.pos_ned_m[2] >= -self._target[2] - self._alt_acceptance_m:
             self._finished = True  # navigator turns the takeoff item into a loiter at the target
         if not self._finished:
-            return Waypoint("takeoff", self._target)
-        return Waypoint("idle" if nav.landed else "position", self._target)
+            return self._wp_climb
+        return self._wp_idle if nav.landed else self._wp_hold
 
 
 class LoiterTask(Task):
@@ -70,15 +74,14 @@ class LoiterTask(Task):
         else:
             self._target = braking_point(nav, self._settings)
             self._idle = nav.landed or not nav.armed
+        self._wp = Waypoint("idle", self._target) if self._idle else Waypoint("position", self._target, self._yaw)
 
     @property
     def target_ned_m(self) -> Vec3:
         return self._target
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
-        if self._idle:
-            return Waypoint("idle", self._target)
-        return Waypoint("position", self._target, self._yaw)
+        return self._wp
 
 
 class LandTask(Task):
@@ -89,9 +92,10 @@ class LandTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         super().__init__(nav, params)
         self._target = braking_point(nav, self._settings)
+        self._wp = Waypoint("land", self._target)
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
-        return Waypoint("land", self._target)
+        return self._wp
 
 
 class RepositionTask(Task):
@@ -105,13 +109,14 @@ class RepositionTask(Task):
         self._target = _fill_nan(target_ned_m, nav.pos_ned_m)
         self._yaw = yaw_rad
         self._speed = speed_m_s if math.isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
+        self._wp = Waypoint("position", self._target, self._yaw, self._speed)
 
     @property
     def target_ned_m(self) -> Vec3:
         return self._target
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
-        return Waypoint("position", self._target, self._yaw, self._speed)
+        return self._wp
 
 
 def braking_point(nav: NavInput, settings: AutoSettings) -> Vec3:

@@ -25,6 +25,9 @@ PRE_RAMP_STATES = frozenset({"disarmed", "spoolup", "ready_for_takeoff"})
 WANT_TAKEOFF_VZ_M_S = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
 REACTIVATE_VZ_M_S = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
 IDLE_ACC_Z_M_S2 = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
+_IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
+_NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
+_TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,7 +113,7 @@ def _get(params: ParamRegistry, name: str, default: float) -> float:
 
 
 def wrap_pi(angle: float) -> float:
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+    return (angle + math.pi) % _TWO_PI - math.pi
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,17 +141,18 @@ class AutoCore:
         self.want_takeoff = False
 
     def step(self, nav: NavInput, dt_s: float, wp: Waypoint) -> TrajectorySetpoint:
-        if wp.kind == "idle":
+        kind = wp.kind
+        if kind == "idle":
             return self._idle(nav)
         self._set_constraints(nav, wp)
-        target, ff = wp.target_ned_m, (NAN, NAN, NAN)
-        if wp.kind == "land":
+        target, ff = wp.target_ned_m, _NO_FEEDFORWARD
+        if kind == "land":
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
         sm = self.smoother.generate(nav.pos_ned_m, target, ff, dt_s)
-        self._unsmoothed_vz = sm.unsmoothed_velocity_ned_m_s[2]
-        self.want_takeoff = self._unsmoothed_vz < WANT_TAKEOFF_VZ_M_S
-        yaw, yawspeed = self._yaw(nav, wp, dt_s)
-        self._kind_prev = wp.kind
+        vz = self._unsmoothed_vz = sm.unsmoothed_velocity_ned_m_s[2]
+        self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
+        yaw, yawspeed = self._limit_yaw_rate(nav, self._yaw_target(nav, wp), dt_s)
+        self._kind_prev = kind
         out = TrajectorySetpoint(sm.position_ned_m, sm.velocity_ned_m_s, sm.acceleration_ned_m_s2, yaw, yawspeed)
         if nav.takeoff_state in PRE_RAMP_STATES:
             out = self._hold_before_ramp(nav, out)
@@ -157,7 +161,7 @@ class AutoCore:
     def _idle(self, nav: NavInput) -> TrajectorySetpoint:
         self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), nav.pos_ned_m)
         self._kind_prev, self.want_takeoff, self._yaw_sp_prev = "idle", False, nav.yaw_rad
-        return TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
+        return _IDLE_SETPOINT  # frozen: one shared instance
 
     def _hold_before_ramp(self, nav: NavInput, out: TrajectorySetpoint) -> TrajectorySetpoint:
         """FlightModeManager: before the takeoff ramp the task is re-activated every cycle (trajectory reset to the
@@ -170,12 +174,14 @@ class AutoCore:
         """FlightTaskAuto::_updateTrajConstraints."""
         s, sm = self.s, self.smoother
         cruise = wp.cruise_m_s if math.isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
-        sm.cruise_speed_m_s = min(cruise, s.xy_vel_max)
+        vel_max = s.xy_vel_max
+        sm.cruise_speed_m_s = vel_max if vel_max < cruise else cruise  # min(cruise, xy_vel_max)
         sm.max_xy_error_m = s.xy_err_max
         if self._unsmoothed_vz < 0.0:  # going up
             acc_z, vel_z = s.acc_up, s.z_v_auto_up
             if wp.kind == "takeoff" and self._dist_to_ground(nav) < s.land_alt1:
-                vel_z, acc_z = s.tko_speed, min(acc_z, s.tko_speed / s.tko_ramp_t)
+                ramp_acc = s.tko_speed / s.tko_ramp_t
+                vel_z, acc_z = s.tko_speed, ramp_acc if ramp_acc < acc_z else acc_z  # min(acc_z, ramp_acc)
                 for axis in sm.axes[2:]:  # keep the altitude setpoint at the vehicle during the ramp
                     axis.set_position(nav.pos_ned_m[2])
         else:
@@ -184,13 +190,14 @@ class AutoCore:
 
     @staticmethod
     def _dist_to_ground(nav: NavInput) -> float:
-        return max(-nav.pos_ned_m[2], 0.0)
+        up = -nav.pos_ned_m[2]
+        return 0.0 if up < 0.0 else up  # max(up, 0.0)
 
     def _land_speed(self, nav: NavInput) -> float:
         """FlightTaskAuto::_prepareLandSetpoints: MPC_LAND_SPEED below ALT2, MPC_Z_VEL_MAX_DN above ALT1, linear in
         between; MPC_LAND_CRWL below ALT3 (SIH has a distance sensor, so the crawl applies)."""
         s, d = self.s, self._dist_to_ground(nav)
-        alt1 = max(s.land_alt1, s.land_alt2)
+        alt1 = s.land_alt2 if s.land_alt2 > s.land_alt1 else s.land_alt1  # max(land_alt1, land_alt2)
         if d <= s.land_alt3:
             return s.land_crawl
         if d <= s.land_alt2:
@@ -198,10 +205,6 @@ class AutoCore:
         if d >= alt1:
             return s.z_vel_max_dn
         return s.land_speed + (d - s.land_alt2) / (alt1 - s.land_alt2) * (s.z_vel_max_dn - s.land_speed)
-
-    def _yaw(self, nav: NavInput, wp: Waypoint, dt_s: float) -> tuple[float, float]:
-        yaw_sp = self._yaw_target(nav, wp)
-        return self._limit_yaw_rate(nav, yaw_sp, dt_s)
 
     def _yaw_target(self, nav: NavInput, wp: Waypoint) -> float:
         if wp.kind == "land":
@@ -223,13 +226,24 @@ class AutoCore:
         """FlightTaskAuto::_limitYawRate: rate-limit the heading and feed its filtered rate forward."""
         prev = self._yaw_sp_prev if math.isfinite(self._yaw_sp_prev) else nav.yaw_rad
         max_rate = self.s.yawrate_max_rad_s
-        dyaw = min(max(wrap_pi(yaw_sp - prev), -max_rate * dt_s), max_rate * dt_s)
-        yaw_sp = wrap_pi(prev + dyaw)
+        pi = math.pi
+        # dyaw = min(max(wrap_pi(yaw_sp - prev), -max_rate * dt_s), max_rate * dt_s), written out
+        dyaw = (yaw_sp - prev + pi) % _TWO_PI - pi
+        low, high = -max_rate * dt_s, max_rate * dt_s
+        if low > dyaw:
+            dyaw = low
+        if high < dyaw:
+            dyaw = high
+        yaw_sp = (prev + dyaw + pi) % _TWO_PI - pi  # wrap_pi
+        filt = self._yawspeed_filt
         if dt_s > 0.0:
             alpha = dt_s / (dt_s + 0.2)
-            self._yawspeed_filt += alpha * (dyaw / dt_s - self._yawspeed_filt)
+            filt = self._yawspeed_filt = filt + alpha * (dyaw / dt_s - filt)
         self._yaw_sp_prev = yaw_sp
-        return yaw_sp, min(max(self._yawspeed_filt, -max_rate), max_rate)
+        low = -max_rate  # min(max(filt, -max_rate), max_rate)
+        if low > filt:
+            filt = low
+        return yaw_sp, (max_rate if max_rate < filt else filt)
 
 
 class Task:
