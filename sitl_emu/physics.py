@@ -27,6 +27,7 @@ from sitl_emu.types import Vec3, Vec4
 GRAVITY_M_S2 = 9.80665  # PX4 CONSTANTS_ONE_G
 DEFAULT_DT_S = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
 MAX_RATE_RAD_S = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
+_MIN_RATE = -MAX_RATE_RAD_S
 
 
 @dataclass(slots=True)
@@ -75,18 +76,6 @@ class SihConfig:
         return self.mass_kg * GRAVITY_M_S2 / (4.0 * self.t_max_n)
 
 
-def _lag_motors(motors: Vec4, cmd: Sequence[float], dt_s: float, tau_s: float) -> Vec4:
-    """sih.cpp read_motors: u += dt/tau (u_sp - u); commands clamped to 0..1 (NaN -> 0)."""
-    k = 1.0 if tau_s <= dt_s else dt_s / tau_s
-    c0, c1, c2, c3 = (_clip01(c) for c in cmd)
-    m0, m1, m2, m3 = motors
-    return m0 + k * (c0 - m0), m1 + k * (c1 - m1), m2 + k * (c2 - m2), m3 + k * (c3 - m3)
-
-
-def _clip01(c: float) -> float:
-    return 0.0 if not c >= 0.0 else (1.0 if c > 1.0 else c)  # `not c >= 0` also catches NaN
-
-
 def _level_q(q: Vec4) -> Vec4:
     """The attitude with roll and pitch removed, yaw kept."""
     w, x, y, z = q
@@ -112,44 +101,58 @@ def _rotate_q(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:
     return qw * inv, qx * inv, qy * inv, qz * inv
 
 
-def _clamp_rate(v: float) -> float:
-    return MAX_RATE_RAD_S if v > MAX_RATE_RAD_S else (-MAX_RATE_RAD_S if v < -MAX_RATE_RAD_S else v)
-
-
 def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig) -> RigidBodyState:
-    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed."""
-    u = _lag_motors(state.motors, motor_cmd, dt_s, cfg.t_tau_s)
-    u0, u1, u2, u3 = u
-    thrust_n = cfg.t_max_n * (u0 + u1 + u2 + u3)  # along body -z
-    w, x, y, z = state.q_wxyz
+    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
+
+    Runs every tick: the motor lag (sih.cpp read_motors: u += dt/tau (u_sp - u), commands clamped to 0..1, NaN -> 0),
+    and the rate clamp (+-6 pi rad/s) are inlined here.
+    """
+    tau = cfg.t_tau_s
+    k = 1.0 if tau <= dt_s else dt_s / tau
+    c0, c1, c2, c3 = motor_cmd
+    c0 = 0.0 if not c0 >= 0.0 else (1.0 if c0 > 1.0 else c0)  # `not c >= 0` also catches NaN
+    c1 = 0.0 if not c1 >= 0.0 else (1.0 if c1 > 1.0 else c1)
+    c2 = 0.0 if not c2 >= 0.0 else (1.0 if c2 > 1.0 else c2)
+    c3 = 0.0 if not c3 >= 0.0 else (1.0 if c3 > 1.0 else c3)
+    m0, m1, m2, m3 = state.motors
+    u0, u1, u2, u3 = m0 + k * (c0 - m0), m1 + k * (c1 - m1), m2 + k * (c2 - m2), m3 + k * (c3 - m3)
+    u = (u0, u1, u2, u3)
+    t_max = cfg.t_max_n
+    thrust_n = t_max * (u0 + u1 + u2 + u3)  # along body -z
+    q_wxyz = state.q_wxyz
+    w, x, y, z = q_wxyz
     # third column of R (body z axis in NED), times -thrust
     bzx, bzy, bzz = 2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)
     vn, ve, vd = state.vel_ned_m_s
-    m = cfg.mass_kg
-    fn = -thrust_n * bzx - cfg.kdv * (vn - cfg.wind_n_m_s)
-    fe = -thrust_n * bzy - cfg.kdv * (ve - cfg.wind_e_m_s)
-    fd = -thrust_n * bzz - cfg.kdv * vd + m * GRAVITY_M_S2
+    m, kdv = cfg.mass_kg, cfg.kdv
+    fn = -thrust_n * bzx - kdv * (vn - cfg.wind_n_m_s)
+    fe = -thrust_n * bzy - kdv * (ve - cfg.wind_e_m_s)
+    fd = -thrust_n * bzz - kdv * vd + m * GRAVITY_M_S2
     an, ae, ad = fn / m, fe / m, fd / m
     pn, pe, pd = state.pos_ned_m
     if state.on_ground and ad >= 0.0:
         return _grounded(state, u, (pn, pe, 0.0), thrust_n, cfg)
     # moments (sih.cpp generate_force_and_torques), damping, gyroscopic term, diagonal inertia
     p, q, r = state.rates_frd_rad_s
-    mx = cfg.l_roll_m * cfg.t_max_n * (-u0 + u1 + u2 - u3) - cfg.kdw * p
-    my = cfg.l_pitch_m * cfg.t_max_n * (u0 - u1 + u2 - u3) - cfg.kdw * q
-    mz = cfg.q_max_nm * (u0 + u1 - u2 - u3) - cfg.kdw * r
+    kdw = cfg.kdw
+    mx = cfg.l_roll_m * t_max * (-u0 + u1 + u2 - u3) - kdw * p
+    my = cfg.l_pitch_m * t_max * (u0 - u1 + u2 - u3) - kdw * q
+    mz = cfg.q_max_nm * (u0 + u1 - u2 - u3) - kdw * r
     ixx, iyy, izz = cfg.ixx, cfg.iyy, cfg.izz
     dp = (mx + (iyy - izz) * q * r) / ixx
     dq = (my + (izz - ixx) * r * p) / iyy
     dr = (mz + (ixx - iyy) * p * q) / izz
-    rates = (_clamp_rate(p + dp * dt_s), _clamp_rate(q + dq * dt_s), _clamp_rate(r + dr * dt_s))
+    np_, nq, nr = p + dp * dt_s, q + dq * dt_s, r + dr * dt_s
+    np_ = MAX_RATE_RAD_S if np_ > MAX_RATE_RAD_S else (_MIN_RATE if np_ < _MIN_RATE else np_)
+    nq = MAX_RATE_RAD_S if nq > MAX_RATE_RAD_S else (_MIN_RATE if nq < _MIN_RATE else nq)
+    nr = MAX_RATE_RAD_S if nr > MAX_RATE_RAD_S else (_MIN_RATE if nr < _MIN_RATE else nr)
     nvn, nve, nvd = vn + an * dt_s, ve + ae * dt_s, vd + ad * dt_s
     npd = pd + 0.5 * (vd + nvd) * dt_s
     pos = (pn + 0.5 * (vn + nvn) * dt_s, pe + 0.5 * (ve + nve) * dt_s, npd)
     if npd >= 0.0:  # touchdown: stop in one step, never sink, never bounce
         return _grounded(state, u, (pos[0], pos[1], 0.0), thrust_n, cfg)
-    sf = _to_body(state.q_wxyz, an, ae, ad - GRAVITY_M_S2)
-    return RigidBodyState(pos, (nvn, nve, nvd), _rotate_q(state.q_wxyz, state.rates_frd_rad_s, dt_s), rates, u,
+    sf = _to_body(q_wxyz, an, ae, ad - GRAVITY_M_S2)
+    return RigidBodyState(pos, (nvn, nve, nvd), _rotate_q(q_wxyz, state.rates_frd_rad_s, dt_s), (np_, nq, nr), u,
                           (an, ae, ad), sf, False)
 
 

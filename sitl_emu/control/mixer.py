@@ -13,6 +13,7 @@ then add yaw, reduce yaw (with 15 % headroom above the maximum), and reduce thru
 from __future__ import annotations
 
 import math
+from math import isfinite
 
 from sitl_emu.types import Vec3, Vec4
 
@@ -57,12 +58,23 @@ def mix(torque: Vec3, thrust: float) -> tuple[Vec4, tuple[bool, bool, bool], tup
     Also returns per-axis positive/negative saturation flags (the torque achieved fell short of the demand), which
     the rate controller uses to stop integrating into the saturation.
     """
-    roll, pitch, yaw = (t if math.isfinite(t) else 0.0 for t in torque)
-    thrust = thrust if math.isfinite(thrust) else 0.0
+    roll, pitch, yaw = torque  # every tick: no generators, no min()/max() on the fast path
+    roll = roll if isfinite(roll) else 0.0
+    pitch = pitch if isfinite(pitch) else 0.0
+    yaw = yaw if isfinite(yaw) else 0.0
+    thrust = thrust if isfinite(thrust) else 0.0
     r, p = _K * roll, _K * pitch
-    fast = (thrust - r + p + yaw, thrust + r - p + yaw, thrust + r + p - yaw, thrust - r - p - yaw)
-    if min(fast) >= 0.0 and max(fast) <= 1.0:  # nothing saturates: the plain mix
-        return fast, _NO_SAT, _NO_SAT
+    f0, f1, f2, f3 = thrust - r + p + yaw, thrust + r - p + yaw, thrust + r + p - yaw, thrust - r - p - yaw
+    # min(fast) >= 0 and max(fast) <= 1, with min()/max()'s own rule (a later item replaces only if < / >)
+    lo = f1 if f1 < f0 else f0
+    lo = f2 if f2 < lo else lo
+    lo = f3 if f3 < lo else lo
+    if lo >= 0.0:
+        hi = f1 if f1 > f0 else f0
+        hi = f2 if f2 > hi else hi
+        hi = f3 if f3 > hi else hi
+        if hi <= 1.0:  # nothing saturates: the plain mix
+            return (f0, f1, f2, f3), _NO_SAT, _NO_SAT
     u = [thrust + ROLL[i] * roll + PITCH[i] * pitch for i in range(4)]
     _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
     _desaturate(u, ROLL, 0.0, 1.0)
