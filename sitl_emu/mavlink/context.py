@@ -37,6 +37,8 @@ class LinkContext(Protocol):
 
 class Handler(Protocol):
     MESSAGES: ClassVar[tuple[str, ...]]  # pymavlink type names, e.g. ("PARAM_SET", "PARAM_REQUEST_LIST")
+    # Optional: a handler whose tick() never sends may set `TICKS: ClassVar[bool] = False`; the endpoint then does
+    # not call it (one call less per link and tick). Absent means True.
 
     def handle(self, msg: Any, ctx: LinkContext) -> None: ...
 

@@ -120,6 +120,7 @@ class Endpoint:
         self._pending_texts: deque[VehicleEvent] = deque(maxlen=MAVLINK_LOG_QUEUE)
         self._now_us = 0
         self._handlers = [cls() for cls in handler_classes]
+        self._tickers = [h for h in self._handlers if getattr(h, "TICKS", True)]  # context.py: TICKS False = idle
         self._routes: dict[str, list[Any]] = {}
         for h in self._handlers:
             for msg_type in h.MESSAGES:
@@ -221,13 +222,16 @@ class Endpoint:
     # --- transmit ------------------------------------------------------------------------------------------------
     def emit(self, now_us: int, events: Sequence[VehicleEvent]) -> None:
         """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream."""
+        # Called every tick on every link: when nothing is due and nothing happened this costs a few comparisons.
         self._now_us = now_us
-        self.streams.emit_due(self, self.node.snapshot)
-        self._pending_texts.extend(e for e in events if e.statustext)
+        if now_us >= self.streams.next_due_us:
+            self.streams.emit_due(self, self.node.snapshot)
+        if events:
+            self._pending_texts.extend(e for e in events if e.statustext)
         if self._pending_texts and self.gcs_connected():
             self.streams.send_statustexts(self, list(self._pending_texts))
             self._pending_texts.clear()
-        for handler in self._handlers:
+        for handler in self._tickers:
             try:
                 handler.tick(self)
             except Exception as err:

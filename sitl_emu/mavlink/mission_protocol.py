@@ -45,6 +45,7 @@ class MissionProtocol:
         "MISSION_REQUEST_LIST", "MISSION_COUNT", "MISSION_CLEAR_ALL", "MISSION_ITEM", "MISSION_ITEM_INT",
         "MISSION_REQUEST", "MISSION_REQUEST_INT", "MISSION_ACK",
     )
+    TICKS: ClassVar[bool] = False  # tick() never sends: the endpoint need not call it
 
     def __init__(self) -> None:
         self._handlers = {

@@ -157,6 +157,9 @@ class ParamProtocol:
 
     # --- transmit ----------------------------------------------------------------------------------------------
     def tick(self, ctx: Any) -> None:
+        # Every link, every tick: idle (no list streaming, registry unchanged) must cost next to nothing.
+        if self._next_index is None and self._seen_version == ctx.vehicle.params.version:
+            return
         self._send_changes(ctx)
         self._stream(ctx)
 

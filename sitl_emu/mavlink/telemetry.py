@@ -11,6 +11,7 @@ from __future__ import annotations
 import enum
 import logging
 from collections.abc import Callable, Sequence
+from heapq import heapify, heapreplace
 from typing import Any
 
 from sitl_emu.mavlink import telemetry_msgs as tm
@@ -85,16 +86,22 @@ class Streams:
         rates = ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else NORMAL_RATES_HZ
         self._default_us: dict[int, int] = {mid: _interval_us(hz) for mid, hz in rates.items()}
         self._interval_us: dict[int, int] = dict(self._default_us)
+        # The schedule: a heap of (due µs, order, msg_id, interval µs), `order` being the stream's place in
+        # _interval_us, so what is due in one pass goes out in table order, as the table scan PX4-style sent it.
+        # After a configuration change or restart it is rebuilt at the next pass from _next_us (the due times kept).
+        self._schedule: list[tuple[int, int, int, int]] = []
+        self._schedule_stale = True
         self._next_us: dict[int, int] = {}
         self._next_heartbeat_us = 0
-        self._earliest_us = 0  # nothing is due before this (simulated µs)
+        self.next_due_us = 0  # nothing is due before this (simulated µs)
         self._statustext_id = 0
         self.build_errors = 0
 
     def restart(self) -> None:
         self._next_us.clear()
+        self._schedule_stale = True
         self._next_heartbeat_us = 0
-        self._earliest_us = 0
+        self.next_due_us = 0
 
     # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
     def known(self, msg_id: int) -> bool:
@@ -113,8 +120,11 @@ class Streams:
                 self._interval_us.pop(msg_id, None)
         else:
             self._interval_us[msg_id] = max(int(interval_us), 1)
+        if not self._schedule_stale:  # keep the other streams' due times
+            self._next_us = {mid: due for due, _, mid, _ in self._schedule}
+            self._schedule_stale = True
         self._next_us.pop(msg_id, None)
-        self._earliest_us = 0
+        self.next_due_us = 0
         return True
 
     def get_interval(self, msg_id: int) -> int:
@@ -134,9 +144,13 @@ class Streams:
         return builder(ctx, snap) if builder is not None else None
 
     def emit_due(self, ctx: Any, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
-        """Send every stream due at ctx.now_us; the snapshot is only taken when something is due."""
+        """Send every stream due at ctx.now_us; the snapshot is only taken when something is due.
+
+        Hot path (every link, every tick): one comparison when nothing is due; otherwise only the due streams are
+        touched (heap), their next due times set first, then their messages built and sent in table order.
+        """
         now = ctx.now_us
-        if now < self._earliest_us:
+        if now < self.next_due_us:
             return 0
         snap = get_snapshot()
         sent = 0
@@ -144,27 +158,46 @@ class Streams:
             ctx.send(tm.heartbeat(ctx, snap))
             sent += 1
             self._next_heartbeat_us = _next_due(self._next_heartbeat_us, HEARTBEAT_INTERVAL_US, now)
-        earliest = self._next_heartbeat_us
-        for msg_id, interval in self._interval_us.items():
-            due = self._next_us.get(msg_id, now)
-            if now >= due:
-                due = self._next_us[msg_id] = _next_due(due, interval, now)
-                msg = self._safe_build(msg_id, ctx, snap)
+        if self._schedule_stale:
+            self._rebuild_schedule(now)
+        heap = self._schedule
+        if heap and heap[0][0] <= now:
+            due_now: list[tuple[int, int]] = []
+            while heap and heap[0][0] <= now:
+                due, order, msg_id, interval = heap[0]
+                nxt = due + interval  # _next_due(), inline
+                heapreplace(heap, (nxt if nxt > now else now + interval, order, msg_id, interval))
+                due_now.append((order, msg_id))
+            if len(due_now) > 1:
+                due_now.sort()
+            for _, msg_id in due_now:
+                try:
+                    msg = BUILDERS[msg_id](ctx, snap)
+                except Exception as err:  # a bad snapshot value must cost one message, not the link
+                    self._build_failed(msg_id, err)
+                    continue
                 if msg is not None:
                     ctx.send(msg)
                     sent += 1
-            earliest = min(earliest, due)
-        self._earliest_us = earliest
+        earliest = self._next_heartbeat_us
+        if heap and heap[0][0] < earliest:
+            earliest = heap[0][0]
+        self.next_due_us = earliest
         return sent
 
-    def _safe_build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
-        try:
-            return BUILDERS[msg_id](ctx, snap)
-        except Exception as err:  # a bad snapshot value must cost one message, not the link
-            self.build_errors += 1
-            if self.build_errors == 1:
-                log.error("cannot build message %d: %r", msg_id, err, exc_info=log.isEnabledFor(logging.DEBUG))
-            return None
+    def _rebuild_schedule(self, now: int) -> None:
+        """A stream without a kept due time is due now (new, re-configured, or after a restart)."""
+        kept = self._next_us
+        self._schedule = [(kept.get(mid, now), order, mid, interval)
+                          for order, (mid, interval) in enumerate(self._interval_us.items())]
+        heapify(self._schedule)
+        self._next_us = {}
+        self._schedule_stale = False
+
+    def _build_failed(self, msg_id: int, err: Exception) -> None:
+        self.build_errors += 1
+        if self.build_errors == 1:
+            log.error("cannot build message %d: %r", msg_id, err, exc_info=log.isEnabledFor(logging.DEBUG))
 
     def send_statustexts(self, ctx: Any, events: Sequence[VehicleEvent]) -> None:
         """STATUSTEXT.hpp: one id per message, chunks of 50 chars with chunk_seq, nothing older than 5 s."""
