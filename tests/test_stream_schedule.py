@@ -1,0 +1,101 @@
+"""The stream scheduler sends what PX4's per-stream rate scheduling sends, in the same order, whatever the history.
+
+The reference below is the plain algorithm (scan the stream table every pass; a stream is due when its time has come,
+its next time is one interval later, or one interval from now if it fell behind). Streams keeps a heap instead; the
+two must agree message for message through rate changes, stopped and restarted streams and reboots.
+"""
+
+from __future__ import annotations
+
+import random
+from typing import Any
+
+from sitl_emu.mavlink import telemetry
+from sitl_emu.mavlink.telemetry import HEARTBEAT_ID, HEARTBEAT_INTERVAL_US, StreamMode, Streams
+
+
+class _Reference:
+    def __init__(self, mode: StreamMode) -> None:
+        rates = telemetry.ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else telemetry.NORMAL_RATES_HZ
+        self.default = {mid: round(1e6 / hz) for mid, hz in rates.items()}
+        self.interval = dict(self.default)
+        self.next: dict[int, int] = {}
+        self.next_hb = 0
+
+    def set_interval(self, msg_id: int, interval_us: float) -> None:
+        if interval_us < -1e-5:
+            self.interval.pop(msg_id, None)
+        elif interval_us <= 1e-5:
+            if msg_id in self.default:
+                self.interval[msg_id] = self.default[msg_id]
+            else:
+                self.interval.pop(msg_id, None)
+        else:
+            self.interval[msg_id] = max(int(interval_us), 1)
+        self.next.pop(msg_id, None)
+
+    def restart(self) -> None:
+        self.next.clear()
+        self.next_hb = 0
+
+    def due(self, now: int) -> list[int]:
+        out = []
+        if now >= self.next_hb:
+            out.append(HEARTBEAT_ID)
+            self.next_hb = _next(self.next_hb, HEARTBEAT_INTERVAL_US, now)
+        for msg_id, interval in self.interval.items():
+            due = self.next.get(msg_id, now)
+            if now >= due:
+                self.next[msg_id] = _next(due, interval, now)
+                out.append(msg_id)
+        return out
+
+
+def _next(due: int, interval: int, now: int) -> int:
+    nxt = due + interval
+    return nxt if nxt > now else now + interval
+
+
+class _Ctx:
+    def __init__(self) -> None:
+        self.now_us = 0
+        self.sent: list[int] = []
+
+    def send(self, msg: Any) -> None:
+        self.sent.append(msg)
+
+
+def _run(mode: StreamMode, seed: int) -> tuple[list[list[int]], list[list[int]]]:
+    """(what Streams sent, what the reference sends) per pass, for a random history of passes and changes."""
+    rng = random.Random(seed)
+    streams, reference, ctx = Streams(mode), _Reference(mode), _Ctx()
+    got, expected = [], []
+    for _ in range(4000):
+        ctx.now_us += rng.choice((1000, 4000, 4000, 4000, 25_000))
+        event = rng.random()
+        if event < 0.01:
+            streams.restart()
+            reference.restart()
+            ctx.now_us = rng.randrange(0, 50_000)  # a reboot: time starts again
+        elif event < 0.05:
+            msg_id = rng.choice([*telemetry.BUILDERS, 77])
+            interval = rng.choice((-1.0, 0.0, 1.0, 3000.0, 20_000.0, 250_000.0, 1.5e6))
+            if streams.set_interval(msg_id, interval):
+                reference.set_interval(msg_id, interval)
+        ctx.sent = []
+        streams.emit_due(ctx, lambda: None)
+        got.append(ctx.sent)
+        expected.append(reference.due(ctx.now_us))
+    return got, expected
+
+
+def test_streams_send_what_a_table_scan_sends_through_rate_changes_and_reboots(monkeypatch):
+    # every builder returns its message id, so the test sees which streams went out in which order
+    monkeypatch.setattr(telemetry.tm, "heartbeat", lambda ctx, snap: HEARTBEAT_ID)
+    for msg_id in list(telemetry.BUILDERS):
+        monkeypatch.setitem(telemetry.BUILDERS, msg_id, lambda ctx, snap, m=msg_id: m)
+    for mode in StreamMode:
+        for seed in range(3):
+            got, expected = _run(mode, seed)
+            assert sum(map(len, got)) > 1000
+            assert got == expected
