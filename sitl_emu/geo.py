@@ -7,7 +7,7 @@ reproject) with CONSTANTS_RADIUS_OF_EARTH = 6371000 m. Altitude: alt_amsl = ref_
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from sitl_emu.types import Vec3
 
@@ -21,32 +21,43 @@ class GeoRef:
     lat_deg: float
     lon_deg: float
     alt_amsl_m: float
+    # derived once (ned_to_global runs for every telemetry snapshot): the reference in radians, its sine and cosine
+    lat_rad: float = field(init=False, repr=False, compare=False)
+    lon_rad: float = field(init=False, repr=False, compare=False)
+    sin_lat: float = field(init=False, repr=False, compare=False)
+    cos_lat: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        lat_rad = math.radians(self.lat_deg)
+        object.__setattr__(self, "lat_rad", lat_rad)
+        object.__setattr__(self, "lon_rad", math.radians(self.lon_deg))
+        object.__setattr__(self, "sin_lat", math.sin(lat_rad))
+        object.__setattr__(self, "cos_lat", math.cos(lat_rad))
 
 
 def ned_to_global(ref: GeoRef, pos_ned_m: Vec3) -> tuple[float, float, float]:
     """(lat_deg, lon_deg, alt_amsl_m) of a local NED position."""
-    ref_lat = math.radians(ref.lat_deg)
-    ref_lon = math.radians(ref.lon_deg)
     x_rad = pos_ned_m[0] / EARTH_RADIUS_M
     y_rad = pos_ned_m[1] / EARTH_RADIUS_M
     c = math.hypot(x_rad, y_rad)
     if c > 0.0:
         sin_c, cos_c = math.sin(c), math.cos(c)
-        sin_ref, cos_ref = math.sin(ref_lat), math.cos(ref_lat)
-        lat = math.asin(max(-1.0, min(1.0, cos_c * sin_ref + x_rad * sin_c * cos_ref / c)))
-        lon = ref_lon + math.atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
+        sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
+        arg = cos_c * sin_ref + x_rad * sin_c * cos_ref / c
+        arg = arg if arg < 1.0 else 1.0  # max(-1.0, min(1.0, arg)), NaN kept
+        lat = math.asin(arg if arg > -1.0 else -1.0)
+        lon = ref.lon_rad + math.atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
     else:
-        lat, lon = ref_lat, ref_lon
+        lat, lon = ref.lat_rad, ref.lon_rad
     lon_deg = (math.degrees(lon) + 180.0) % 360.0 - 180.0
     return math.degrees(lat), lon_deg, ref.alt_amsl_m - pos_ned_m[2]
 
 
 def global_to_ned(ref: GeoRef, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> Vec3:
     """Local NED position (m) of a geodetic point."""
-    ref_lat = math.radians(ref.lat_deg)
     lat = math.radians(lat_deg)
     d_lon = math.radians(lon_deg - ref.lon_deg)
-    sin_ref, cos_ref = math.sin(ref_lat), math.cos(ref_lat)
+    sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
     sin_lat, cos_lat = math.sin(lat), math.cos(lat)
     cos_d_lon = math.cos(d_lon)
     arg = max(-1.0, min(1.0, sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))

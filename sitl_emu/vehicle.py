@@ -71,6 +71,10 @@ class Vehicle:
 
     def _boot(self) -> None:
         self._snap: VehicleSnapshot | None = None
+        self._geo_of: Vec3 | None = None  # the position (tuple object) self._geo was computed for
+        self._geo: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        self._euler_of: Vec4 | None = None  # the quaternion (tuple object) self._euler was computed for
+        self._euler: Vec3 = (0.0, 0.0, 0.0)
         self._time_us = 0
         self.ref = GeoRef(*self._home_tuple)
         self._rng = np.random.default_rng(self._seed)
@@ -219,21 +223,24 @@ class Vehicle:
         return self._snap
 
     def _make_snapshot(self) -> VehicleSnapshot:
+        """Built about every second tick when telemetry runs: what did not change since the last one (the same
+        position or attitude tuple, e.g. at rest) is reused, not recomputed."""
         c, s = self.commander, self._estimate
-        lat, lon, alt = ned_to_global(self.ref, s.pos_ned_m)
+        pos, q = s.pos_ned_m, s.q_wxyz
+        if pos is not self._geo_of:
+            self._geo_of, self._geo = pos, ned_to_global(self.ref, pos)
+        lat, lon, alt = self._geo
+        if q is not self._euler_of:
+            self._euler_of, self._euler = q, _euler(q)
         ctrl = self.parts.control
+        pre_flight_ok = c.pre_flight_checks_pass()
+        ref = self.ref
         return VehicleSnapshot(
-            time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
-            user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe,
-            landed_state=self.landed_state(), pre_flight_checks_pass=c.pre_flight_checks_pass(),
-            position_valid=c.estimator_ready, takeoff_detected=c.have_taken_off,
-            offboard_control=c.offboard_mode, pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s,
-            acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz, rates_frd_rad_s=s.rates_frd_rad_s,
-            euler_rad=_euler(s.q_wxyz), lat_deg=lat, lon_deg=lon, alt_amsl_m=alt, ref_lat_deg=self.ref.lat_deg,
-            ref_lon_deg=self.ref.lon_deg, ref_alt_amsl_m=self.ref.alt_amsl_m, home=c.home,
-            local_setpoint=ctrl.local_setpoint, attitude_setpoint_q_wxyz=ctrl.attitude_setpoint_q_wxyz,
-            rates_setpoint_rad_s=ctrl.rates_setpoint_rad_s, thrust_setpoint=ctrl.thrust_setpoint,
-            motors=self._state.motors, extras={"system_status": float(c.system_status())},
+            self._time_us, c.armed, c.nav_state, c.intention.user_intended, c.failsafe, self.landed_state(),
+            pre_flight_ok, c.estimator_ready, c.have_taken_off, c.offboard_mode, pos, s.vel_ned_m_s,
+            s.acc_ned_m_s2, q, s.rates_frd_rad_s, self._euler, lat, lon, alt, ref.lat_deg, ref.lon_deg,
+            ref.alt_amsl_m, c.home, ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s,
+            ctrl.thrust_setpoint, self._state.motors, extras={"system_status": float(c.system_status(pre_flight_ok))},
         )
 
 
