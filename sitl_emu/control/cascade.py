@@ -183,9 +183,11 @@ class MulticopterControl:
         self._local_out = None
 
     def _attitude_mode(self, state: RigidBodyState, sp: AttitudeSetpoint) -> tuple[Vec4 | None, Vec3, float]:
-        thrust = -sp.thrust_body[2] if math.isfinite(sp.thrust_body[2]) else 0.0
-        thrust = min(1.0, max(0.0, thrust))
-        if sp.q_wxyz is not None and all(math.isfinite(c) for c in sp.q_wxyz):
+        thrust = -sp.thrust_body[2] if isfinite(sp.thrust_body[2]) else 0.0
+        thrust = thrust if thrust > 0.0 else 0.0  # min(1.0, max(0.0, thrust)) as exact conditionals
+        thrust = thrust if thrust < 1.0 else 1.0
+        q = sp.q_wxyz
+        if q is not None and isfinite(q[0]) and isfinite(q[1]) and isfinite(q[2]) and isfinite(q[3]):
             q_sp = q_normalized(sp.q_wxyz)
             yaw_ff = sp.body_rates_rad_s[2] if math.isfinite(sp.body_rates_rad_s[2]) else 0.0
             return q_sp, self.attitude.update(state.q_wxyz, q_sp, yaw_ff), thrust

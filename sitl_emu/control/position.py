@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from math import acos, cos, hypot, isfinite, sin, sqrt
 from typing import NamedTuple
 
-from sitl_emu.control.qmath import constrain, normalized, q_from_dcm_columns
+from sitl_emu.control.qmath import constrain, q_from_dcm_columns
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import NAN, NAN3, TrajectorySetpoint, Vec3, Vec4
 
@@ -146,12 +146,16 @@ def limit_tilt(bz: Vec3, max_angle_rad: float) -> Vec3:
 def bodyz_to_attitude(bz: Vec3, yaw_rad: float) -> Vec4:
     """ControlMath::bodyzToAttitude: attitude with body z along bz (world frame) and the given heading.
 
-    Written on scalars (qmath's normalized and cross inlined in their operation order, zero components kept)."""
+    Written on scalars, it runs every position cycle: qmath's normalized, cross and (for a positive trace, the
+    usual case) q_from_dcm_columns with q_normalized are inlined in their operation order, zero components kept."""
     z0, z1, z2 = bz
     if z0 * z0 + z1 * z1 + z2 * z2 < 1.2e-7:
         z0, z1, z2 = 0.0, 0.0, 1.0
     n = sqrt(z0 * z0 + z1 * z1 + z2 * z2)
-    z0, z1, z2 = (z0 / n, z1 / n, z2 / n) if n > 0.0 else (0.0, 0.0, 0.0)
+    if n > 0.0:
+        z0, z1, z2 = z0 / n, z1 / n, z2 / n
+    else:
+        z0 = z1 = z2 = 0.0
     y0, y1, y2 = -sin(yaw_rad), cos(yaw_rad), 0.0
     x0, x1, x2 = y1 * z2 - y2 * z1, y2 * z0 - y0 * z2, y0 * z1 - y1 * z0  # cross(y_c, bz)
     if z2 < 0.0:
@@ -159,8 +163,22 @@ def bodyz_to_attitude(bz: Vec3, yaw_rad: float) -> Vec4:
     if abs(z2) < 1e-6:
         x0, x1, x2 = 0.0, 0.0, 1.0
     n = sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-    x0, x1, x2 = (x0 / n, x1 / n, x2 / n) if n > 0.0 else (0.0, 0.0, 0.0)
-    return q_from_dcm_columns((x0, x1, x2), (z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0), (z0, z1, z2))
+    if n > 0.0:
+        x0, x1, x2 = x0 / n, x1 / n, x2 / n
+    else:
+        x0 = x1 = x2 = 0.0
+    b0, b1, b2 = z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0  # by = cross(bz, bx)
+    tr = x0 + b1 + z2
+    if not tr > 0.0:
+        return q_from_dcm_columns((x0, x1, x2), (b0, b1, b2), (z0, z1, z2))
+    s = sqrt(tr + 1.0)
+    w = 0.5 * s
+    s = 0.5 / s
+    qx, qy, qz = (b2 - z1) * s, (z0 - x2) * s, (x1 - b0) * s
+    n = sqrt(w * w + qx * qx + qy * qy + qz * qz)
+    if not n > 0.0:
+        return 1.0, 0.0, 0.0, 0.0
+    return w / n, qx / n, qy / n, qz / n
 
 
 class VelocityDerivative:
@@ -282,8 +300,21 @@ class PositionControl:
         a0 = (f0 + a0 if isfinite(a0) else f0) if isfinite(f0) else a0  # addIfNotNan(feed-forward, PID)
         a1 = (f1 + a1 if isfinite(a1) else f1) if isfinite(f1) else a1
         a2 = (f2 + a2 if isfinite(a2) else f2) if isfinite(f2) else a2
-        # acceleration -> thrust: tilt-limited body z, collective from the hover thrust, at least the minimum
-        z0, z1, z2 = limit_tilt(normalized((-a0, -a1, G)), tilt_rad)
+        # acceleration -> thrust: body z = limit_tilt(normalized((-a0, -a1, G)), tilt_rad), inlined
+        z0, z1 = -a0, -a1
+        n = sqrt(z0 * z0 + z1 * z1 + G * G)
+        if n > 0.0:
+            z0, z1, z2 = z0 / n, z1 / n, G / n
+        else:
+            z0 = z1 = z2 = 0.0
+        z2 = -1.0 if z2 < -1.0 else (1.0 if z2 > 1.0 else z2)
+        angle = acos(z2)
+        angle = tilt_rad if tilt_rad < angle else angle  # min(acos(z), tilt_rad)
+        rn = hypot(z0, z1)
+        if rn * rn < 1.2e-7:  # FLT_EPSILON
+            z0, z1, rn = 1.0, 0.0, 1.0
+        sn = sin(angle)
+        z0, z1, z2 = sn * z0 / rn, sn * z1 / rn, cos(angle)
         h = self.hover_thrust
         c = (a2 * (h / G) - h) / z2
         tmin = 10e-4 if thr_min < 10e-4 else thr_min  # max(thr_min, 10e-4)

@@ -108,19 +108,43 @@ class RateControl:
 
     def _integrate(self, e0: float, e1: float, e2: float, dt_s: float, sat_pos: tuple[bool, bool, bool],
                    sat_neg: tuple[bool, bool, bool]) -> None:
-        """The integrator of the three axes (see the module docstring); min(e, 0) is `0 if e > 0 else e` exactly."""
+        """The integrator of the three axes (see the module docstring), unrolled: it runs every tick in flight.
+
+        min(e, 0) is `0 if e > 0 else e`, max(e, 0) is `0 if e < 0 else e`, max(0, x) is `x if x > 0 else 0`,
+        min(lim, v) is `v if v < lim else lim` and max(-lim, v) is `v if v > -lim else -lim`, exactly."""
         s = self._settings
-        gi, lim, integ = s.gain_i, s.int_lim, self._int
-        for k, e in ((0, e0), (1, e1), (2, e2)):
-            if sat_pos[k]:
-                e = 0.0 if e > 0.0 else e
-            if sat_neg[k]:
-                e = 0.0 if e < 0.0 else e
-            f = e / _I_FACTOR_RATE
-            i_factor = 1.0 - f * f
-            i_factor = i_factor if i_factor > 0.0 else 0.0  # max(0.0, 1 - f^2)
-            v = integ[k] + i_factor * gi[k] * e * dt_s
-            if isfinite(v):
-                hi = lim[k]
-                v = v if v < hi else hi  # min(hi, v) is `v if v < hi else hi`
-                integ[k] = v if v > -hi else -hi  # max(-hi, v)
+        g0, g1, g2 = s.gain_i
+        l0, l1, l2 = s.int_lim
+        p0, p1, p2 = sat_pos
+        n0, n1, n2 = sat_neg
+        integ = self._int
+        if p0:
+            e0 = 0.0 if e0 > 0.0 else e0
+        if n0:
+            e0 = 0.0 if e0 < 0.0 else e0
+        f = e0 / _I_FACTOR_RATE
+        k = 1.0 - f * f
+        v = integ[0] + (k if k > 0.0 else 0.0) * g0 * e0 * dt_s
+        if isfinite(v):
+            v = v if v < l0 else l0
+            integ[0] = v if v > -l0 else -l0
+        if p1:
+            e1 = 0.0 if e1 > 0.0 else e1
+        if n1:
+            e1 = 0.0 if e1 < 0.0 else e1
+        f = e1 / _I_FACTOR_RATE
+        k = 1.0 - f * f
+        v = integ[1] + (k if k > 0.0 else 0.0) * g1 * e1 * dt_s
+        if isfinite(v):
+            v = v if v < l1 else l1
+            integ[1] = v if v > -l1 else -l1
+        if p2:
+            e2 = 0.0 if e2 > 0.0 else e2
+        if n2:
+            e2 = 0.0 if e2 < 0.0 else e2
+        f = e2 / _I_FACTOR_RATE
+        k = 1.0 - f * f
+        v = integ[2] + (k if k > 0.0 else 0.0) * g2 * e2 * dt_s
+        if isfinite(v):
+            v = v if v < l2 else l2
+            integ[2] = v if v > -l2 else -l2

@@ -39,13 +39,15 @@ class TakeoffHandling:
     def update_state(self, armed: bool, landed: bool, want_takeoff: bool, now_us: int,
                      skip_takeoff: bool = False) -> TakeoffState:
         """updateTakeoffState: advance the state machine (it may pass several states in one call, as PX4's does)."""
+        st = self.state
+        if st is _FLIGHT and armed and not landed and self._armed_since_us is not None:
+            return st  # the usual case in the air: nothing below would change it
         if not armed:
             self._armed_since_us = None
             self.state = TakeoffState.DISARMED
             return self.state
         if self._armed_since_us is None:
             self._armed_since_us = now_us
-        st = self.state
         if st <= TakeoffState.DISARMED:
             st = TakeoffState.SPOOLUP
         if st == TakeoffState.SPOOLUP and now_us - self._armed_since_us >= self.spoolup_time_s * 1e6:
@@ -64,6 +66,8 @@ class TakeoffHandling:
 
     def update_ramp(self, dt_s: float, desired_vz_up: float) -> float:
         """updateRamp: the upward velocity limit for this cycle (m/s, positive up)."""
+        if self.state is _FLIGHT:
+            return desired_vz_up
         if self.state < TakeoffState.RAMPUP:
             return self.ramp_vz_init
         if self.state == TakeoffState.RAMPUP:
@@ -74,3 +78,6 @@ class TakeoffHandling:
             if self._ramp_progress < 1.0:
                 return self.ramp_vz_init + self._ramp_progress * (desired_vz_up - self.ramp_vz_init)
         return desired_vz_up
+
+
+_FLIGHT = TakeoffState.FLIGHT
