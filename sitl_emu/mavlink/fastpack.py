@@ -97,12 +97,20 @@ def frame(msg_id: int, crc_extra: bytes, payload: bytes, seq: int, sysid: int, c
 
 
 def frame_message(msg: Any, seq: int, sysid: int, compid: int) -> bytes:
-    """The frame of a Packed or of any pymavlink message object (a struct.error etc. for a value out of range)."""
+    """The frame of a Packed or of any pymavlink message object (a struct.error etc. for a value out of range).
+
+    Hot path (every message sent): frame() is inlined here.
+    """
     if type(msg) is Packed:
         spec = msg.spec
-        return frame(spec.msg_id, spec.crc_extra, spec.pack(*msg.values), seq, sysid, compid)
-    spec = _SPECS_BY_CLASS.get(type(msg)) or spec_for_class(type(msg))
-    return frame(spec.msg_id, spec.crc_extra, spec.payload_of(msg), seq, sysid, compid)
+        payload = spec.pack(*msg.values)
+    else:
+        spec = _SPECS_BY_CLASS.get(type(msg)) or spec_for_class(type(msg))
+        payload = spec.payload_of(msg)
+    body = payload.rstrip(b"\0") or payload[:1]
+    msg_id = spec.msg_id
+    head = _HEADER.pack(len(body), 0, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
+    return MAGIC_V2 + head + _CRC.pack(x25_crc(head + spec.crc_extra, 0xFFFF))
 
 
 # --- per-class specs -------------------------------------------------------------------------------------------------
