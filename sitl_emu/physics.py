@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from math import cos, sin, sqrt
 
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3, Vec4
@@ -83,29 +84,11 @@ def _level_q(q: Vec4) -> Vec4:
     return math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)
 
 
-def _rotate_q(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:
-    """q <- q (x) exp(omega dt / 2), normalised."""
-    w, x, y, z = q
-    p, r_, s = rates
-    n = math.sqrt(p * p + r_ * r_ + s * s)
-    half = 0.5 * n * dt_s
-    if n < 1e-12:
-        return q
-    c, k = math.cos(half), math.sin(half) / n
-    dw, dx, dy, dz = c, p * k, r_ * k, s * k
-    qw = w * dw - x * dx - y * dy - z * dz
-    qx = w * dx + x * dw + y * dz - z * dy
-    qy = w * dy - x * dz + y * dw + z * dx
-    qz = w * dz + x * dy - y * dx + z * dw
-    inv = 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-    return qw * inv, qx * inv, qy * inv, qz * inv
-
-
 def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig) -> RigidBodyState:
     """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
 
     Runs every tick: the motor lag (sih.cpp read_motors: u += dt/tau (u_sp - u), commands clamped to 0..1, NaN -> 0),
-    and the rate clamp (+-6 pi rad/s) are inlined here.
+    the rate clamp (+-6 pi rad/s), the accelerometer rotation R^T v and the quaternion exponential are inlined here.
     """
     tau = cfg.t_tau_s
     k = 1.0 if tau <= dt_s else dt_s / tau
@@ -151,9 +134,27 @@ def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: Si
     pos = (pn + 0.5 * (vn + nvn) * dt_s, pe + 0.5 * (ve + nve) * dt_s, npd)
     if npd >= 0.0:  # touchdown: stop in one step, never sink, never bounce
         return _grounded(state, u, (pos[0], pos[1], 0.0), thrust_n, cfg)
-    sf = _to_body(q_wxyz, an, ae, ad - GRAVITY_M_S2)
-    return RigidBodyState(pos, (nvn, nve, nvd), _rotate_q(q_wxyz, state.rates_frd_rad_s, dt_s), (np_, nq, nr), u,
-                          (an, ae, ad), sf, False)
+    # accelerometer: R^T (a - g) in FRD; R's third column is (bzx, bzy, bzz) above
+    fz = ad - GRAVITY_M_S2
+    r00, r01 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z)
+    r10, r11 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z)
+    r20, r21 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x)
+    sf = (r00 * an + r10 * ae + r20 * fz, r01 * an + r11 * ae + r21 * fz, bzx * an + bzy * ae + bzz * fz)
+    # attitude: q <- q (x) exp(omega dt / 2) with the rates at the start of the step, normalised
+    n = sqrt(p * p + q * q + r * r)
+    if n < 1e-12:
+        q_new = q_wxyz
+    else:
+        half = 0.5 * n * dt_s
+        dw, k = cos(half), sin(half) / n
+        dx, dy, dz = p * k, q * k, r * k
+        qw = w * dw - x * dx - y * dy - z * dz
+        qx = w * dx + x * dw + y * dz - z * dy
+        qy = w * dy - x * dz + y * dw + z * dx
+        qz = w * dz + x * dy - y * dx + z * dw
+        inv = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        q_new = (qw * inv, qx * inv, qy * inv, qz * inv)
+    return RigidBodyState(pos, (nvn, nve, nvd), q_new, (np_, nq, nr), u, (an, ae, ad), sf, False)
 
 
 def _grounded(state: RigidBodyState, u: Vec4, pos: Vec3, thrust_n: float, cfg: SihConfig) -> RigidBodyState:
@@ -161,15 +162,6 @@ def _grounded(state: RigidBodyState, u: Vec4, pos: Vec3, thrust_n: float, cfg: S
     q = state.q_wxyz if state.on_ground and state.q_wxyz[1] == 0.0 == state.q_wxyz[2] else _level_q(state.q_wxyz)
     return RigidBodyState(pos, (0.0, 0.0, 0.0), q, (0.0, 0.0, 0.0), u, (0.0, 0.0, 0.0),
                           (0.0, 0.0, -GRAVITY_M_S2), True)
-
-
-def _to_body(q: Vec4, vn: float, ve: float, vd: float) -> Vec3:
-    """R^T v: a NED vector in the FRD body frame."""
-    w, x, y, z = q
-    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
-    r10, r11, r12 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)
-    r20, r21, r22 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)
-    return (r00 * vn + r10 * ve + r20 * vd, r01 * vn + r11 * ve + r21 * vd, r02 * vn + r12 * ve + r22 * vd)
 
 
 def hover_state(altitude_m: float, cfg: SihConfig | None = None, yaw_rad: float = 0.0) -> RigidBodyState:
