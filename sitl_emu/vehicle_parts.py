@@ -11,7 +11,7 @@ import math
 
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.flight.commander import Commander
-from sitl_emu.flight.land_detector import LandDetector, LandDetectorInput
+from sitl_emu.flight.land_detector import LandDetector
 from sitl_emu.flight.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.flight.tasks import NavInput
 from sitl_emu.geo import GeoRef
@@ -67,14 +67,14 @@ class Parts:
             return self.ld_out
         self.ld_next_us, self.ld_armed = now_us + LAND_DETECTOR_PERIOD_US, c.armed
         f = est.specific_force_frd
-        out = self._detector.update(LandDetectorInput(
-            time_us=now_us, armed=c.armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
-            specific_force_norm_m_s2=math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
-            thrust_setpoint=self.control.thrust_setpoint, hover_thrust=self.control.hover_thrust,
-            setpoint_vz_m_s=descent_vz(self.control.local_setpoint), in_descent_mode=climb_rate_controlled))
-        self.ground_contact = bool(out.ground_contact)
-        self.ld_out = (out.landed, out.maybe_landed)
-        return self.ld_out
+        ctrl = self.control
+        # LandDetector.update(LandDetectorInput(...)) without the input/output objects
+        landed, maybe_landed, ground_contact = self._detector.update_values(
+            now_us, c.armed, est.vel_ned_m_s, est.rates_frd_rad_s, math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
+            ctrl.thrust_setpoint, ctrl.hover_thrust, descent_vz(ctrl.local_setpoint), climb_rate_controlled)
+        self.ground_contact = bool(ground_contact)
+        out = self.ld_out = (landed, maybe_landed)
+        return out
 
 
 def descent_vz(sp: TrajectorySetpoint | None) -> float:

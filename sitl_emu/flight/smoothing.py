@@ -256,13 +256,18 @@ class PositionSmoother:
 
     def generate(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> SmoothedSetpoint:
         """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis)."""
+        vel_sp = self.update(vehicle_pos, target, feedforward_vel, dt_s)
+        ax = self.axes
+        return SmoothedSetpoint((ax[0].x, ax[1].x, ax[2].x), (ax[0].v, ax[1].v, ax[2].v),
+                                (ax[0].a, ax[1].a, ax[2].a), vel_sp)
+
+    def update(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> Vec3:
+        """generate() without building its result: the axes hold the new state; returns the unsmoothed velocity."""
         vel_sp = self._velocity_target(target, feedforward_vel)
         isfinite = math.isfinite
         if isfinite(vel_sp[0]) and isfinite(vel_sp[1]) and isfinite(vel_sp[2]):
             self._advance(vehicle_pos, vel_sp, dt_s)
-        ax = self.axes
-        return SmoothedSetpoint((ax[0].x, ax[1].x, ax[2].x), (ax[0].v, ax[1].v, ax[2].v),
-                                (ax[0].a, ax[1].a, ax[2].a), vel_sp)
+        return vel_sp
 
     def _velocity_target(self, target: Vec3, ff: Vec3) -> Vec3:
         isfinite = math.isfinite
@@ -288,7 +293,7 @@ class PositionSmoother:
 
     def _advance(self, vehicle_pos: Vec3, vel_sp: Vec3, dt_s: float) -> None:
         stretch_xy = self._stretch_xy(vehicle_pos)
-        stretch_z = self._stretch_z(vehicle_pos)
+        stretch_z = 1.0 if self.max_z_error_m <= _EPS else self._stretch_z(vehicle_pos)
         ax, ay, az = self.axes
         ax.update_traj(dt_s, stretch_xy)
         ay.update_traj(dt_s, stretch_xy)
@@ -296,7 +301,21 @@ class PositionSmoother:
         ax.update_durations(vel_sp[0])
         ay.update_durations(vel_sp[1])
         az.update_durations(vel_sp[2])
-        synchronize(self.axes)
+        # synchronize(self.axes), written out for three axes
+        tx, ty, tz = ax._t1 + ax._t2 + ax._t3, ay._t1 + ay._t2 + ay._t3, az._t1 + az._t2 + az._t3
+        if tx <= _EPS and ty <= _EPS and tz <= _EPS:
+            return
+        longest, desired = (1, ty) if ty > tx else (0, tx)
+        if tz > desired:
+            longest, desired = 2, tz
+        if desired <= _EPS:
+            return
+        if longest != 0 and tx < desired:
+            ax.update_durations_given_total_time(desired)
+        if longest != 1 and ty < desired:
+            ay.update_durations_given_total_time(desired)
+        if longest != 2 and tz < desired:
+            az.update_durations_given_total_time(desired)
 
     def _stretch_xy(self, vehicle_pos: Vec3) -> float:
         """Slow the trajectory while the vehicle lags behind it (PositionSmoothing::_generateTrajectory)."""

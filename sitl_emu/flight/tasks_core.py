@@ -148,12 +148,12 @@ class AutoCore:
         target, ff = wp.target_ned_m, _NO_FEEDFORWARD
         if kind == "land":
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
-        sm = self.smoother.generate(nav.pos_ned_m, target, ff, dt_s)
-        vz = self._unsmoothed_vz = sm.unsmoothed_velocity_ned_m_s[2]
+        vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
         yaw, yawspeed = self._limit_yaw_rate(nav, self._yaw_target(nav, wp), dt_s)
         self._kind_prev = kind
-        out = TrajectorySetpoint(sm.position_ned_m, sm.velocity_ned_m_s, sm.acceleration_ned_m_s2, yaw, yawspeed)
+        ax, ay, az = self.smoother.axes
+        out = TrajectorySetpoint((ax.x, ay.x, az.x), (ax.v, ay.v, az.v), (ax.a, ay.a, az.a), yaw, yawspeed)
         if nav.takeoff_state in PRE_RAMP_STATES:
             out = self._hold_before_ramp(nav, out)
         return out
