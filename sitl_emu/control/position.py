@@ -257,7 +257,10 @@ class PositionControl:
                     thr_max: float) -> PositionOutput:
         """`update` with the PositionLimits fields passed as floats (the cascade's path: no limits object)."""
         vel_dot = self._deriv.update(vel, dt_s, self.settings.veld_lp_hz)
-        sp, in_failsafe = self.select_setpoint(sp, now_us)
+        if sp is self._last_valid:  # select_setpoint's answer for the same (immutable, valid) setpoint object
+            self._invalid_since_us, in_failsafe = None, False
+        else:
+            sp, in_failsafe = self.select_setpoint(sp, now_us)
         vel_sp = self._position_control(pos, sp, vel_xy, vel_up, vel_dn)
         acc_sp, thr = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, tilt_rad, thr_min,
                                              thr_max, dt_s)
@@ -322,7 +325,18 @@ class PositionControl:
         t0, t1, t2 = z0 * c, z1 * c, z2 * c
         if (t2 >= -tmin and e2 >= 0.0) or (t2 <= -thr_max and e2 <= 0.0):
             e2 = 0.0  # vertical anti-windup
-        t0, t1, t2 = self._saturate_thrust(t0, t1, t2, thr_max)
+        # saturation: prioritise vertical thrust but keep MPC_THR_XY_MARG for horizontal control
+        xy = hypot(t0, t1)
+        tmax2 = thr_max * thr_max
+        margin = s.thr_xy_margin
+        allocated_xy = margin if margin < xy else xy  # min(xy, margin)
+        rem = tmax2 - allocated_xy * allocated_xy
+        lo = -sqrt(0.0 if rem < 0.0 else rem)  # -sqrt(max(rem, 0))
+        t2 = lo if lo > t2 else t2  # max(t2, lo)
+        rem = tmax2 - t2 * t2
+        xy_max = sqrt(0.0 if rem < 0.0 else rem)
+        if xy > xy_max:
+            t0, t1 = t0 / xy * xy_max, t1 / xy * xy_max
         # horizontal tracking anti-windup: feed back the part of the demand the thrust could not produce
         k = G / h
         prod_x, prod_y = t0 * k, t1 * k
@@ -340,22 +354,6 @@ class PositionControl:
         i2 = integ[2]
         integ[2] = -G if i2 < -G else (G if i2 > G else i2)
         return (a0, a1, a2), (t0, t1, t2)
-
-    def _saturate_thrust(self, t0: float, t1: float, t2: float, thr_max: float) -> Vec3:
-        """Prioritise vertical thrust but keep MPC_THR_XY_MARG for horizontal control (min/max as exact
-        conditionals: min(a, b) is `b if b < a else a`)."""
-        xy = hypot(t0, t1)
-        tmax2 = thr_max * thr_max
-        margin = self.settings.thr_xy_margin
-        allocated_xy = margin if margin < xy else xy
-        rem = tmax2 - allocated_xy * allocated_xy
-        lo = -sqrt(0.0 if rem < 0.0 else rem)  # -sqrt(max(rem, 0))
-        tz = lo if lo > t2 else t2  # max(t2, lo)
-        rem = tmax2 - tz * tz
-        xy_max = sqrt(0.0 if rem < 0.0 else rem)
-        if xy > xy_max:
-            return t0 / xy * xy_max, t1 / xy * xy_max, tz
-        return t0, t1, tz
 
 
 __all__ = ["NAN", "NAN3", "PositionControl", "PositionControlSettings", "PositionLimits", "PositionOutput"]
