@@ -111,7 +111,8 @@ class _ReferenceRate:
     """RateControl with the per-axis loops, list comprehensions and min/max of its readable form."""
 
     def __init__(self, s: RateControlSettings) -> None:
-        self.s, self.integ, self.prev, self.acc, self.yaw = s, [0.0, 0.0, 0.0], None, [0.0, 0.0, 0.0], 0.0
+        self.s, self.integ, self.acc, self.yaw = s, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], 0.0
+        self.prev: Vec3 | None = None
 
     def update(self, rates: Vec3, sp: Vec3, dt: float, landed: bool, sat_pos: tuple[bool, bool, bool],
                sat_neg: tuple[bool, bool, bool]) -> Vec3:

@@ -59,6 +59,8 @@ class MulticopterControl:
         self._version = -1
         self._sat_pos: tuple[bool, bool, bool] = (False, False, False)
         self._sat_neg: tuple[bool, bool, bool] = (False, False, False)
+        self._local_setpoint: TrajectorySetpoint | None = None
+        self._local_out: PositionOutput | None = None
         self.position = PositionControl()
         self.attitude = AttitudeControl()
         self.rate = RateControl()
@@ -112,8 +114,8 @@ class MulticopterControl:
         self.hte.reset()
         self._hte_in_air = False
         self.rate.reset()
-        self._local_setpoint: TrajectorySetpoint | None = None
-        self._local_out: PositionOutput | None = None  # the local setpoint's source, until it is built
+        self._local_setpoint = None
+        self._local_out = None  # the local setpoint's source, until it is built
         self._q_sp: Vec4 | None = None
         self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
         self._thrust = 0.0
@@ -188,7 +190,7 @@ class MulticopterControl:
         thrust = thrust if thrust < 1.0 else 1.0
         q = sp.q_wxyz
         if q is not None and isfinite(q[0]) and isfinite(q[1]) and isfinite(q[2]) and isfinite(q[3]):
-            q_sp = q_normalized(sp.q_wxyz)
+            q_sp = q_normalized(q)
             yaw_ff = sp.body_rates_rad_s[2] if math.isfinite(sp.body_rates_rad_s[2]) else 0.0
             return q_sp, self.attitude.update(state.q_wxyz, q_sp, yaw_ff), thrust
         r = sp.body_rates_rad_s
