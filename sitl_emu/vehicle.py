@@ -72,8 +72,10 @@ class Vehicle:
 
     def _boot(self) -> None:
         self._snap: VehicleSnapshot | None = None
-        self._geo_of: Vec3 | None = None  # the position (tuple object) self._geo was computed for
-        self._geo: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        # lat/lon of the last snapshot and the north/east float objects they were computed from (at rest physics
+        # passes the same objects on); the altitude is recomputed (it is one subtraction)
+        self._geo_of: tuple[object, object] = (None, None)
+        self._lat_lon: tuple[float, float] = (0.0, 0.0)
         self._euler_of: Vec4 | None = None  # the quaternion (tuple object) self._euler was computed for
         self._euler: Vec3 = (0.0, 0.0, 0.0)
         self._time_us = 0
@@ -228,9 +230,14 @@ class Vehicle:
         position or attitude tuple, e.g. at rest) is reused, not recomputed."""
         c, s = self.commander, self._estimate
         pos, q = s.pos_ned_m, s.q_wxyz
-        if pos is not self._geo_of:
-            self._geo_of, self._geo = pos, ned_to_global(self.ref, pos)
-        lat, lon, alt = self._geo
+        north, east = pos[0], pos[1]
+        geo_of = self._geo_of
+        if north is not geo_of[0] or east is not geo_of[1]:
+            lat, lon, alt = ned_to_global(self.ref, pos)
+            self._geo_of, self._lat_lon = (north, east), (lat, lon)
+        else:
+            lat, lon = self._lat_lon
+            alt = self.ref.alt_amsl_m - pos[2]  # as ned_to_global computes it
         if q is not self._euler_of:
             self._euler_of, self._euler = q, _euler(q)
         ctrl = self.parts.control

@@ -63,6 +63,11 @@ def test_position_attitude_and_status_follow_the_vehicle_through_a_flight():
         s = _check(v)
     assert s.nav_state == NavState.OFFBOARD and s.offboard_control is not None
     assert s.lat_deg > resting.lat_deg + 5e-5  # ~10 m north moves the latitude by ~9e-5 degrees
+    _command(v, 21)  # land there, then rest on the ground (disarmed) away from the origin
+    for _ in range(60):
+        v.run_for(0.25)
+        s = _check(v)
+    assert not s.armed and s.lat_deg > resting.lat_deg + 5e-5 and abs(s.alt_amsl_m - resting.alt_amsl_m) < 0.05
 
 
 def test_the_snapshot_is_rebuilt_after_a_step_and_after_an_input():
