@@ -22,6 +22,7 @@ import struct
 import zlib
 from typing import Any, ClassVar
 
+from sitl_emu.mavlink.fastpack import ENCODER
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import Severity
 
@@ -202,14 +203,14 @@ class ParamProtocol:
             wire = int32_to_float_bits(int(value))
         else:
             wire = float(value)
-        return ctx.mav.param_value_encode(name.encode("ascii"), wire, _TYPE_CODES[definition.type], len(registry),
+        return ENCODER.param_value_encode(name.encode("ascii"), wire, _TYPE_CODES[definition.type], len(registry),
                                           registry.index_of(name))
 
     @staticmethod
     def _hash_msg(ctx: Any) -> Any:
         registry: ParamRegistry = ctx.vehicle.params
         wire = uint32_to_float_bits(px4_param_hash(registry))
-        return ctx.mav.param_value_encode(HASH_CHECK_NAME.encode("ascii"), wire, MAV_PARAM_TYPE_UINT32, len(registry),
+        return ENCODER.param_value_encode(HASH_CHECK_NAME.encode("ascii"), wire, MAV_PARAM_TYPE_UINT32, len(registry),
                                           HASH_CHECK_INDEX)
 
 

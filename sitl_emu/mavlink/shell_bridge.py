@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from sitl_emu.mavlink.fastpack import ENCODER
 from sitl_emu.shell import Shell
 
 SERIAL_CONTROL_DEV_SHELL = 10
@@ -97,7 +98,7 @@ class ShellBridge:
             chunk = bytes(self._out[:MAX_CHUNK])
             del self._out[:MAX_CHUNK]
             data = list(chunk) + [0] * (MAX_CHUNK - len(chunk))
-            ctx.send(ctx.mav.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
+            ctx.send(ENCODER.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
                                                    len(chunk), data))
 
     def _collect_events(self, ctx: Any) -> None:
