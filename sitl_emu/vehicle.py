@@ -45,6 +45,7 @@ from sitl_emu.vehicle_parts import Parts, yaw_of
 
 EVENT_HISTORY = 1000
 COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
+_TERMINATION = NavState.TERMINATION  # a module constant: enum member lookups cost on the per-tick path
 
 
 class Vehicle:
@@ -119,7 +120,7 @@ class Vehicle:
         parts = self.parts
         out = parts.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
-        armed = c.armed and c.nav_state != NavState.TERMINATION
+        armed = c.armed and c.nav_state != _TERMINATION
         motors = parts.control.update(self._estimate, out.trajectory, out.attitude, armed, c.landed, now, dt_s,
                                       ground_contact=parts.ground_contact, want_takeoff=out.want_takeoff)
         sih = self._sih if self.params.version == self._sih_version else self._sih_config()

@@ -24,6 +24,9 @@ from sitl_emu.types import NAN, CommandAck, HomePosition, OffboardControlMode, V
 Emit = Callable[[Severity, str, str, bool, bool], None]
 # geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
 NedOf = Callable[[float, float, float], Vec3]
+# module constants: enum member lookups cost on the per-cycle path
+_TERMINATION = NavState.TERMINATION
+_AUTO_TAKEOFF = NavState.AUTO_TAKEOFF
 
 
 @dataclass(frozen=True, slots=True)
@@ -244,7 +247,7 @@ class Commander:
                 user, self._ready, self.home is not None, self.offboard_fresh(now_us))):
             # the common case, decided without allocations: Failsafe.update would return Decision(user, False)
             self._failsafe.active = False
-            self.nav_state = NavState.TERMINATION if armed and self.nav_state == NavState.TERMINATION else user
+            self.nav_state = _TERMINATION if armed and self.nav_state == _TERMINATION else user
             self.failsafe = False
             return
         inputs = self.check_inputs(now_us)
@@ -264,10 +267,15 @@ class Commander:
 
     # ---- the periodic update ------------------------------------------------------------------------------------
     def update(self, now_us: int) -> None:
-        """One commander cycle: readiness, home, auto-disarm, takeoff completion, the mode in force."""
-        self._update_ready()
-        self._auto_disarm(now_us)
-        self._takeoff_completion()
+        """One commander cycle: readiness, home, auto-disarm, takeoff completion, the mode in force.
+
+        Each step is called only when its own first checks would not make it return at once (every 8 ms)."""
+        if self._ready and (self.home is None or not self._ready_announced):
+            self._update_ready()
+        if self.armed:
+            self._auto_disarm(now_us)
+            if self.nav_state == _AUTO_TAKEOFF:
+                self._takeoff_completion()
         self._apply_mode(now_us)
 
     def _update_ready(self) -> None:
@@ -297,7 +305,7 @@ class Commander:
 
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
-        if (self.armed and not self.landed and self.nav_state == NavState.AUTO_TAKEOFF
+        if (self.armed and not self.landed and self.nav_state == _AUTO_TAKEOFF
                 and self._task_finished):
             self.change_mode(NavState.AUTO_LOITER)
 

@@ -27,6 +27,7 @@ from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetp
 TASK_PERIOD_US = 8000
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
                          NavState.AUTO_RTL})
+_OFFBOARD = NavState.OFFBOARD  # a module constant: enum member lookups cost on the per-tick path
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,7 +76,7 @@ class ModeExecutor:
             new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
         else:
             new_task = False  # no command and the task (or its absence) still fits: _select_task changes nothing
-        if nav_state == NavState.OFFBOARD:
+        if nav_state == _OFFBOARD:
             out = self._offboard_out
             if out is None:
                 out = self._offboard_out = self._offboard_output()
