@@ -77,8 +77,17 @@ class AxisSmoother:
             self._dir = 0
             self._t1 = self._t2 = self._t3 = 0.0
             return
-        self._dir = self._direction()
-        jerk = self._dir * self.max_jerk
+        # the jerk direction: towards vel_sp from the velocity reached once the acceleration is brought to zero
+        vel_zero_acc = v
+        if abs(a) > _EPS:
+            j_zero = -_sign(a) * self.max_jerk
+            t_zero = -a / j_zero
+            vel_zero_acc = v + a * t_zero + 0.5 * j_zero * t_zero * t_zero
+        direction = _sign(vel_sp - vel_zero_acc)
+        if direction == 0:
+            direction = _sign(a)
+        self._dir = direction
+        jerk = direction * self.max_jerk
         if abs(jerk) <= _EPS:
             self._t1 = self._t2 = self._t3 = 0.0
             return
@@ -86,7 +95,13 @@ class AxisSmoother:
         t1 = self._t1 = self._t1_min_time(a, dv, jerk)
         t3 = a / jerk + t1
         t3 = self._t3 = 0.0 if t3 < 0.0 else t3  # max(t3, 0.0)
-        self._t2 = self._t2_from(t1, t3, a, dv, jerk)
+        # T2 from the velocity the jerk phases leave to the constant-acceleration phase
+        den = a + jerk * t1
+        if abs(den) <= _EPS:
+            self._t2 = 0.0
+            return
+        t2 = (-0.5 * t1 * t1 * jerk - t1 * t3 * jerk - t1 * a + 0.5 * t3 * t3 * jerk - t3 * a + dv) / den
+        self._t2 = 0.0 if t2 < 0.0 else t2  # max(t2, 0.0)
 
     def update_durations_given_total_time(self, total_s: float) -> None:
         """Stretch the current plan so that it lasts `total_s` (used to synchronise the axes)."""
@@ -143,15 +158,6 @@ class AxisSmoother:
         t = max(t, 0.0)
         return j, a0 + j * t, v0 + a0 * t + 0.5 * j * t * t, x0 + v0 * t + 0.5 * a0 * t * t + j * t * t * t / 6.0
 
-    def _direction(self) -> int:
-        vel_zero_acc = self.v
-        if abs(self.a) > _EPS:
-            j_zero = -_sign(self.a) * self.max_jerk
-            t_zero = -self.a / j_zero
-            vel_zero_acc = self.v + self.a * t_zero + 0.5 * j_zero * t_zero * t_zero
-        direction = _sign(self._vel_sp - vel_zero_acc)
-        return direction if direction != 0 else _sign(self.a)
-
     def _saturate_t1(self, a0: float, jerk: float, t1: float) -> float:
         accel_t1 = a0 + jerk * t1
         if accel_t1 > self.max_accel:
@@ -183,20 +189,18 @@ class AxisSmoother:
             return 0.0
         root = math.sqrt(delta)
         t1 = 0.0
-        for cand in (max((-qb + root) / (2.0 * qa), 0.0), max((-qb - root) / (2.0 * qa), 0.0)):
+        cand = (-qb + root) / (2.0 * qa)
+        cand = 0.0 if cand < 0.0 else cand  # max(cand, 0.0)
+        t3 = a0 / jerk + cand
+        if t3 >= 0.0 and cand + t3 <= total:
+            t1 = cand
+        else:
+            cand = (-qb - root) / (2.0 * qa)
+            cand = 0.0 if cand < 0.0 else cand
             t3 = a0 / jerk + cand
             if t3 >= 0.0 and cand + t3 <= total:
                 t1 = cand
-                break
         return self._saturate_t1(a0, jerk, t1)
-
-    @staticmethod
-    def _t2_from(t1: float, t3: float, a0: float, dv: float, jerk: float) -> float:
-        den = a0 + jerk * t1
-        if abs(den) <= _EPS:
-            return 0.0
-        t2 = (-0.5 * t1 * t1 * jerk - t1 * t3 * jerk - t1 * a0 + 0.5 * t3 * t3 * jerk - t3 * a0 + dv) / den
-        return 0.0 if t2 < 0.0 else t2  # max(t2, 0.0)
 
 
 def synchronize(axes: list[AxisSmoother]) -> None:
