@@ -29,6 +29,7 @@ from typing import Any
 
 from sitl_emu.mavlink.link import Address
 from sitl_emu.params import default_registry
+from sitl_emu.runner import SocketWatch
 from sitl_emu.server import IO_BUDGET_DATAGRAMS, LinkSettings, VehicleNode
 from sitl_emu.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner, build_nodes
 from sitl_emu.vehicle import Vehicle
@@ -110,6 +111,7 @@ class Sim:
             for node in self.nodes:
                 node.api.link.remote = sink
         self._tracks = [_Track() for _ in self.nodes]
+        self._watch = SocketWatch(self.nodes)
         self._time_us = 0
         self.clock = LockstepClock(self)
         self._runner: SwarmRunner | None = None
@@ -149,10 +151,12 @@ class Sim:
     def advance_to(self, target_us: int) -> None:
         """Step every vehicle tick by tick up to `target_us` of Sim time, with each node's I/O after its tick."""
         self._require_lockstep()
+        look = self._watch.ready
         stepped = True
         while stepped:
             stepped = False
-            for node, track in zip(self.nodes, self._tracks, strict=True):
+            ready = look()  # one look at every socket per tick: a node reads only the links with data waiting
+            for index, (node, track) in enumerate(zip(self.nodes, self._tracks, strict=True)):
                 vehicle = node.vehicle
                 before = vehicle.time_us
                 if track.base_us + before + vehicle.dt_us > target_us:
@@ -160,7 +164,7 @@ class Sim:
                 vehicle.step()
                 if vehicle.time_us < before:  # rebooted: its time restarts at 0 now
                     track.base_us += before
-                node.step_io(vehicle.time_us)
+                node.step_io(vehicle.time_us, ready.get(index, 0) if ready else 0)
                 stepped = True
         self._time_us = max(self._time_us, target_us)
 
@@ -205,6 +209,7 @@ class Sim:
     # --- lifetime ----------------------------------------------------------------------------------------------
     def close(self) -> None:
         self.stop()
+        self._watch.close()
         for node in self.nodes:
             node.close()
         self._sink.close()

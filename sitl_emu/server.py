@@ -22,6 +22,10 @@ from sitl_emu.types import VehicleSnapshot
 log = logging.getLogger(__name__)
 
 IO_BUDGET_DATAGRAMS = 200  # per link per step_io: a flood waits in the socket buffer instead of starving physics
+# `readable` bits of step_io: which links have datagrams waiting (runners learn it from one epoll per tick)
+READ_API = 1
+READ_GCS = 2
+READ_BOTH = READ_API | READ_GCS
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,23 +83,33 @@ class VehicleNode:
         return "; ".join(parts)
 
     def filenos(self) -> list[int]:
+        """The sockets' descriptors, API link first (the order of the READ_API, READ_GCS bits)."""
         return [ep.link.fileno() for ep in self.endpoints]
 
     # --- the one call a runner makes -----------------------------------------------------------------------------
-    def step_io(self, now_us: int) -> int:
-        """Handle what arrived, then send what is due at `now_us`. Returns the number of datagrams read."""
+    def step_io(self, now_us: int, readable: int = READ_BOTH) -> int:
+        """Handle what arrived, then send what is due at `now_us`. Returns the number of datagrams read.
+
+        `readable` (READ_API | READ_GCS bits) names the links to read. A runner that watches the sockets passes the
+        links that have data waiting, so an idle link costs no recvfrom; by default both are read. Skipping a link
+        with nothing waiting changes nothing else: emit() sets the endpoint's time as poll() would have.
+        Called every tick for every vehicle, so it is written flat (no loops over the two endpoints).
+        """
         if now_us < self._last_now_us:  # the vehicle rebooted (time starts again at 0): restart the schedules
             for ep in self.endpoints:
                 ep.restart()
         self._last_now_us = now_us
         received = 0
-        for ep in self.endpoints:
-            received += ep.poll(now_us, self.io_budget)
+        if readable:
+            if readable & READ_API:
+                received = self.api.poll(now_us, self.io_budget)
+            if readable & READ_GCS:
+                received += self.gcs.poll(now_us, self.io_budget)
         events = self.vehicle.events_after(self._event_seq)
         if events:
             self._event_seq = events[-1].seq
-        for ep in self.endpoints:
-            ep.emit(now_us, events)
+        self.api.emit(now_us, events)
+        self.gcs.emit(now_us, events)
         return received
 
     # --- services for the endpoints ------------------------------------------------------------------------------

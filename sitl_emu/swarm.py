@@ -21,7 +21,7 @@ from dataclasses import replace
 from typing import Any
 
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.runner import MAX_LAG_US, RealTimeRunner, _wait_readable
+from sitl_emu.runner import MAX_LAG_US, RealTimeRunner, SocketWatch
 from sitl_emu.server import LinkSettings, VehicleNode
 
 log = logging.getLogger(__name__)
@@ -85,55 +85,72 @@ class SwarmRunner(RealTimeRunner):
         self.timeline_us = 0  # simulated time since this runner was created, the same for every vehicle
         self._last_warning_s = -math.inf
 
-    def run(self, duration_s: float | None = None) -> None:
-        """Run until stopped, or for `duration_s` more of simulated time."""
+    def _run(self, duration_s: float | None, watch: SocketWatch) -> None:
+        """Run until stopped, or for `duration_s` more of simulated time (RealTimeRunner.run opens `watch`)."""
         dt_us = int(self.nodes[0].vehicle.dt_us)
         end_us = None if duration_s is None else self.timeline_us + round(duration_s * 1e6)
         anchor_us, start_wall = self.timeline_us, time.monotonic()
-        fds = [fd for node in self.nodes for fd in node.filenos()]
-        while not self._stop.is_set():
-            target_us = anchor_us + int((time.monotonic() - start_wall) * 1e6 * self.speed)
-            if end_us is not None:
-                target_us = min(target_us, end_us)
+        ready: dict[int, int] | None = None  # None: not known, look before the first tick
+        stop = self._stop
+        while not stop.is_set():
+            woke = time.monotonic()
+            target_us = anchor_us + int((woke - start_wall) * 1e6 * self.speed)
+            if end_us is not None and end_us < target_us:
+                target_us = end_us
             lag_us = target_us - self.timeline_us
             if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
                 anchor_us -= lag_us - MAX_LAG_US
                 target_us -= lag_us - MAX_LAG_US
                 self.dropped_us += lag_us - MAX_LAG_US
                 self._warn_lag(lag_us)
-            self._advance(target_us, dt_us)
+            self._advance(target_us, dt_us, ready)
             for hook in self.hooks:
                 hook()
             self.iterations += 1
             if end_us is not None and self.timeline_us >= end_us:
                 break
             next_wall = start_wall + (self.timeline_us + dt_us - anchor_us) / 1e6 / self.speed
+            if next_wall < woke + self.min_wake_s:  # batching: wake at a steady period, however long this batch took
+                next_wall = woke + self.min_wake_s
             timeout = next_wall - time.monotonic()
-            if timeout > 0:
-                _wait_readable(fds, max(timeout, self.min_wake_s))
+            ready = watch.ready(timeout) if timeout > 0 else None
 
-    def _advance(self, target_us: int, dt_us: int) -> None:
+    def _advance(self, target_us: int, dt_us: int, ready: dict[int, int] | None) -> None:
+        """Every tick due by `target_us`: all physics of the tick, then all I/O (~7 % faster than interleaving: the
+        same code runs back to back, caches stay warm). One look at the sockets per tick says which nodes read;
+        `ready` (what the wake-up saw) serves the first tick."""
+        assert self._watch is not None
+        look = self._watch.ready
         stepped_any = False
         nodes, offsets = self.nodes, self._offsets_us
         while self.timeline_us + dt_us <= target_us:
             due = []
-            for i, node in enumerate(nodes):  # all physics of this tick first, then all I/O: ~7% faster than
-                vehicle = node.vehicle         # interleaving (the same code runs back to back, caches stay warm)
-                before_us = int(vehicle.time_us)
+            for i, node in enumerate(nodes):
+                vehicle = node.vehicle
+                before_us = vehicle.time_us
                 if before_us + offsets[i] + dt_us > target_us:
                     continue
                 vehicle.step()
                 if vehicle.time_us < before_us:  # rebooted: its clock restarts at 0, its place on the timeline stays
                     offsets[i] += before_us
-                due.append(node)
-            for node in due:
-                node.step_io(node.vehicle.time_us)
+                due.append(i)
+            if stepped_any or ready is None:
+                ready = look()
+            if ready:
+                for i in due:
+                    node = nodes[i]
+                    node.step_io(node.vehicle.time_us, ready.get(i, 0))
+            else:
+                for i in due:
+                    node = nodes[i]
+                    node.step_io(node.vehicle.time_us, 0)
             self.steps += len(due)
             stepped_any = stepped_any or bool(due)
             self.timeline_us += dt_us
         if not stepped_any:  # woken by a datagram between ticks: answer it now
-            for node in nodes:
-                node.step_io(node.vehicle.time_us)
+            for i, readable in (look() if ready is None else ready).items():
+                node = nodes[i]
+                node.step_io(node.vehicle.time_us, readable)
 
     def _warn_lag(self, lag_us: int) -> None:
         now = time.monotonic()
