@@ -5,10 +5,10 @@ objects; at ~700 messages per simulated second per vehicle that was most of the 
 - `ENCODER.<name>_encode(...)` takes the same arguments (and defaults) as pymavlink's `MAVLink.<name>_encode` and
   returns a `Packed`: the message's spec and its field values in wire order, packed when sent (as pymavlink packs a
   message object when it is sent, so a value out of its wire range fails at the same place).
-- `payload_of(msg)` gives the payload of a pymavlink message object (what handlers build with `ctx.mav`).
-- `frame(...)` wraps a payload into a MAVLink 2 frame: trailing zero bytes of the payload cut (at least one byte
-  kept), incompat/compat flags 0, X.25 (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra.
-  No signing: PX4 SITL does not sign (MAV_SIGN_CFG 0), nor do we.
+- `frame_message(msg, seq, sysid, compid)` frames a Packed or any pymavlink message object (what handlers build
+  with `ctx.mav`) as MAVLink 2: trailing zero bytes of the payload cut (at least one byte kept), incompat/compat
+  flags 0, X.25 (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra. No signing: PX4 SITL
+  does not sign (MAV_SIGN_CFG 0), nor do we. The caller owns the sequence number (Endpoint: its `mav.seq`).
 
 The field order, struct layout and crc_extra come from the pymavlink message classes themselves, so the wire format is
 theirs. Each class gets two small functions generated from that metadata, mirroring pymavlink's own generated

@@ -91,6 +91,8 @@ class UdpLink:
         self.stats.tx_bytes += len(data)
 
     def close(self) -> None:
+        if self._poller is not None and self._sock.fileno() >= 0:
+            self._poller.unregister(self._sock)  # its number may be reused by a later socket
         self._sock.close()
 
     def _note_sender(self, addr: Address) -> None:
