@@ -28,7 +28,7 @@ from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.physics import RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
-from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, LandedState, MavState, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
@@ -46,6 +46,7 @@ from sitl_emu.vehicle_parts import Parts, yaw_of
 EVENT_HISTORY = 1000
 COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
 _TERMINATION = NavState.TERMINATION  # a module constant: enum member lookups cost on the per-tick path
+_STATUS_VALUES = {status: float(status) for status in MavState}  # snapshot extras["system_status"]
 
 
 class Vehicle:
@@ -242,14 +243,14 @@ class Vehicle:
         if q is not self._euler_of:
             self._euler_of, self._euler = q, _euler(q)
         ctrl = self.parts.control
-        pre_flight_ok = c.pre_flight_checks_pass()
+        pre_flight_ok, offboard, status = c.telemetry_status()
         ref = self.ref
         return _new_snapshot((  # the fields in _SNAPSHOT_FIELDS order
             self._time_us, c.armed, c.nav_state, c.intention.user_intended, c.failsafe, self.landed_state(),
-            pre_flight_ok, c.estimator_ready, c.have_taken_off, c.offboard_mode, pos, s.vel_ned_m_s,
+            pre_flight_ok, c.estimator_ready, c.have_taken_off, offboard, pos, s.vel_ned_m_s,
             s.acc_ned_m_s2, q, s.rates_frd_rad_s, self._euler, lat, lon, alt, ref.lat_deg, ref.lon_deg,
             ref.alt_amsl_m, c.home, ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s,
-            ctrl.thrust_setpoint, self._state.motors, {"system_status": float(c.system_status(pre_flight_ok))},
+            ctrl.thrust_setpoint, self._state.motors, {"system_status": _STATUS_VALUES[status]},
         ))
 
 
@@ -284,5 +285,7 @@ def _euler(q: Vec4) -> Vec3:
     """(roll, pitch, yaw) of a w-first quaternion, ZYX (PX4 matrix::Eulerf)."""
     w, x, y, z = q
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch, yaw_of(q)
+    sin_pitch = 2.0 * (w * y - z * x)
+    sin_pitch = sin_pitch if sin_pitch < 1.0 else 1.0  # max(-1.0, min(1.0, sin_pitch)), NaN kept
+    pitch = math.asin(sin_pitch if sin_pitch > -1.0 else -1.0)
+    return roll, pitch, math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))  # yaw_of(q)

@@ -169,6 +169,13 @@ class Commander:
         return arming.can_arm_now(self.nav_state, self._ready, self.home is not None,
                                   self.offboard_fresh(self._now_us), self.armed)
 
+    def telemetry_status(self) -> tuple[bool, OffboardControlMode | None, MavState]:
+        """(pre_flight_checks_pass(), offboard_mode, system_status()) together, checking the offboard signal's
+        freshness once (the vehicle's snapshot needs all three whenever telemetry is due)."""
+        fresh = self.offboard_fresh(self._now_us)
+        ok = arming.can_arm_now(self.nav_state, self._ready, self.home is not None, fresh, self.armed)
+        return ok, (self._offboard_mode if fresh else None), self.system_status(ok)
+
     def system_status(self, pre_flight_checks_pass: bool | None = None) -> MavState:
         """HEARTBEAT.system_status (HEARTBEAT.hpp); pass pre_flight_checks_pass() if you already have it."""
         if self.nav_state == NavState.TERMINATION and self.armed:
