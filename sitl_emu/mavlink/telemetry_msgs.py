@@ -263,11 +263,20 @@ def _mm(m: float) -> int:
 
 
 def _int32(x: float) -> int:
-    return max(min(_iround(x), 2**31 - 1), -(2**31))
+    """_iround(x) clamped to int32 (written out: called for every position field of the 50 Hz streams)."""
+    if not math.isfinite(x):
+        return 0
+    r = round(x)
+    return 2147483647 if r > 2147483647 else -2147483648 if r < -2147483648 else r
 
 
 def _cm_s(m_s: float) -> int:
-    return max(min(_iround(m_s * 100.0), 32767), -32768)
+    """_iround(m_s * 100) clamped to int16, written out as _int32."""
+    x = m_s * 100.0
+    if not math.isfinite(x):
+        return 0
+    r = round(x)
+    return 32767 if r > 32767 else -32768 if r < -32768 else r
 
 
 def _wrap_2pi(a: float) -> float:
