@@ -259,3 +259,16 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
         assert must <= seen, sorted(must - seen)
     finally:
         h.close()
+
+
+def test_integer_fields_saturate_and_send_zero_for_non_finite_values():
+    from sitl_emu.mavlink import telemetry_msgs as tm
+
+    def int32_ref(x: float) -> int:
+        return max(min(round(x) if math.isfinite(x) else 0, 2**31 - 1), -(2**31))
+
+    rng = random.Random(3)
+    values = [0.5, 1.5, -2.5, NAN, math.inf, -math.inf, 2**31 - 0.5, 2**31 - 0.6, -(2**31) - 0.5, 1e300, -1e300]
+    for x in values + [rng.uniform(-5e9, 5e9) for _ in range(2000)]:
+        assert tm._int32(x) == int32_ref(x)
+        assert tm._cm_s(x / 100.0) == max(min(int32_ref(x / 100.0 * 100.0), 32767), -32768)
