@@ -238,7 +238,7 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
         h.gcs.send(mav.param_request_read_encode(1, 1, b"MPC_XY_VEL_MAX", -1))
         h.gcs.send(mav.mission_request_list_encode(1, 1, 0))
         h.gcs.send(mav.mission_count_encode(1, 1, 3, 0))
-        for msg_id, param2 in ((148, 0), (300, 0), (435, 0)):
+        for msg_id, param2 in ((148, 0), (300, 0), (435, 0), (242, 0), (245, 0), (147, 0)):
             h.gcs.command_long(512, msg_id, param2)
         h.gcs.command_long(400, 1.0)  # arm: denied before the estimator is ready -> a status text
         h.gcs.send(mav.serial_control_encode(10, 2, 0, 0, 5, list(b"help\n") + [0] * 65))
