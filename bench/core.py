@@ -67,13 +67,20 @@ def core_speed() -> tuple[float, float]:
 
 def core_speed_with_io() -> float:
     """Simulated s per CPU s of the same manoeuvre with a node doing its MAVLink I/O after every step (default
-    streams on both links, sent to a socket nobody reads)."""
+    streams on both links, sent to a socket nobody reads; a link is read when the runners' socket watch says so)."""
     from sitl_emu.api import Sim
+    from sitl_emu.runner import SocketWatch
 
     with Sim() as sim:
         node = sim.nodes[0]
         v = node.vehicle
+        look = SocketWatch(sim.nodes).ready  # as the runners do: one look at the sockets per tick
+
+        def io() -> None:
+            ready = look()
+            node.step_io(v.time_us, ready.get(0, 0) if ready else 0)
+
         cpu = time.process_time()
-        manoeuvre(v, lambda: node.step_io(v.time_us))
+        manoeuvre(v, io)
         cpu = time.process_time() - cpu
         return v.time_us / 1e6 / cpu

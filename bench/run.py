@@ -2,7 +2,10 @@
 
 Figures (targets from issue 4 in brackets):
   core        simulated seconds per CPU second, one vehicle, fixed manoeuvre, no I/O [>= 1000]; and with I/O
-  serve       `sitl-emu serve` at real time, hovering, default streams on both links: % of one core [<= 3]
+  runner      the runners' own cost: a stub vehicle (no physics) at real time, % of one core and CPU per tick; the
+              swarm runner's CPU per vehicle-tick with 100 stub vehicles (bench/runner.py)
+  serve       `sitl-emu serve` at real time, hovering, default streams on both links: % of one core [<= 3], with
+              the default batching, waking every tick, and --batch-ms 20
   startup     wall time from process start to the first HEARTBEAT [< 0.5 s] and to health all good
   flight      reference loopback flight (arm, takeoff, OFFBOARD square, land) by a scripted pymavlink client:
               in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
@@ -26,9 +29,10 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
-from bench import core, scale, serve  # noqa: E402
+from bench import core, runner, scale, serve  # noqa: E402
+from sitl_emu.cli import DEFAULT_BATCH_MS  # noqa: E402
 
-NAMES = ("core", "serve", "startup", "flight", "latency", "scale")
+NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale")
 
 
 def say(line: str) -> None:
@@ -52,11 +56,29 @@ def bench_core(quick: bool) -> None:
         f"streams on both links, best of {runs})")
 
 
+def bench_runner(quick: bool) -> None:
+    seconds = 3.0 if quick else 10.0
+    share, per_tick = runner.real_time_share(seconds)
+    bare, per_wake = runner.real_time_share(seconds, streams=False)
+    batched, _ = runner.real_time_share(seconds, DEFAULT_BATCH_MS / 1000.0)
+    say(f"runner at real time, stub vehicle (no physics), default streams: {share:.1f} % of one core waking every "
+        f"tick ({per_tick:.0f} us CPU per tick), {batched:.1f} % with the default --batch-ms {DEFAULT_BATCH_MS:g}; "
+        f"streams off: {bare:.1f} % ({per_wake:.0f} us per tick and wake-up)")
+    count = 100
+    per_vehicle = runner.swarm_tick_cost(count, 1.0 if quick else 4.0)
+    bare_vehicle = runner.swarm_tick_cost(count, 1.0 if quick else 4.0, streams=False)
+    say(f"swarm runner, {count} stub vehicles, CPU-bound: {per_vehicle:.1f} us per vehicle-tick with default streams, "
+        f"{bare_vehicle:.1f} us with streams off (runner + node + links alone)")
+
+
 def bench_serve(quick: bool) -> None:
     seconds = 5.0 if quick else 30.0
     share = serve.hover_cpu_share(seconds)
-    say(f"serve at real time: {share:.1f} % of one core (hovering {seconds:.0f} s, default streams on both links; "
-        "target <= 3)")
+    say(f"serve at real time: {share:.1f} % of one core (hovering {seconds:.0f} s, default streams on both links, "
+        f"default --batch-ms {DEFAULT_BATCH_MS:g}; target <= 3)")
+    every_tick = serve.hover_cpu_share(seconds, ("--batch-ms", "0"))
+    say(f"serve at real time --batch-ms 0: {every_tick:.1f} % of one core (same, waking for every 4 ms tick as PX4 "
+        "SITL does)")
     batched = serve.hover_cpu_share(seconds, ("--batch-ms", "20"))
     say(f"serve at real time --batch-ms 20: {batched:.1f} % of one core (same, waking every 20 ms)")
 
@@ -105,7 +127,7 @@ def bench_latency(quick: bool) -> None:
 def bench_scale(quick: bool) -> None:
     cpu = sorted(os.sched_getaffinity(0))[-1]
     seconds = 3.0 if quick else 8.0
-    best, trials = scale.search(1 if quick else 4, 256, seconds, cpu)
+    best, trials = scale.search(8, 256, seconds, cpu)
     tried = ", ".join(f"{n} {'ok' if scale.on_time(r) else 'late'} ({r['cpu_share'] * 100:.0f} % cpu, "
                       f"lag {r['max_lag_s'] * 1000:.0f} ms)" for n, r in trials)
     ok = [(n, r) for n, r in trials if scale.on_time(r) and r["cpu_share"] > 0]
@@ -115,7 +137,7 @@ def bench_scale(quick: bool) -> None:
 
 
 BENCHES: dict[str, Callable[[bool], None]] = {
-    "core": bench_core, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
+    "core": bench_core, "runner": bench_runner, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
     "latency": bench_latency, "scale": bench_scale,
 }
 
