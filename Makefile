@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench clean speedups clean-speedups
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -27,5 +27,14 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(BIN)/python -m bench
 
-clean:
+# Opt-in: compile the vehicle core's hot modules in place with mypyc (tools/build_speedups.py). Nothing else
+# compiles anything; a stale build is bypassed at import with a warning (sitl_emu/_speedups.py).
+speedups: $(STAMP)
+	$(BIN)/python tools/build_speedups.py
+
+clean-speedups:
+	find sitl_emu -name '*.so' -delete
+	rm -rf sitl_emu/_speedups_manifest.json build/mypyc
+
+clean: clean-speedups
 	rm -rf $(VENV) build *.egg-info

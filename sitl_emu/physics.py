@@ -45,6 +45,11 @@ class RigidBodyState:
     on_ground: bool = True
 
 
+# RigidBodyState's field names, for copying a state: a class compiled by `make speedups` (mypyc) has no __slots__.
+RIGID_BODY_FIELDS = ("pos_ned_m", "vel_ned_m_s", "q_wxyz", "rates_frd_rad_s", "motors", "acc_ned_m_s2",
+                     "specific_force_frd", "on_ground")
+
+
 @dataclass(frozen=True, slots=True)
 class SihConfig:
     mass_kg: float = 1.0

@@ -18,17 +18,15 @@ from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint
 HOLD = TrajectorySetpoint(position_ned_m=(0.0, 0.0, -2.5))
 
 
-@pytest.fixture(scope="module")
-def hovering():
-    loop = hover_loop(2.5, settle_s=6.0)
-    return loop
+@pytest.fixture
+def hovering() -> ClosedLoop:
+    """A loop settled in hover, built anew for each test: it is deterministic, so this is the same as a copy, and
+    the controllers compiled by `make speedups` (mypyc) cannot be deep-copied."""
+    return hover_loop(2.5, settle_s=6.0)
 
 
-def fresh(hovering) -> ClosedLoop:
-    """A copy of the settled hover loop (cheaper than taking off again)."""
-    import copy
-
-    return copy.deepcopy(hovering)
+def fresh(hovering: ClosedLoop) -> ClosedLoop:
+    return hovering
 
 
 def test_takeoff_then_hover_holds_altitude(hovering):

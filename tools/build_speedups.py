@@ -1,0 +1,175 @@
+"""`make speedups`: compile the hot modules of the vehicle core in place with mypyc (opt-in, never by default).
+
+usage: .venv/bin/python tools/build_speedups.py [--clean] [MODULE.py ...]
+
+The compiled extension modules are written next to their sources (sitl_emu/.../*.so), plus one shared library
+(sitl_emu/_speedups_native__mypyc*.so) and a manifest (sitl_emu/_speedups_manifest.json) that records the sha256 of
+every source the build read. At import time sitl_emu/_speedups.py compares the manifest with the sources and falls
+back to the pure-Python modules, with one warning, when anything changed since the build.
+
+Exactness: the C compiler must evaluate every float expression as written. -ffp-contract=off forbids fusing a*b+c into
+one FMA (which rounds once instead of twice); nothing here passes -march=native or -ffast-math, and CFLAGS from the
+environment are ignored so they cannot bring either in.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = "sitl_emu"
+GROUP = "sitl_emu._speedups_native"  # the shared library: sitl_emu/_speedups_native__mypyc<EXT_SUFFIX>
+MANIFEST = ROOT / PACKAGE / "_speedups_manifest.json"
+BUILD_DIR = Path("build") / "mypyc"
+
+# The vehicle core's hot path, measured with `python -m bench --only core` (see README, "make speedups").
+DEFAULT_MODULES = (
+    "sitl_emu/physics.py",
+    "sitl_emu/control/attitude.py",
+    "sitl_emu/control/cascade.py",
+    "sitl_emu/control/hover.py",
+    "sitl_emu/control/mixer.py",
+    "sitl_emu/control/position.py",
+    "sitl_emu/control/qmath.py",
+    "sitl_emu/control/rate.py",
+    "sitl_emu/control/takeoff.py",
+)
+
+EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]
+
+
+def sha256_of(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def module_name(rel_path: str) -> str:
+    return rel_path.removesuffix(".py").replace("/", ".").removesuffix(".__init__")
+
+
+def _module_path(name: str) -> str | None:
+    for candidate in (name.replace(".", "/") + ".py", name.replace(".", "/") + "/__init__.py"):
+        if (ROOT / candidate).is_file():
+            return candidate
+    return None
+
+
+def _imported_modules(rel_path: str) -> set[str]:
+    """The sitl_emu modules one source imports (absolute imports only, as the code base uses)."""
+    tree = ast.parse((ROOT / rel_path).read_text(), rel_path)
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return {name for name in found if name.split(".")[0] == PACKAGE}
+
+
+def dependency_sources(compiled: list[str]) -> list[str]:
+    """Every sitl_emu source the compiled modules import, transitively (mypyc may bake their constants in)."""
+    seen: set[str] = set()
+    todo = list(compiled)
+    while todo:
+        rel = todo.pop()
+        if rel in seen:
+            continue
+        seen.add(rel)
+        parts = module_name(rel).split(".")
+        todo.extend(p for p in (_module_path(".".join(parts[:i])) for i in range(1, len(parts))) if p)
+        todo.extend(p for p in (_module_path(name) for name in _imported_modules(rel)) if p)
+    return sorted(seen - set(compiled))
+
+
+def built_files() -> list[Path]:
+    """Every compiled artefact under the package, whoever built it."""
+    from importlib.machinery import EXTENSION_SUFFIXES
+
+    suffixes = tuple(set(EXTENSION_SUFFIXES) | {".so", ".pyd"})
+    return sorted(p for p in (ROOT / PACKAGE).rglob("*") if p.is_file() and p.name.endswith(suffixes))
+
+
+def clean() -> None:
+    for path in built_files():
+        path.unlink()
+    MANIFEST.unlink(missing_ok=True)
+
+
+def compile_in_place(sources: list[str]) -> None:
+    """mypyc -> C -> extension modules copied next to their sources (setuptools build_ext --inplace)."""
+    from mypyc.build import mypycify
+    from setuptools import setup
+
+    extensions = mypycify(sources, opt_level="3", debug_level="0", group_name=GROUP, target_dir=str(BUILD_DIR))
+    for ext in extensions:
+        ext.extra_compile_args = [*ext.extra_compile_args, *EXACT_FLOAT_FLAGS]
+    setup(
+        name="sitl_emu_speedups",
+        ext_modules=extensions,
+        script_args=["build_ext", "--inplace", "--force", "--build-temp", str(BUILD_DIR / "temp"),
+                     "--build-lib", str(BUILD_DIR / "lib")],
+    )
+
+
+def write_manifest(sources: list[str]) -> None:
+    import mypy.version
+
+    suffix = _ext_suffix()
+    compiled = {}
+    for rel in sources:
+        so = Path(rel.removesuffix(".py") + suffix)
+        compiled[module_name(rel)] = {"py": rel, "py_sha256": sha256_of(ROOT / rel), "so": str(so),
+                                      "so_sha256": sha256_of(ROOT / so)}
+    shared = Path(GROUP.replace(".", "/") + "__mypyc" + suffix)
+    manifest = {
+        "built_by": "make speedups (tools/build_speedups.py)",
+        "built_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "python": sys.version.split()[0],
+        "ext_suffix": suffix,
+        "mypy": mypy.version.__version__,
+        "compiled": compiled,
+        "shared_lib": {"so": str(shared), "so_sha256": sha256_of(ROOT / shared)},
+        "depends": {rel: sha256_of(ROOT / rel) for rel in dependency_sources(sources)},
+    }
+    MANIFEST.write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+
+
+def _ext_suffix() -> str:
+    import sysconfig
+
+    suffix = sysconfig.get_config_var("EXT_SUFFIX")
+    assert isinstance(suffix, str)
+    return suffix
+
+
+def main(argv: list[str]) -> int:
+    os.chdir(ROOT)
+    if argv[:1] == ["--clean"]:
+        clean()
+        print("speedups removed: sitl_emu runs as pure Python")
+        return 0
+    sources = [a for a in argv if not a.startswith("-")] or list(DEFAULT_MODULES)
+    sources = [s for s in sources if not s.endswith("__init__.py")]  # a package stays pure (the guard needs it)
+    missing = [s for s in sources if not (ROOT / s).is_file()]
+    if missing:
+        print(f"no such source: {', '.join(missing)}", file=sys.stderr)
+        return 2
+    for var in ("CFLAGS", "CPPFLAGS", "LDFLAGS"):
+        os.environ.pop(var, None)  # keep -march=native / -ffast-math out (see the module docstring)
+    started = time.monotonic()
+    clean()  # an old .so must never survive a partial rebuild
+    compile_in_place(sources)
+    write_manifest(sources)
+    print(f"speedups built in {time.monotonic() - started:.0f} s: {len(sources)} modules compiled with mypyc "
+          f"({', '.join(module_name(s) for s in sources)}); `make clean-speedups` goes back to pure Python")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
