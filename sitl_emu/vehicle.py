@@ -26,7 +26,7 @@ from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
-from sitl_emu.physics import RigidBodyState, SihConfig
+from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
 from sitl_emu.px4 import AUTO_MODES, LandedState, MavState, NavState, Severity
 from sitl_emu.types import (
@@ -159,7 +159,7 @@ class Vehicle:
             return truth
         n = self._rng.normal(0.0, self._noise_m, 3)
         p = truth.pos_ned_m
-        est = RigidBodyState(**{f: getattr(truth, f) for f in RigidBodyState.__slots__})  # type: ignore[attr-defined]
+        est = RigidBodyState(**{f: getattr(truth, f) for f in RIGID_BODY_FIELDS})
         est.pos_ned_m = (p[0] + float(n[0]), p[1] + float(n[1]), p[2] + float(n[2]))
         return est
 

@@ -10,6 +10,7 @@ Pure functions of a `CheckInputs` snapshot. Sources:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.px4 import NavState
 
@@ -17,14 +18,14 @@ from sitl_emu.px4 import NavState
 class Req:
     """One bit per mode requirement (failsafe_flags.mode_req_*); plain ints, as enum.Flag is slow per step."""
 
-    NONE = 0
-    ATTITUDE = 1  # angular velocity + attitude
-    POSITION = 2  # local (relaxed or not), global position and local altitude
-    HOME = 4
-    MISSION = 8
-    OFFBOARD = 16
-    MANUAL = 32
-    PREVENT_ARMING = 64
+    NONE: Final = 0
+    ATTITUDE: Final = 1  # angular velocity + attitude
+    POSITION: Final = 2  # local (relaxed or not), global position and local altitude
+    HOME: Final = 4
+    MISSION: Final = 8
+    OFFBOARD: Final = 16
+    MANUAL: Final = 32
+    PREVENT_ARMING: Final = 64
 
 
 _A, _P, _M = Req.ATTITUDE, Req.POSITION, Req.MANUAL
