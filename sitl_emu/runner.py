@@ -51,13 +51,14 @@ class SocketWatch:
     def ready(self, timeout_s: float = 0.0) -> dict[int, int]:
         try:
             if self._epoll is not None:
-                fds = [fd for fd, _ in self._epoll.poll(timeout_s)]
+                events = self._epoll.poll(timeout_s)
+                if not events:  # the common case, every tick: no allocation
+                    return NOTHING_READY
+                fds = [fd for fd, _ in events]
             else:
                 fds = select.select(self._fds, [], [], timeout_s)[0]
         except (OSError, ValueError):  # a socket (or the watch) closed under us during shutdown
             time.sleep(min(timeout_s, 0.01))
-            return NOTHING_READY
-        if not fds:
             return NOTHING_READY
         ready: dict[int, int] = {}
         where = self._where
