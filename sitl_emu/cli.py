@@ -139,8 +139,8 @@ def main(verbose: int) -> None:
 @click.option("--batch-ms", type=click.FloatRange(0, 1000), default=DEFAULT_BATCH_MS, show_default=True,
               help="Wake at most every N ms of simulated time and run the ticks due in one batch (each message "
                    "still stamped at its own tick; input wakes the vehicle at once). The default wakes ~100 times a "
-                   "simulated second, as PX4's mavlink loop (MAVLINK_MAX_INTERVAL 10 ms), for far less CPU than "
-                   "waking for every 4 ms tick; 0 wakes for every tick.")
+                   "simulated second, as PX4's mavlink loop at its slowest (MAVLINK_MAX_INTERVAL 10 ms), for about a "
+                   "quarter less CPU than waking for every 4 ms tick; 0 wakes for every tick, as PX4 SITL.")
 @click.option("--home", default=None, help="Home as LAT,LON,ALT (deg, deg, m AMSL).")
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
