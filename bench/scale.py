@@ -53,7 +53,7 @@ def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int
             good = max(good, n)
             share = result["cpu_share"]
             guess = int(n / share * HEADROOM) if share > 0 else 2 * n
-            n = max(n + 1, min(guess, 4 * n, bad - 1, limit))
+            n = min(max(guess, n + max(1, n // 8)), 4 * n, bad - 1, limit)  # at least the stopping gap onwards
         else:
             bad = min(bad, n)
             n = (good + bad) // 2
