@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Final
 
 from sitl_emu.types import Vec3
 
-EARTH_RADIUS_M = 6371000.0  # PX4 lib/geo/geo.h CONSTANTS_RADIUS_OF_EARTH
+EARTH_RADIUS_M: Final = 6371000.0  # PX4 lib/geo/geo.h CONSTANTS_RADIUS_OF_EARTH
 
 
 @dataclass(frozen=True, slots=True)

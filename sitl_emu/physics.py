@@ -21,14 +21,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from math import cos, sin, sqrt
+from typing import Final
 
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3, Vec4
 
-GRAVITY_M_S2 = 9.80665  # PX4 CONSTANTS_ONE_G
-DEFAULT_DT_S = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
-MAX_RATE_RAD_S = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
-_MIN_RATE = -MAX_RATE_RAD_S
+GRAVITY_M_S2: Final = 9.80665  # PX4 CONSTANTS_ONE_G
+DEFAULT_DT_S: Final = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
+MAX_RATE_RAD_S: Final = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
+_MIN_RATE: Final = -MAX_RATE_RAD_S
 
 
 @dataclass(slots=True)

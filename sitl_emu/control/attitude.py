@@ -9,12 +9,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from math import acos, asin, cos, isfinite, sin, sqrt
+from typing import Final
 
 from sitl_emu.control.qmath import constrain, q_from_two_vectors
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3, Vec4
 
-_NEAR_ONE = 1.0 - 1e-5  # Quaternion(src, dst) degenerate when the reduced attitude is a half turn
+_NEAR_ONE: Final = 1.0 - 1e-5  # Quaternion(src, dst) degenerate when the reduced attitude is a half turn
 
 
 @dataclass(frozen=True, slots=True)

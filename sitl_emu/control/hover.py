@@ -11,14 +11,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.params import ParamRegistry
 
-G = 9.80665
-NOISE_LEARNING_TAU_S = 2.0
-LPF_TAU_S = 1.0
-VALID_VAR = 0.001
-VALID_HYSTERESIS_US = 2_000_000
+G: Final = 9.80665
+NOISE_LEARNING_TAU_S: Final = 2.0
+LPF_TAU_S: Final = 1.0
+VALID_VAR: Final = 0.001
+VALID_HYSTERESIS_US: Final = 2_000_000
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,16 +13,18 @@ then add yaw, reduce yaw (with 15 % headroom above the maximum), and reduce thru
 from __future__ import annotations
 
 import math
-from math import isfinite
+from typing import Final
 
 from sitl_emu.types import Vec3, Vec4
 
-_K = 1.0 / math.sqrt(2.0)
-ROLL = (-_K, _K, _K, -_K)
-PITCH = (_K, -_K, _K, -_K)
-YAW = (1.0, 1.0, -1.0, -1.0)
-THRUST = (1.0, 1.0, 1.0, 1.0)
-_NO_SAT = (False, False, False)
+_K: Final = 1.0 / math.sqrt(2.0)
+ROLL: Final = (-_K, _K, _K, -_K)
+PITCH: Final = (_K, -_K, _K, -_K)
+YAW: Final = (1.0, 1.0, -1.0, -1.0)
+THRUST: Final = (1.0, 1.0, 1.0, 1.0)
+_NO_SAT: Final = (False, False, False)
+# isfinite(x) is written `x - x == 0.0` (exact for floats: finite gives 0.0, inf and NaN give NaN): no call when
+# compiled by `make speedups` (mypyc has no isfinite primitive).
 
 
 def _desat_gain(vec: Vec4, u: list[float], lo: float, hi: float) -> float:
@@ -59,10 +61,10 @@ def mix(torque: Vec3, thrust: float) -> tuple[Vec4, tuple[bool, bool, bool], tup
     the rate controller uses to stop integrating into the saturation.
     """
     roll, pitch, yaw = torque  # every tick: no generators, no min()/max() on the fast path
-    roll = roll if isfinite(roll) else 0.0
-    pitch = pitch if isfinite(pitch) else 0.0
-    yaw = yaw if isfinite(yaw) else 0.0
-    thrust = thrust if isfinite(thrust) else 0.0
+    roll = roll if roll - roll == 0.0 else 0.0
+    pitch = pitch if pitch - pitch == 0.0 else 0.0
+    yaw = yaw if yaw - yaw == 0.0 else 0.0
+    thrust = thrust if thrust - thrust == 0.0 else 0.0
     r, p = _K * roll, _K * pitch
     f0, f1, f2, f3 = thrust - r + p + yaw, thrust + r - p + yaw, thrust + r + p - yaw, thrust - r - p - yaw
     # min(fast) >= 0 and max(fast) <= 1, with min()/max()'s own rule (a later item replaces only if < / >)

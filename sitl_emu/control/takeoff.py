@@ -9,8 +9,9 @@ commands idle thrust; the tilt limit is MPC_TILTMAX_LND until flight (Multicopte
 from __future__ import annotations
 
 from enum import IntEnum
+from typing import Final
 
-G = 9.80665
+G: Final = 9.80665
 
 
 class TakeoffState(IntEnum):
@@ -80,4 +81,4 @@ class TakeoffHandling:
         return desired_vz_up
 
 
-_FLIGHT = TakeoffState.FLIGHT
+_FLIGHT: Final = TakeoffState.FLIGHT
