@@ -44,8 +44,8 @@ class SocketWatch:
                 self._where[fd] = (index, bit)
         self._fds = list(self._where)
         self._epoll = select.epoll(len(self._fds) or 1) if hasattr(select, "epoll") else None
-        for fd in self._fds:
-            if self._epoll is not None:
+        if self._epoll is not None:
+            for fd in self._fds:
                 self._epoll.register(fd, select.EPOLLIN)
 
     def ready(self, timeout_s: float = 0.0) -> dict[int, int]:
@@ -86,9 +86,10 @@ class RealTimeRunner:
         self.iterations = 0
         self.steps = 0
         self.dropped_us = 0
-        # Sleep at least this long between wake-ups (0: wake for every tick). Longer batches of ticks cost less CPU
-        # per tick (measured: 12.8 % -> 8.7 % at 16 ms -> 6.3 % at 40 ms of a core for one hovering vehicle);
-        # telemetry then leaves in bursts (each message still stamped at its own tick); input wakes us at once.
+        # Sleep at least this long (wall time) between wake-ups and run the ticks due in one batch; 0 wakes for every
+        # tick. Each wake-up costs more CPU than most ticks (cold caches), so batches save CPU; telemetry then leaves
+        # in bursts (each message still stamped at its own tick) and a datagram still wakes us at once. `serve` sets
+        # it from --batch-ms (sitl_emu/cli.py DEFAULT_BATCH_MS); library users (tests, joyfly demo) wake every tick.
         self.min_wake_s = 0.0
         self._watch: SocketWatch | None = None
 
