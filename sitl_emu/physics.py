@@ -45,6 +45,21 @@ class RigidBodyState:
     specific_force_frd: Vec3 = (0.0, 0.0, -GRAVITY_M_S2)  # what an accelerometer reads
     on_ground: bool = True
 
+    # Written out (the same as the one @dataclass would generate), so that `make speedups` compiles it: mypyc leaves
+    # a generated __init__ to the dataclasses module, i.e. interpreted, and a state is built on every physics step.
+    def __init__(self, pos_ned_m: Vec3 = (0.0, 0.0, 0.0), vel_ned_m_s: Vec3 = (0.0, 0.0, 0.0),
+                 q_wxyz: Vec4 = (1.0, 0.0, 0.0, 0.0), rates_frd_rad_s: Vec3 = (0.0, 0.0, 0.0),
+                 motors: Vec4 = (0.0, 0.0, 0.0, 0.0), acc_ned_m_s2: Vec3 = (0.0, 0.0, 0.0),
+                 specific_force_frd: Vec3 = (0.0, 0.0, -GRAVITY_M_S2), on_ground: bool = True) -> None:
+        self.pos_ned_m = pos_ned_m
+        self.vel_ned_m_s = vel_ned_m_s
+        self.q_wxyz = q_wxyz
+        self.rates_frd_rad_s = rates_frd_rad_s
+        self.motors = motors
+        self.acc_ned_m_s2 = acc_ned_m_s2
+        self.specific_force_frd = specific_force_frd
+        self.on_ground = on_ground
+
 
 # RigidBodyState's field names, for copying a state: a class compiled by `make speedups` (mypyc) has no __slots__.
 RIGID_BODY_FIELDS = ("pos_ned_m", "vel_ned_m_s", "q_wxyz", "rates_frd_rad_s", "motors", "acc_ned_m_s2",
