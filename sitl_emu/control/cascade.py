@@ -36,6 +36,8 @@ ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 POSITION_PERIOD_US: Final = 8000
 _FLIGHT: Final = TakeoffState.FLIGHT
 _RAMPUP: Final = TakeoffState.RAMPUP
+# takeoff_state's names, made once: it is read on every tick, and an enum's .name is a Python-level property
+_TAKEOFF_NAMES: Final = {state: state.name.lower() for state in TakeoffState}
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,7 +99,7 @@ class MulticopterControl:
 
     @property
     def takeoff_state(self) -> str:
-        return self.takeoff.state.name.lower()
+        return _TAKEOFF_NAMES[self.takeoff.state]
 
     @property
     def tilt_limit_rad(self) -> float:
