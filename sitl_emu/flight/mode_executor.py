@@ -30,14 +30,26 @@ _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.A
 _OFFBOARD = NavState.OFFBOARD  # a module constant: enum member lookups cost on the per-tick path
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class ExecutorOutput:
+    """Built on every tick, so not frozen and with its __init__ written out (as NavInput). Treat it as read-only."""
+
     trajectory: TrajectorySetpoint | None
     attitude: AttitudeSetpoint | None
     setpoint_type: str  # "idle" | "position" | "takeoff" | "land" | "offboard" | "none"
     task_finished: bool
     messages: Sequence[tuple[Severity, str]]
     want_takeoff: bool | None = None  # the task's vehicle_constraints.want_takeoff; None: from the setpoint
+
+    def __init__(self, trajectory: TrajectorySetpoint | None, attitude: AttitudeSetpoint | None, setpoint_type: str,
+                 task_finished: bool, messages: Sequence[tuple[Severity, str]],
+                 want_takeoff: bool | None = None) -> None:
+        self.trajectory = trajectory
+        self.attitude = attitude
+        self.setpoint_type = setpoint_type
+        self.task_finished = task_finished
+        self.messages = messages
+        self.want_takeoff = want_takeoff
 
 
 _NO_SETPOINT = ExecutorOutput(None, None, "none", False, ())

@@ -30,7 +30,7 @@ _NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
 _TWO_PI = 2.0 * math.pi
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class NavInput:
     """What the navigator tasks see of the vehicle, in the local NED frame (z = 0 is the ground at home).
 
@@ -38,6 +38,10 @@ class NavInput:
     before the ramp ("disarmed", "spoolup", "ready_for_takeoff") the trajectory is held at the vehicle, as PX4's
     FlightModeManager does; the default "flight" disables that. `ref_alt_amsl_m` is the AMSL altitude of the local
     origin (only used for the RTL message, which PX4 prints in AMSL).
+
+    Built on every tick, so not frozen and with its __init__ written out (the same as the generated one): a frozen
+    dataclass sets each field through object.__setattr__, and `make speedups` (mypyc) compiles only a written-out
+    __init__. Treat it as read-only.
     """
 
     time_us: int
@@ -50,6 +54,20 @@ class NavInput:
     armed: bool
     takeoff_state: str = "flight"
     ref_alt_amsl_m: float = 488.0
+
+    def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
+                 home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: str = "flight",
+                 ref_alt_amsl_m: float = 488.0) -> None:
+        self.time_us = time_us
+        self.pos_ned_m = pos_ned_m
+        self.vel_ned_m_s = vel_ned_m_s
+        self.yaw_rad = yaw_rad
+        self.home_ned_m = home_ned_m
+        self.home_yaw_rad = home_yaw_rad
+        self.landed = landed
+        self.armed = armed
+        self.takeoff_state = takeoff_state
+        self.ref_alt_amsl_m = ref_alt_amsl_m
 
 
 @dataclass(frozen=True, slots=True)
