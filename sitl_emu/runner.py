@@ -24,6 +24,7 @@ from sitl_emu.server import READ_API, READ_BOTH, READ_GCS
 log = logging.getLogger(__name__)
 
 MAX_LAG_US = 500_000  # if the host stalls longer than this, drop the lost time instead of fast-forwarding through it
+FINE_TIMEOUT_S = 0.002  # below this a wait uses select() (µs resolution) on the epoll fd, not epoll's whole ms
 NOTHING_READY: dict[int, int] = {}  # ready()'s answer when no socket has data (shared: never mutate it)
 
 
@@ -32,9 +33,9 @@ class SocketWatch:
 
     `ready(timeout_s)` returns {node index: READ_API | READ_GCS bits} for the nodes with data, waiting up to
     `timeout_s` for the first datagram (0: just look). Level-triggered: a link that a read budget left with data is
-    reported again next time. epoll times out in whole milliseconds, rounded up, so a runner sleeping in it wakes at
-    most 1 ms after a tick is due (never before it); a datagram wakes it at once. Where epoll is missing (not Linux)
-    select() does the same.
+    reported again next time. epoll times out in whole milliseconds, rounded up, so short waits (high --speed) go
+    through select() on the epoll fd instead; a datagram wakes the runner at once either way. Where epoll is missing
+    (not Linux) select() on the sockets does the same.
     """
 
     def __init__(self, nodes: Sequence[Any]) -> None:
@@ -47,10 +48,14 @@ class SocketWatch:
         if self._epoll is not None:
             for fd in self._fds:
                 self._epoll.register(fd, select.EPOLLIN)
+        self._epoll_fd = [self._epoll.fileno()] if self._epoll is not None else []
 
     def ready(self, timeout_s: float = 0.0) -> dict[int, int]:
         try:
             if self._epoll is not None:
+                if 0 < timeout_s < FINE_TIMEOUT_S:  # epoll would round up to 1 ms: wait on its fd with select()
+                    select.select(self._epoll_fd, (), (), timeout_s)
+                    timeout_s = 0.0
                 events = self._epoll.poll(timeout_s)
                 if not events:  # the common case, every tick: no allocation
                     return NOTHING_READY
