@@ -110,3 +110,12 @@ def test_batched_ticks_keep_simulated_time_with_fewer_wake_ups():
     assert runner.steps == 250 and h.vehicle.time_us == 1_000_000
     assert wall > 0.9  # real time, not as fast as possible
     assert runner.iterations < 125  # ~20 wake-ups (a busy machine adds a few), not one per 4 ms tick (250)
+
+
+def test_serve_batches_in_simulated_ms_but_wakes_at_most_1000_times_a_second():
+    from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
+
+    assert wake_period_s(DEFAULT_BATCH_MS, 1.0) == pytest.approx(0.010)  # 100 wake-ups a second at real time
+    assert wake_period_s(DEFAULT_BATCH_MS, 5.0) == pytest.approx(0.002)  # still 10 simulated ms at --speed 5
+    assert wake_period_s(DEFAULT_BATCH_MS, 60.0) == pytest.approx(0.001)  # floor: 1000 a second
+    assert wake_period_s(0.0, 60.0) == 0.0  # --batch-ms 0: every tick, at any speed
