@@ -30,7 +30,7 @@ if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
 from bench import core, runner, scale, serve  # noqa: E402
-from sitl_emu.cli import DEFAULT_BATCH_MS  # noqa: E402
+from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
 NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale")
 
@@ -60,7 +60,7 @@ def bench_runner(quick: bool) -> None:
     seconds = 3.0 if quick else 10.0
     share, per_tick = runner.real_time_share(seconds)
     bare, per_wake = runner.real_time_share(seconds, streams=False)
-    batched, _ = runner.real_time_share(seconds, DEFAULT_BATCH_MS / 1000.0)
+    batched, _ = runner.real_time_share(seconds, wake_period_s(DEFAULT_BATCH_MS, 1.0))
     say(f"runner at real time, stub vehicle (no physics), default streams: {share:.1f} % of one core waking every "
         f"tick ({per_tick:.0f} us CPU per tick), {batched:.1f} % with the default --batch-ms {DEFAULT_BATCH_MS:g}; "
         f"streams off: {bare:.1f} % ({per_wake:.0f} us per tick and wake-up)")

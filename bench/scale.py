@@ -63,7 +63,7 @@ def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int
 
 def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
     from sitl_emu.api import Sim
-    from sitl_emu.cli import DEFAULT_BATCH_MS
+    from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
     from sitl_emu.swarm import SwarmRunner
     from sitl_emu.types import VehicleCommand
 
@@ -78,7 +78,7 @@ def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
             v.handle_command(VehicleCommand(22, (nan,) * 7))
             v.run_until(2_100_000 + round(TAKEOFF_S * 1e6))  # climbing; the timed part is the climb's end and hover
         runner = SwarmRunner(sim.nodes, speed=1.0)
-        runner.min_wake_s = DEFAULT_BATCH_MS / 1000.0  # as `sitl-emu serve --count N` runs them
+        runner.min_wake_s = wake_period_s(DEFAULT_BATCH_MS, 1.0)  # as `sitl-emu serve --count N` runs them
         t0_sim = min(v.time_us for v in sim.vehicles)
         lag = {"max": 0.0}
         t0 = time.monotonic()
