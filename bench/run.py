@@ -44,6 +44,13 @@ def machine() -> None:
                   if ln.startswith("model name")), platform.processor() or "?")
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     say(f"machine: {model}, {os.cpu_count()} CPUs, load average {load}, Python {platform.python_version()}")
+    # imported first, so that describe() sees whether the vehicle core runs compiled
+    import sitl_emu.control.cascade
+    import sitl_emu.physics
+    import sitl_emu.vehicle  # noqa: F401
+    from sitl_emu._speedups import describe
+
+    say(f"build: {describe()} (make speedups compiles the vehicle core; make clean-speedups goes back)")
 
 
 def bench_core(quick: bool) -> None:
