@@ -114,42 +114,47 @@ class RealTimeRunner:
             self._watch.close()
             self._watch = None
 
+    def _sim_us(self) -> int:
+        """The simulated time this runner keeps on the wall clock: the lead vehicle's (SwarmRunner: its timeline)."""
+        return int(self.nodes[0].vehicle.time_us)
+
     def _run(self, duration_s: float | None, watch: SocketWatch) -> None:
-        lead = self.nodes[0].vehicle
-        dt_us = int(lead.dt_us)
-        start_sim_us = int(lead.time_us)
-        end_us = None if duration_s is None else start_sim_us + int(duration_s * 1e6)
-        start_wall = time.monotonic()
+        """Run until stopped, or for `duration_s` more of simulated time (run() opens `watch`)."""
+        dt_us = int(self.nodes[0].vehicle.dt_us)
+        anchor_us, start_wall = self._sim_us(), time.monotonic()  # simulated time `anchor_us` at wall `start_wall`
+        end_us = None if duration_s is None else anchor_us + round(duration_s * 1e6)
         ready: dict[int, int] | None = None  # None: not known, look before the first tick
         stop = self._stop
         while not stop.is_set():
             woke = time.monotonic()
-            target_us = start_sim_us + int((woke - start_wall) * 1e6 * self.speed)
+            target_us = anchor_us + int((woke - start_wall) * 1e6 * self.speed)
             if end_us is not None and end_us < target_us:
                 target_us = end_us
-            if target_us - lead.time_us > MAX_LAG_US:
-                start_sim_us, target_us = self._limit_lag(start_sim_us, target_us, lead)
-            before_us = lead.time_us
+            lag_us = target_us - self._sim_us()
+            if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
+                skipped = lag_us - MAX_LAG_US
+                self._warn_lag(lag_us)
+                anchor_us -= skipped
+                target_us -= skipped
+                self.dropped_us += skipped
+            before_us = self._sim_us()
             self._advance(target_us, dt_us, ready)
-            if lead.time_us < before_us:  # rebooted: simulated time restarted at 0, so does the wall-clock anchor
-                start_sim_us, start_wall = int(lead.time_us), time.monotonic()
+            if self._sim_us() < before_us:  # rebooted: simulated time restarted at 0, so does the wall-clock anchor
+                anchor_us, start_wall = self._sim_us(), time.monotonic()
             for hook in self.hooks:
                 hook()
             self.iterations += 1
-            if end_us is not None and lead.time_us >= end_us:
+            if end_us is not None and self._sim_us() >= end_us:
                 break
-            next_wall = start_wall + (lead.time_us + dt_us - start_sim_us) / 1e6 / self.speed
+            next_wall = start_wall + (self._sim_us() + dt_us - anchor_us) / 1e6 / self.speed
             if next_wall < woke + self.min_wake_s:  # batching: wake at a steady period, however long this batch took
                 next_wall = woke + self.min_wake_s
             timeout = next_wall - time.monotonic()
             ready = watch.ready(timeout) if timeout > 0 else None
 
-    def _limit_lag(self, start_sim_us: int, target_us: int, lead: Any) -> tuple[int, int]:
-        skipped = target_us - int(lead.time_us) - MAX_LAG_US
+    def _warn_lag(self, lag_us: int) -> None:
         if self.dropped_us == 0:
             log.warning("cannot keep up with --speed %g: simulated time falls behind the wall clock", self.speed)
-        self.dropped_us += skipped
-        return start_sim_us + skipped, target_us - skipped
 
     def _advance(self, target_us: int, dt_us: int, ready: dict[int, int] | None) -> None:
         """Run every tick due by `target_us`; `ready` (what the wake-up saw) serves the first, later ones look again."""

@@ -21,7 +21,7 @@ from dataclasses import replace
 from typing import Any
 
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.runner import MAX_LAG_US, RealTimeRunner, SocketWatch
+from sitl_emu.runner import RealTimeRunner
 from sitl_emu.server import LinkSettings, VehicleNode
 
 log = logging.getLogger(__name__)
@@ -86,35 +86,9 @@ class SwarmRunner(RealTimeRunner):
         self.timeline_us = 0  # simulated time since this runner was created, the same for every vehicle
         self._last_warning_s = -math.inf
 
-    def _run(self, duration_s: float | None, watch: SocketWatch) -> None:
-        """Run until stopped, or for `duration_s` more of simulated time (RealTimeRunner.run opens `watch`)."""
-        dt_us = int(self.nodes[0].vehicle.dt_us)
-        end_us = None if duration_s is None else self.timeline_us + round(duration_s * 1e6)
-        anchor_us, start_wall = self.timeline_us, time.monotonic()
-        ready: dict[int, int] | None = None  # None: not known, look before the first tick
-        stop = self._stop
-        while not stop.is_set():
-            woke = time.monotonic()
-            target_us = anchor_us + int((woke - start_wall) * 1e6 * self.speed)
-            if end_us is not None and end_us < target_us:
-                target_us = end_us
-            lag_us = target_us - self.timeline_us
-            if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
-                anchor_us -= lag_us - MAX_LAG_US
-                target_us -= lag_us - MAX_LAG_US
-                self.dropped_us += lag_us - MAX_LAG_US
-                self._warn_lag(lag_us)
-            self._advance(target_us, dt_us, ready)
-            for hook in self.hooks:
-                hook()
-            self.iterations += 1
-            if end_us is not None and self.timeline_us >= end_us:
-                break
-            next_wall = start_wall + (self.timeline_us + dt_us - anchor_us) / 1e6 / self.speed
-            if next_wall < woke + self.min_wake_s:  # batching: wake at a steady period, however long this batch took
-                next_wall = woke + self.min_wake_s
-            timeout = next_wall - time.monotonic()
-            ready = watch.ready(timeout) if timeout > 0 else None
+    def _sim_us(self) -> int:
+        """The shared timeline is what the wall clock paces (it never goes back, even when a vehicle reboots)."""
+        return self.timeline_us
 
     def _advance(self, target_us: int, dt_us: int, ready: dict[int, int] | None) -> None:
         """Every tick due by `target_us`: all physics of the tick, then all I/O (~7 % faster than interleaving: the

@@ -119,3 +119,32 @@ def test_serve_batches_in_simulated_ms_but_wakes_at_most_1000_times_a_second():
     assert wake_period_s(DEFAULT_BATCH_MS, 5.0) == pytest.approx(0.002)  # still 10 simulated ms at --speed 5
     assert wake_period_s(DEFAULT_BATCH_MS, 60.0) == pytest.approx(0.001)  # floor: 1000 a second
     assert wake_period_s(0.0, 60.0) == 0.0  # --batch-ms 0: every tick, at any speed
+
+
+class _StallingVehicle(FakeVehicle):
+    """A vehicle whose step at `stall_at_us` blocks the host for `stall_s` of wall time (a paused VM, a GC storm)."""
+
+    stall_at_us: int = 40_000
+    stall_s: float = 0.8
+
+    def step(self) -> None:
+        super().step()
+        if self.time_us == self.stall_at_us:
+            time.sleep(self.stall_s)
+
+
+@pytest.mark.parametrize("swarm", [False, True], ids=["single", "swarm"])
+def test_after_a_host_stall_the_runner_drops_the_lost_time_and_keeps_real_time_again(swarm):
+    h = Harness(_StallingVehicle())
+    try:
+        runner = (SwarmRunner if swarm else RealTimeRunner)([h.node], speed=1.0)
+        samples: list[tuple[float, int]] = []
+        runner.hooks.append(lambda: samples.append((time.monotonic(), h.vehicle.time_us)))
+        runner.run(duration_s=1.6)
+        assert 0.2e6 <= runner.dropped_us <= 0.5e6  # 0.8 s stall, 0.5 s of it may be caught up
+        after = [(t, us) for t, us in samples if us >= 1_000_000]  # well after the stall, once caught up
+        (t0, us0), (t1, us1) = after[0], after[-1]
+        assert us1 - us0 >= 400_000
+        assert (us1 - us0) / 1e6 <= 1.5 * (t1 - t0) + 0.02  # paced by the wall clock again, not racing ahead
+    finally:
+        h.close()
