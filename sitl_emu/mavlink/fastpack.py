@@ -85,22 +85,12 @@ class Packed:
     def pack(self, mav: Any, force_mavlink1: bool = False) -> bytes:
         if force_mavlink1:
             raise ValueError("Packed messages are MAVLink 2 only")
-        spec = self.spec
-        return frame(spec.msg_id, spec.crc_extra, spec.pack(*self.values), mav.seq, mav.srcSystem, mav.srcComponent)
-
-
-def frame(msg_id: int, crc_extra: bytes, payload: bytes, seq: int, sysid: int, compid: int) -> bytes:
-    """One MAVLink 2 frame, exactly as pymavlink's MAVLink_message._pack builds it (unsigned)."""
-    body = payload.rstrip(b"\0") or payload[:1]
-    head = _HEADER.pack(len(body), 0, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
-    return MAGIC_V2 + head + _CRC.pack(x25_crc(head + crc_extra, 0xFFFF))
+        return frame_message(self, mav.seq, mav.srcSystem, mav.srcComponent)
 
 
 def frame_message(msg: Any, seq: int, sysid: int, compid: int) -> bytes:
-    """The frame of a Packed or of any pymavlink message object (a struct.error etc. for a value out of range).
-
-    Hot path (every message sent): frame() is inlined here.
-    """
+    """The MAVLink 2 frame of a Packed or of any pymavlink message object, exactly as pymavlink's
+    MAVLink_message._pack builds it, unsigned (a struct.error etc. for a value out of range)."""
     if type(msg) is Packed:
         spec = msg.spec
         payload = spec.pack(*msg.values)
