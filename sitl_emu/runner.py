@@ -3,7 +3,8 @@
 A runner advances each node's vehicle in fixed steps of simulated time and calls `node.step_io(now_us, readable)`
 after each step (and whenever a datagram arrives), so streams, heartbeats and timeouts all follow simulated time.
 `RealTimeRunner(speed)` keeps simulated time at `speed` x wall time and sleeps in epoll on the sockets, so incoming
-commands are answered without waiting for the next step. `run_lockstep()` steps as fast as possible, for tests.
+commands are answered without waiting for the next step. In-process lockstep (as fast as possible) is
+`sitl_emu.api.Sim`.
 
 Which links have data waiting comes from one `SocketWatch.ready()` per tick over every socket (the wake-up's own
 epoll serves the first tick after it), so an idle link costs no system call: before, each node tried a recvfrom on
@@ -19,7 +20,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from sitl_emu.server import READ_API, READ_BOTH, READ_GCS
+from sitl_emu.server import READ_API, READ_GCS
 
 log = logging.getLogger(__name__)
 
@@ -178,16 +179,3 @@ class RealTimeRunner:
             for index, readable in (look() if ready is None else ready).items():
                 node = self.nodes[index]
                 node.step_io(node.vehicle.time_us, readable)
-
-
-def run_lockstep(nodes: Sequence[Any], duration_s: float, io_every_steps: int = 1) -> None:
-    """Step every node as fast as possible for `duration_s` of simulated time, doing I/O every few steps."""
-    for node in nodes:
-        vehicle = node.vehicle
-        end_us = vehicle.time_us + int(duration_s * 1e6)
-        n = 0
-        while vehicle.time_us < end_us:
-            vehicle.step()
-            n += 1
-            if n % io_every_steps == 0:
-                node.step_io(vehicle.time_us, READ_BOTH)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import errno
 import logging
-import select
 import socket
 from dataclasses import dataclass
 
@@ -45,9 +44,6 @@ class UdpLink:
         self.peer_latched = False
         self.stats = LinkStats()
         self._sock = _open_socket(bind_host, port, name)
-        self._poller = select.poll() if hasattr(select, "poll") else None  # no poll() on Windows
-        if self._poller is not None:
-            self._poller.register(self._sock, select.POLLIN)
         self.local_address: Address = self._sock.getsockname()
 
     @property
@@ -58,10 +54,10 @@ class UdpLink:
         return self._sock.fileno()
 
     def receive(self, max_datagrams: int = 256) -> list[bytes]:
-        """Datagrams waiting now (never blocks). The first one's sender becomes the peer."""
-        poller = self._poller
-        if poller is not None and not poller.poll(0):  # nothing waiting (cheaper than recvfrom raising)
-            return []
+        """Datagrams waiting now (never blocks). The first one's sender becomes the peer.
+
+        Runners call this only for a socket their SocketWatch saw readable (sitl_emu/runner.py), so an idle link
+        costs nothing here and this does not look again before reading."""
         out: list[bytes] = []
         while len(out) < max_datagrams:
             try:
@@ -91,8 +87,6 @@ class UdpLink:
         self.stats.tx_bytes += len(data)
 
     def close(self) -> None:
-        if self._poller is not None and self._sock.fileno() >= 0:
-            self._poller.unregister(self._sock)  # its number may be reused by a later socket
         self._sock.close()
 
     def _note_sender(self, addr: Address) -> None:
