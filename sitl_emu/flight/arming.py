@@ -77,16 +77,23 @@ class CheckInputs:
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
-        have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else 0
-        if self.home_valid:
-            have |= Req.HOME
-        if self.mission_valid:
-            have |= Req.MISSION
-        if self.offboard_signal:
-            have |= Req.OFFBOARD
-        if self.manual_control:
-            have |= Req.MANUAL
-        return have
+        return available_bits(self.estimator_ready, self.home_valid, self.offboard_signal, self.manual_control,
+                              self.mission_valid)
+
+
+def available_bits(estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
+                   mission_valid: bool = False) -> int:
+    """The requirement bits satisfied by these inputs (CheckInputs.available, without building a CheckInputs)."""
+    have = (Req.ATTITUDE | Req.POSITION) if estimator_ready else 0
+    if home_valid:
+        have |= Req.HOME
+    if mission_valid:
+        have |= Req.MISSION
+    if offboard_signal:
+        have |= Req.OFFBOARD
+    if manual_control:
+        have |= Req.MANUAL
+    return have
 
 
 def requirements(nav_state: NavState) -> int:
@@ -128,23 +135,11 @@ def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
     return arming_failure(nav_state, c, armed) is None
 
 
-# can_run() without building a CheckInputs (the commander asks every cycle): the requirements not met by the
-# estimator, home or offboard signal. Same answer as can_run(nav_state, CheckInputs(...)) with no manual control
-# and no mission.
-_RUN_NEEDS: dict[NavState, int] = {m: r & ~Req.PREVENT_ARMING for m, r in _REQUIREMENTS.items()}
-_ESTIMATOR_BITS = Req.ATTITUDE | Req.POSITION
-
-
 def can_run_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool) -> bool:
-    """can_run(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal)), without the allocation."""
-    need = _RUN_NEEDS.get(nav_state, 0)
-    if estimator_ready:
-        need &= ~_ESTIMATOR_BITS
-    if home_valid:
-        need &= ~Req.HOME
-    if offboard_signal:
-        need &= ~Req.OFFBOARD
-    return not need
+    """can_run(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal)), without the allocation (the
+    commander asks every cycle)."""
+    return not (requirements(nav_state) & ~(available_bits(estimator_ready, home_valid, offboard_signal)
+                                            | Req.PREVENT_ARMING))
 
 
 _CAN_ARM_MEMO: dict[tuple[NavState, bool, bool, bool, bool], bool] = {}

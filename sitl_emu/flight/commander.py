@@ -274,15 +274,10 @@ class Commander:
 
     # ---- the periodic update ------------------------------------------------------------------------------------
     def update(self, now_us: int) -> None:
-        """One commander cycle: readiness, home, auto-disarm, takeoff completion, the mode in force.
-
-        Each step is called only when its own first checks would not make it return at once (every 8 ms)."""
-        if self._ready and (self.home is None or not self._ready_announced):
-            self._update_ready()
-        if self.armed:
-            self._auto_disarm(now_us)
-            if self.nav_state == _AUTO_TAKEOFF:
-                self._takeoff_completion()
+        """One commander cycle: readiness, home, auto-disarm, takeoff completion, the mode in force."""
+        self._update_ready()
+        self._auto_disarm(now_us)
+        self._takeoff_completion()
         self._apply_mode(now_us)
 
     def _update_ready(self) -> None:
