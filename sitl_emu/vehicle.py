@@ -104,8 +104,8 @@ class Vehicle:
     def step(self) -> None:
         """Advance exactly one physics tick (dt_us), in the fixed order of the module docstring.
 
-        This runs 250 times per simulated second, so the adapters of vehicle_parts are partly inlined here and
-        work is skipped where its inputs did not change (each shortcut says why it is exact)."""
+        This runs 250 times per simulated second, so work is skipped where its inputs did not change (each
+        shortcut says why it is exact)."""
         c = self.commander
         if c.reboot_requested:
             self._boot()
@@ -122,16 +122,14 @@ class Vehicle:
         out = parts.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         armed = c.armed and c.nav_state != _TERMINATION
-        motors = parts.control.update(self._estimate, out.trajectory, out.attitude, armed, c.landed, now, dt_s,
-                                      ground_contact=parts.ground_contact, want_takeoff=out.want_takeoff)
+        motors = parts.control_update(self._estimate, out, armed, c.landed, now, dt_s)
         sih = self._sih if self.params.version == self._sih_version else self._sih_config()
         state = self._state = physics_step(self._state, motors, dt_s, sih)
         self._estimate = state if self._noise_m <= 0.0 else self._estimate_from(state)
-        if now >= parts.ld_next_us or c.armed != parts.ld_armed:  # else Parts.land returns its last output
-            climb_rate_controlled = out.attitude is None and out.setpoint_type != "none"
-            landed, maybe_landed = parts.land(self._estimate, c, climb_rate_controlled, now)
-            if landed != c.landed or maybe_landed != c.maybe_landed:  # else on_land_detector changes nothing
-                c.on_land_detector(landed, maybe_landed)
+        climb_rate_controlled = out.attitude is None and out.setpoint_type != "none"
+        landed, maybe_landed = parts.land(self._estimate, c, climb_rate_controlled, now)
+        if landed != c.landed or maybe_landed != c.maybe_landed:  # else on_land_detector changes nothing
+            c.on_land_detector(landed, maybe_landed)
         if out.messages:
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)

@@ -37,11 +37,10 @@ class Parts:
         self.executor = ModeExecutor(params)
         self._detector = LandDetector(params)
         self.ground_contact = False
-        # the land detector runs when now_us >= ld_next_us (every LAND_DETECTOR_PERIOD_US) or when arming changed
-        # (armed != ld_armed); Vehicle.step checks this itself to skip the call, land() checks it again
-        self.ld_next_us = -(1 << 62)
-        self.ld_armed = False
-        self.ld_out = (True, True)
+        # the land detector runs when now_us >= _ld_next_us (every LAND_DETECTOR_PERIOD_US) or when arming changed
+        self._ld_next_us = -(1 << 62)
+        self._ld_armed = False
+        self._ld_out = (True, True)
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
         """What the navigator task sees (tasks_core.NavInput)."""
@@ -62,9 +61,9 @@ class Parts:
 
         `climb_rate_controlled` is PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard
         position/velocity/acceleration (not offboard attitude/rates, not manual modes)."""
-        if now_us < self.ld_next_us and c.armed == self.ld_armed:
-            return self.ld_out
-        self.ld_next_us, self.ld_armed = now_us + LAND_DETECTOR_PERIOD_US, c.armed
+        if now_us < self._ld_next_us and c.armed == self._ld_armed:
+            return self._ld_out
+        self._ld_next_us, self._ld_armed = now_us + LAND_DETECTOR_PERIOD_US, c.armed
         f = est.specific_force_frd
         ctrl = self.control
         # LandDetector.update(LandDetectorInput(...)) without the input/output objects
@@ -72,7 +71,7 @@ class Parts:
             now_us, c.armed, est.vel_ned_m_s, est.rates_frd_rad_s, math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
             ctrl.thrust_setpoint, ctrl.hover_thrust, descent_vz(ctrl.local_setpoint), climb_rate_controlled)
         self.ground_contact = bool(ground_contact)
-        out = self.ld_out = (landed, maybe_landed)
+        out = self._ld_out = (landed, maybe_landed)
         return out
 
 
