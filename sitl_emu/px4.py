@@ -1,4 +1,4 @@
-"""PX4's numbering, in one place: nav_state, custom_mode (main/sub), landed state, results, severities.
+"""PX4's numbering, in one place: nav_state, custom_mode (main/sub), landed state, commands, results, severities.
 
 Sources (see ../shared/reference/px4-behaviour.md section 2):
 - nav_state numbers: PX4 msg/versioned/VehicleStatus.msg
@@ -81,7 +81,37 @@ class LandedState(IntEnum):
     LANDING = 4
 
 
+class MavCmd(IntEnum):
+    """MAV_CMD numbers (MAVLink common.xml, names without the MAV_CMD_ prefix) of the commands the emulator answers.
+
+    The commander's (Commander.cpp handle_command) and the mavlink module's (mavlink_receiver.cpp
+    handle_message_command_both). PX4 keeps MAVLink's numbering for vehicle_command internally, and so do we.
+    """
+
+    NAV_RETURN_TO_LAUNCH = 20
+    NAV_LAND = 21
+    NAV_TAKEOFF = 22
+    DO_SET_MODE = 176
+    DO_SET_HOME = 179
+    DO_FLIGHTTERMINATION = 185
+    DO_CHANGE_ALTITUDE = 186
+    DO_REPOSITION = 192
+    PREFLIGHT_CALIBRATION = 241
+    PREFLIGHT_REBOOT_SHUTDOWN = 246
+    MISSION_START = 300
+    COMPONENT_ARM_DISARM = 400
+    RUN_PREARM_CHECKS = 401
+    GET_HOME_POSITION = 410  # legacy alias of REQUEST_MESSAGE(HOME_POSITION), PX4 <= v1.17
+    GET_MESSAGE_INTERVAL = 510
+    SET_MESSAGE_INTERVAL = 511
+    REQUEST_MESSAGE = 512
+    REQUEST_PROTOCOL_VERSION = 519  # legacy alias of REQUEST_MESSAGE(PROTOCOL_VERSION), PX4 <= v1.17
+    REQUEST_AUTOPILOT_CAPABILITIES = 520  # legacy alias of REQUEST_MESSAGE(AUTOPILOT_VERSION), PX4 <= v1.17
+
+
 class MavResult(IntEnum):
+    """MAV_RESULT, the COMMAND_ACK result."""
+
     ACCEPTED = 0
     TEMPORARILY_REJECTED = 1
     DENIED = 2
