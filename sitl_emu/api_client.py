@@ -20,7 +20,7 @@ from typing import Any, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.px4 import MODE_FLAG_SAFETY_ARMED, MavResult, NavState, custom_mode, decode_custom_mode, main_sub
+from sitl_emu.px4 import MODE_FLAG_SAFETY_ARMED, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, main_sub
 
 NAN = math.nan
 SETPOINT_PERIOD_S = 0.05  # 20 Hz, as MAVSDK's offboard plugin streams
@@ -166,7 +166,7 @@ class FlightClient:
 
     def set_mode(self, nav_state: NavState) -> int:
         main, sub = main_sub(nav_state)
-        return self.command(176, 1, main, sub)  # DO_SET_MODE, base mode custom
+        return self.command(MavCmd.DO_SET_MODE, 1, main, sub)  # base mode: custom
 
     # --- state ---------------------------------------------------------------------------------------------------
     @property
@@ -225,8 +225,8 @@ def fly_square(client: FlightClient, side_m: float = 5.0, altitude_m: float = 2.
 
 def _square_steps(c: FlightClient, side_m: float, altitude_m: float) -> None:
     c.wait(lambda: c.healthy, 30.0, "health all good")
-    _expect(c.command(400, 1), "arm")
-    _expect(c.command(22, NAN, NAN, NAN, NAN, NAN, NAN, NAN), "takeoff")
+    _expect(c.command(MavCmd.COMPONENT_ARM_DISARM, 1), "arm")
+    _expect(c.command(MavCmd.NAV_TAKEOFF, NAN, NAN, NAN, NAN, NAN, NAN, NAN), "takeoff")
     c.wait(lambda: c.seen.pos_ned_m is not None and -c.seen.pos_ned_m[2] > altitude_m - 0.2, 30.0, "takeoff altitude")
     c.wait(lambda: c.in_mode(NavState.AUTO_LOITER), 30.0, "Hold after takeoff")
     assert c.seen.pos_ned_m is not None
@@ -238,7 +238,7 @@ def _square_steps(c: FlightClient, side_m: float, altitude_m: float) -> None:
         c.setpoint_ned_m = (north, east, z)
         c.wait(partial(_near, c, north, east, 0.3), 20.0, f"corner ({north:g}, {east:g})")
     c.spin(1.0)
-    _expect(c.command(21), "land")
+    _expect(c.command(MavCmd.NAV_LAND), "land")
     c.setpoint_ned_m = None
     c.wait(lambda: not c.armed, 40.0, "landing and auto-disarm")
 

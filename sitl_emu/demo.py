@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import time
 
-from sitl_emu.px4 import LandedState, MavResult, NavState, custom_mode, decode_custom_mode, mode_name
+from sitl_emu.px4 import LandedState, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, mode_name
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
@@ -57,8 +57,8 @@ class Demo:
         self.say("boot: disarmed in Hold, waiting for the simulated estimator")
         self.run(2.5)
         self.status()
-        self.command("arm", 400, 1.0)
-        self.command("takeoff", 22)
+        self.command("arm", MavCmd.COMPONENT_ARM_DISARM, 1.0)
+        self.command("takeoff", MavCmd.NAV_TAKEOFF)
         self.run(12.0)
         self.status()
         self.say("hold for 3 s")
@@ -68,16 +68,16 @@ class Demo:
         self._stream = TrajectorySetpoint(position_ned_m=(0.0, 0.0, z))
         self.run(0.5)
         main, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
-        self.command("set mode OFFBOARD", 176, 1 | 128, main, sub)
+        self.command("set mode OFFBOARD", MavCmd.DO_SET_MODE, 1 | 128, main, sub)
         self.say("offboard: position setpoint 10 m north")
         self._stream = TrajectorySetpoint(position_ned_m=(10.0, 0.0, z))
         for _ in range(4):
             self.run(2.0)
             self.status()
         main, sub = decode_custom_mode(custom_mode(NavState.AUTO_LOITER))
-        self.command("set mode Hold", 176, 1 | 128, main, sub)
+        self.command("set mode Hold", MavCmd.DO_SET_MODE, 1 | 128, main, sub)
         self._stream = None
-        self.command("land", 21)
+        self.command("land", MavCmd.NAV_LAND)
         while self.v.snapshot().armed and self.v.time_us < 120_000_000:
             self.run(1.0)
             if self.v.time_us % 2_000_000 == 0:

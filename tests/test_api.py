@@ -14,7 +14,7 @@ from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.api import Sim
 from sitl_emu.api_client import FlightClient, fly_square
-from sitl_emu.px4 import NavState
+from sitl_emu.px4 import MavCmd, NavState
 
 
 def _fly(seed: int = 0, noise_m: float = 0.0, **params: float) -> tuple[object, list[tuple[float, ...]], float, Sim]:
@@ -148,7 +148,7 @@ def test_a_plain_pymavlink_connection_talks_to_a_lockstep_vehicle():
                 sim.run_for(0.1)
                 while (msg := conn.recv_match(blocking=False)) is not None:
                     msgs.append(msg)
-            conn.mav.command_long_send(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0)  # arm
+            conn.mav.command_long_send(1, 1, MavCmd.COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0)  # arm
             sim.run_for(0.1)
             while (msg := conn.recv_match(blocking=False)) is not None:
                 msgs.append(msg)
@@ -157,5 +157,5 @@ def test_a_plain_pymavlink_connection_talks_to_a_lockstep_vehicle():
     kinds = {m.get_type() for m in msgs}
     assert {"HEARTBEAT", "ATTITUDE", "LOCAL_POSITION_NED", "COMMAND_ACK"} <= kinds
     ack = next(m for m in msgs if m.get_type() == "COMMAND_ACK")
-    assert (ack.command, ack.result) == (400, 0)
+    assert (ack.command, ack.result) == (MavCmd.COMPONENT_ARM_DISARM, 0)
     assert sim.vehicle(0).snapshot().armed

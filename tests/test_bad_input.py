@@ -14,6 +14,7 @@ import time
 import pytest
 from fakes import Harness
 
+from sitl_emu.px4 import MavCmd
 from sitl_emu.runner import RealTimeRunner
 from sitl_emu.vehicle import Vehicle
 
@@ -31,9 +32,9 @@ def h():
 def _still_serving(h) -> None:
     """The peer still gets answers and heartbeats, and nothing went wrong inside."""
     n_ack, n_hb = len(h.api.of_type("COMMAND_ACK")), len(h.api.of_type("HEARTBEAT"))
-    h.api.command_long(512, 148)
+    h.api.command_long(MavCmd.REQUEST_MESSAGE, 148)
     h.run(1.01)
-    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")[n_ack:]] == [(512, 0)]
+    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")[n_ack:]] == [(MavCmd.REQUEST_MESSAGE, 0)]
     assert len(h.api.of_type("HEARTBEAT")) > n_hb
     for ep in h.node.endpoints:
         assert ep.stats.handler_errors == 0 and ep.stats.tx_pack_errors == 0
@@ -48,7 +49,7 @@ def _frame(h, msg) -> bytes:
 
 def test_garbage_and_broken_frames_are_dropped_and_counted(h):
     rng = random.Random(7)
-    good = _frame(h, h.api.mav.command_long_encode(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0))
+    good = _frame(h, h.api.mav.command_long_encode(1, 1, MavCmd.COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))
     bad_crc = good[:-1] + bytes([good[-1] ^ 0xFF])
     unknown_id = bytes([0xFD, 1, 0, 0, 0, 255, 190, 0xFF, 0xFF, 0xFF, 0, 0, 0])
     datagrams = [b"", b"\xfd", b"\xfe", bad_crc, good[:7], good[:-3], unknown_id, bytes(60000),
@@ -63,15 +64,15 @@ def test_garbage_and_broken_frames_are_dropped_and_counted(h):
 
 
 def test_a_truncated_frame_does_not_swallow_the_next_datagram(h):
-    half = _frame(h, h.api.mav.command_long_encode(1, 1, 400, 0, 1, 0, 0, 0, 0, 0, 0))[:20]
+    half = _frame(h, h.api.mav.command_long_encode(1, 1, MavCmd.COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))[:20]
     h.api.send_raw(half)
-    h.api.command_long(512, 148)
+    h.api.command_long(MavCmd.REQUEST_MESSAGE, 148)
     h.io()
-    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")] == [(512, 0)]
+    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")] == [(MavCmd.REQUEST_MESSAGE, 0)]
 
 
 def test_mavlink1_frames_are_understood_and_answered_in_mavlink2(h):
-    msg = h.api.mav.command_long_encode(1, 1, 512, 0, 148, 0, 0, 0, 0, 0, 0)
+    msg = h.api.mav.command_long_encode(1, 1, MavCmd.REQUEST_MESSAGE, 0, 148, 0, 0, 0, 0, 0, 0)
     h.api.send(msg, force_mavlink1=True)
     h.io()
     (ack,) = h.api.of_type("COMMAND_ACK")
@@ -80,7 +81,7 @@ def test_mavlink1_frames_are_understood_and_answered_in_mavlink2(h):
 
 def test_messages_for_another_system_change_nothing(h):
     other = (2, 1)
-    h.api.command_long(400, 1.0, target=other)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0, target=other)
     h.api.send(h.api.mav.set_mode_encode(2, 1, 6 << 16))
     h.api.send(h.api.mav.set_position_target_local_ned_encode(0, 2, 1, 1, 2552, 0, 0, -5, 0, 0, 0, 0, 0, 0, 0, 0))
     h.api.send(h.api.mav.param_set_encode(2, 1, b"MIS_TAKEOFF_ALT", 9.0, 9))
@@ -98,7 +99,7 @@ CMDS = (400, 176, 22, 21, 20, 192, 300, 241, 511, 510, 512, 520, 519, 410, 186, 
 @pytest.mark.parametrize("value", [NAN, INF, -INF, 1e30, -1e30, 2147483647.0])
 def test_nan_inf_and_huge_values_in_every_field_never_break_the_link(h, value):
     v7 = [value] * 7
-    h.api.command_long(400, 1.0)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     for c in CMDS:
         h.api.command_long(c, *v7)
         h.api.send(h.api.mav.command_int_encode(1, 1, 5, c, 0, 0, *v7[:4], 2**31 - 1, -(2**31), value))
@@ -122,7 +123,8 @@ def test_out_of_range_enums_are_refused_quietly(h):
     h.api.send(h.api.mav.set_attitude_target_encode(0, 1, 1, 0xFF, [1, 0, 0, 0], 0, 0, 0, 0.5))
     h.run(0.2)
     acks = [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")]
-    assert acks == [(176, 1), (65535, 3)]  # unsupported mode: TEMPORARILY_REJECTED; unknown command: UNSUPPORTED
+    # unsupported mode: TEMPORARILY_REJECTED; unknown command: UNSUPPORTED
+    assert acks == [(MavCmd.DO_SET_MODE, 1), (65535, 3)]
     assert not h.vehicle.snapshot().armed and h.vehicle.snapshot().nav_state == 4
     _still_serving(h)
 
@@ -152,7 +154,7 @@ def test_setpoint_flood_of_10000_per_second_keeps_physics_on_time_and_the_peer_s
         flooder.start()
         wall0, sim0 = time.monotonic(), h.vehicle.time_us
         time.sleep(0.5)
-        h.gcs.command_long(512, 148)
+        h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 148)
         time.sleep(2.0)
         wall, sim = time.monotonic() - wall0, (h.vehicle.time_us - sim0) / 1e6
     finally:
@@ -166,6 +168,6 @@ def test_setpoint_flood_of_10000_per_second_keeps_physics_on_time_and_the_peer_s
     assert sent["n"] > 15_000
     assert sim > 0.9 * wall, f"physics fell behind: {sim:.2f} s simulated in {wall:.2f} s"
     assert accepted > 0.5 * sent["n"], "most setpoints are handled, the rest dropped by the socket"
-    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(512, 0)]
+    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(MavCmd.REQUEST_MESSAGE, 0)]
     assert len(h.gcs.of_type("HEARTBEAT")) >= 2
     assert h.vehicle.snapshot().offboard_control is not None

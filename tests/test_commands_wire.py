@@ -13,6 +13,7 @@ from fakes import Harness
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.mavlink.version import ProtocolVersionMessage
+from sitl_emu.px4 import MavCmd
 from sitl_emu.vehicle import Vehicle
 
 NAN = math.nan
@@ -46,25 +47,25 @@ def _ask(h, command, *params, wait_s=0.1):
 
 # (command, params, expected results, text that must appear) for a ready, disarmed vehicle in Hold
 READY_CASES = [
-    (400, (1,), [0], "Armed by external command\t"),
-    (400, (2,), [], "Unsupported ARM_DISARM param: 2.000"),
-    (400, (0,), [0], ""),
-    (176, (1, 4, 3), [0], ""),
-    (176, (1, 6, 0), [0], ""),  # OFFBOARD while disarmed: always accepted
-    (176, (1, 99, 0), [1], "Unsupported main mode"),
-    (176, (1, 4, 7), [1], "Unsupported auto mode"),
-    (22, (), [0], ""),  # accepted while disarmed; the takeoff (and its text) starts at arming
-    (21, (), [0], "Landing at current position\t"),
-    (20, (), [0], "Returning to launch\t"),
-    (192, (-1, 1, 0, NAN, NAN, NAN, NAN), [0], ""),
-    (300, (0, 0), [2], "Mission start denied! No valid mission\t"),
-    (241, (0, 0, 0, 0, 0, 0, 0), [2], "Calibration denied: not supported in SIH mode\t"),
+    (MavCmd.COMPONENT_ARM_DISARM, (1,), [0], "Armed by external command\t"),
+    (MavCmd.COMPONENT_ARM_DISARM, (2,), [], "Unsupported ARM_DISARM param: 2.000"),
+    (MavCmd.COMPONENT_ARM_DISARM, (0,), [0], ""),
+    (MavCmd.DO_SET_MODE, (1, 4, 3), [0], ""),
+    (MavCmd.DO_SET_MODE, (1, 6, 0), [0], ""),  # OFFBOARD while disarmed: always accepted
+    (MavCmd.DO_SET_MODE, (1, 99, 0), [1], "Unsupported main mode"),
+    (MavCmd.DO_SET_MODE, (1, 4, 7), [1], "Unsupported auto mode"),
+    (MavCmd.NAV_TAKEOFF, (), [0], ""),  # accepted while disarmed; the takeoff (and its text) starts at arming
+    (MavCmd.NAV_LAND, (), [0], "Landing at current position\t"),
+    (MavCmd.NAV_RETURN_TO_LAUNCH, (), [0], "Returning to launch\t"),
+    (MavCmd.DO_REPOSITION, (-1, 1, 0, NAN, NAN, NAN, NAN), [0], ""),
+    (MavCmd.MISSION_START, (0, 0), [2], "Mission start denied! No valid mission\t"),
+    (MavCmd.PREFLIGHT_CALIBRATION, (0, 0, 0, 0, 0, 0, 0), [2], "Calibration denied: not supported in SIH mode\t"),
     (31000, (), [3], ""),
-    (511, (0, 1e6), [4], ""),  # HEARTBEAT's rate cannot be changed
-    (512, (148,), [0], ""),
-    (520, (1,), [0], ""),
-    (519, (1,), [0], ""),
-    (410, (), [0], ""),
+    (MavCmd.SET_MESSAGE_INTERVAL, (0, 1e6), [4], ""),  # HEARTBEAT's rate cannot be changed
+    (MavCmd.REQUEST_MESSAGE, (148,), [0], ""),
+    (MavCmd.REQUEST_AUTOPILOT_CAPABILITIES, (1,), [0], ""),
+    (MavCmd.REQUEST_PROTOCOL_VERSION, (1,), [0], ""),
+    (MavCmd.GET_HOME_POSITION, (), [0], ""),
 ]
 
 
@@ -77,23 +78,23 @@ def test_ack_codes_and_texts_when_ready(h, command, params, results, text):
 
 
 def test_before_ready_arming_is_rejected_and_home_is_denied(h):
-    got, texts = _ask(h, 400, 1)
+    got, texts = _ask(h, MavCmd.COMPONENT_ARM_DISARM, 1)
     assert got == [1] and "Arming denied: Resolve system health failures first\t" in texts
-    assert _ask(h, 512, 242)[0] == [2]
-    assert _ask(h, 410)[0] == [2]
+    assert _ask(h, MavCmd.REQUEST_MESSAGE, 242)[0] == [2]
+    assert _ask(h, MavCmd.GET_HOME_POSITION)[0] == [2]
 
 
 def test_armed_offboard_without_setpoints_is_temporarily_rejected(h):
     h.run(2.5)
-    assert _ask(h, 400, 1)[0] == [0]
-    assert _ask(h, 176, 1 | 128, 6, 0)[0] == [1]
-    assert _ask(h, 400, 0)[0] == [0]
+    assert _ask(h, MavCmd.COMPONENT_ARM_DISARM, 1)[0] == [0]
+    assert _ask(h, MavCmd.DO_SET_MODE, 1 | 128, 6, 0)[0] == [1]
+    assert _ask(h, MavCmd.COMPONENT_ARM_DISARM, 0)[0] == [0]
 
 
 def test_arm_then_takeoff_climbs_in_auto_takeoff_then_holds(h):
     h.run(2.5)
-    assert _ask(h, 400, 1)[0] == [0]
-    got, texts = _ask(h, 22, wait_s=1.5)
+    assert _ask(h, MavCmd.COMPONENT_ARM_DISARM, 1)[0] == [0]
+    got, texts = _ask(h, MavCmd.NAV_TAKEOFF, wait_s=1.5)
     assert got == [0] and "Using default takeoff altitude: 2.5 m\t" in texts
     assert h.gcs.of_type("HEARTBEAT")[-1].custom_mode == 33816576  # AUTO.TAKEOFF
     assert h.run_until(lambda: h.api.of_type("EXTENDED_SYS_STATE")[-1].landed_state == 3, 4.0)  # TAKEOFF
@@ -106,15 +107,16 @@ def test_set_mode_message_is_acked_as_do_set_mode(h):
     h.run(2.5)
     h.gcs.send(h.gcs.mav.set_mode_encode(1, 1, (5 << 24) | (4 << 16)))
     h.run(1.1)
-    assert _acks(h.gcs) == [(176, 0)]
+    assert _acks(h.gcs) == [(MavCmd.DO_SET_MODE, 0)]
     assert h.gcs.of_type("HEARTBEAT")[-1].custom_mode == 84148224
 
 
 def test_set_and_get_message_interval_apply_to_their_own_link(h):
     h.run(2.0)
-    h.api.command_long(511, 30, 100_000)  # ATTITUDE at 10 Hz on the API link only
-    h.gcs.command_long(511, 331, 50_000, NAN, NAN, NAN, NAN, NAN)  # ODOMETRY at 20 Hz on GCS (NaN params are fine)
-    h.gcs.command_long(511, 32, -1)  # stop LOCAL_POSITION_NED on GCS
+    h.api.command_long(MavCmd.SET_MESSAGE_INTERVAL, 30, 100_000)  # ATTITUDE at 10 Hz on the API link only
+    # ODOMETRY at 20 Hz on GCS (NaN params are fine)
+    h.gcs.command_long(MavCmd.SET_MESSAGE_INTERVAL, 331, 50_000, NAN, NAN, NAN, NAN, NAN)
+    h.gcs.command_long(MavCmd.SET_MESSAGE_INTERVAL, 32, -1)  # stop LOCAL_POSITION_NED on GCS
     h.io()
     n_api, n_gcs = len(h.api.received), len(h.gcs.received)
     h.run(2.0)
@@ -123,31 +125,32 @@ def test_set_and_get_message_interval_apply_to_their_own_link(h):
     assert api["ATTITUDE"] == pytest.approx(20, abs=1) and gcs["ATTITUDE"] == pytest.approx(100, abs=1)
     assert gcs["ODOMETRY"] == pytest.approx(40, abs=1) and gcs["LOCAL_POSITION_NED"] == 0
     assert api["LOCAL_POSITION_NED"] == pytest.approx(60, abs=1)
-    for cmd, params in ((510, (30,)), (510, (32,)), (510, (0,)), (512, (244, 331))):
-        h.gcs.command_long(cmd, *params)
-    h.api.command_long(510, 30)
+    for msg_id in (30, 32, 0):
+        h.gcs.command_long(MavCmd.GET_MESSAGE_INTERVAL, msg_id)
+    h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 244, 331)
+    h.api.command_long(MavCmd.GET_MESSAGE_INTERVAL, 30)
     h.io()
     gcs_iv = [(m.message_id, m.interval_us) for m in h.gcs.of_type("MESSAGE_INTERVAL")]
     assert gcs_iv == [(30, 20_000), (32, 0), (0, 1_000_000), (331, 50_000)]  # stopped: 0, as PX4's code does
     assert [(m.message_id, m.interval_us) for m in h.api.of_type("MESSAGE_INTERVAL")] == [(30, 100_000)]
-    h.gcs.command_long(511, 32, 0)  # back to the default rate
+    h.gcs.command_long(MavCmd.SET_MESSAGE_INTERVAL, 32, 0)  # back to the default rate
     h.io()
-    h.gcs.command_long(510, 32)
+    h.gcs.command_long(MavCmd.GET_MESSAGE_INTERVAL, 32)
     h.io()
     assert h.gcs.of_type("MESSAGE_INTERVAL")[-1].interval_us == 20_000
 
 
 @pytest.mark.parametrize("params", [(9999, 1000), (30, 1000, 1), (30, 1000, 0, 2), (30, 1000, 0, 0, 0, 0, 1)])
 def test_set_message_interval_failures(h, params):
-    assert _ask(h, 511, *params)[0] == [4]
+    assert _ask(h, MavCmd.SET_MESSAGE_INTERVAL, *params)[0] == [4]
 
 
 def test_request_message_sends_the_message_before_the_ack(h):
     h.run(2.5)
     for msg_id in (148, 300, 242, 1, 245):
-        h.gcs.command_long(512, msg_id)
-    h.gcs.command_long(520, 1, target=(1, 0))  # legacy, any component
-    h.gcs.command_long(512, 12345)  # no such stream
+        h.gcs.command_long(MavCmd.REQUEST_MESSAGE, msg_id)
+    h.gcs.command_long(MavCmd.REQUEST_AUTOPILOT_CAPABILITIES, 1, target=(1, 0))  # legacy, any component
+    h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 12345)  # no such stream
     n = len(h.gcs.received)
     h.io()
     got = [m.get_type() for m in h.gcs.received[n:] if m.get_type() not in ("HEARTBEAT",)]
@@ -175,11 +178,11 @@ def test_seed_sequence_arm_stream_offboard_climb_follow_then_loss_returns(h):
             h.api.send(h.api.mav.set_position_target_local_ned_encode(
                 0, 1, 1, 1, 3576, target["x"], 0.0, target["z"], 0, 0, 0, 0, 0, 0, 0, 0))
     h.run(2.5, stream)
-    h.api.command_long(400, 1.0)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     h.run(0.6, stream)  # ten setpoints and more
-    h.api.command_long(176, 1 | 128, 6, 0)
+    h.api.command_long(MavCmd.DO_SET_MODE, 1 | 128, 6, 0)
     h.run(0.1, stream)
-    assert _acks(h.api) == [(400, 0), (176, 0)]
+    assert _acks(h.api) == [(MavCmd.COMPONENT_ARM_DISARM, 0), (MavCmd.DO_SET_MODE, 0)]
     h.run(10.0, stream)
     pos = h.api.of_type("LOCAL_POSITION_NED")[-1]
     assert pos.z == pytest.approx(-5.0, abs=0.3) and abs(pos.x) < 0.3
@@ -197,7 +200,7 @@ def test_seed_sequence_arm_stream_offboard_climb_follow_then_loss_returns(h):
 
 
 def test_available_modes_on_request_all_or_one(h):
-    h.gcs.command_long(512, 435, 0)
+    h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 435, 0)
     h.io()
     modes = h.gcs.of_type("AVAILABLE_MODES")
     assert [m.mode_index for m in modes] == list(range(1, len(modes) + 1))
@@ -206,9 +209,9 @@ def test_available_modes_on_request_all_or_one(h):
     assert by_mode[50593792].mode_name == "Hold" and by_mode[50593792].standard_mode == 0
     assert by_mode[84148224].standard_mode == 5 and by_mode[84148224].mode_name == ""  # Return = SAFE_RECOVERY
     assert by_mode[196608].properties == 0 and by_mode[393216].properties == 1  # Position basic, Offboard advanced
-    assert _acks(h.gcs) == [(512, 0)]
-    h.gcs.command_long(512, 435, 3)
-    h.gcs.command_long(512, 435, len(modes) + 1)
+    assert _acks(h.gcs) == [(MavCmd.REQUEST_MESSAGE, 0)]
+    h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 435, 3)
+    h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 435, len(modes) + 1)
     h.io()
     assert h.gcs.of_type("AVAILABLE_MODES")[-1].mode_index == 3
-    assert _acks(h.gcs)[1:] == [(512, 0), (512, 2)]
+    assert _acks(h.gcs)[1:] == [(MavCmd.REQUEST_MESSAGE, 0), (MavCmd.REQUEST_MESSAGE, 2)]

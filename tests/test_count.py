@@ -17,6 +17,7 @@ from pathlib import Path
 
 from sitl_emu.api import ScaledWallClock
 from sitl_emu.api_client import FlightClient
+from sitl_emu.px4 import MavCmd
 
 REPO = Path(__file__).resolve().parent.parent
 SPEED = 4.0
@@ -73,7 +74,7 @@ def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_ot
         homes = [c.seen.lat_lon_deg for c in clients]
         assert 2.5 < _east_m(homes[0], homes[1]) < 3.5 and 5.5 < _east_m(homes[0], homes[2]) < 6.5
         flyer = clients[1]
-        assert flyer.command(400, 1) == 0 and flyer.command(22) == 0
+        assert flyer.command(MavCmd.COMPONENT_ARM_DISARM, 1) == 0 and flyer.command(MavCmd.NAV_TAKEOFF) == 0
         flyer.wait(lambda: flyer.seen.pos_ned_m is not None and flyer.seen.pos_ned_m[2] < -2.0, 20.0, "takeoff")
         for c in (clients[0], clients[2]):
             c.spin(0.5)
@@ -118,7 +119,8 @@ def test_a_vehicle_that_reboots_keeps_its_place_and_the_others_keep_stepping():
     with Sim(count=2) as sim:
         runner = SwarmRunner(sim.nodes, speed=1000.0)
         runner.run(duration_s=0.5)
-        ack = sim.vehicle(0).handle_command(VehicleCommand(246, (1.0,) + (math.nan,) * 6))  # reboot autopilot
+        reboot = VehicleCommand(MavCmd.PREFLIGHT_REBOOT_SHUTDOWN, (1.0,) + (math.nan,) * 6)  # param1 1: autopilot
+        ack = sim.vehicle(0).handle_command(reboot)
         runner.run(duration_s=0.5)
         times = [v.time_us for v in sim.vehicles]
     assert ack is not None and ack.result == 0

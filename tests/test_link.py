@@ -8,6 +8,7 @@ import pytest
 from fakes import Client, FakeVehicle, Harness
 
 from sitl_emu.mavlink.link import PortInUseError, UdpLink
+from sitl_emu.px4 import MavCmd
 from sitl_emu.server import LinkSettings, VehicleNode
 
 
@@ -34,13 +35,14 @@ def test_first_peer_is_latched_and_later_senders_are_parsed_but_not_answered(h):
         first.target = second.target = h.api.target
         first.heartbeat()
         h.io()
-        second.command_long(512, 148)  # parsed (a command from a stranger) but the reply goes to the first peer
+        # parsed (a command from a stranger) but the reply goes to the first peer
+        second.command_long(MavCmd.REQUEST_MESSAGE, 148)
         h.run(1.2)
         first.drain()
         second.drain()
         assert first.of_type("HEARTBEAT"), "the first peer receives the link's traffic"
         assert not second.received, "a later sender is never answered"
-        assert [a.command for a in first.of_type("COMMAND_ACK")] == [512]
+        assert [a.command for a in first.of_type("COMMAND_ACK")] == [MavCmd.REQUEST_MESSAGE]
         assert h.node.api.link.stats.rx_ignored_foreign == 1
         n_before = len(h.api.received)
         h.run(1.0)
@@ -105,14 +107,15 @@ def test_messages_not_only_for_us_are_forwarded_to_the_other_link_unchanged(h):
     qgc, mavros = h.gcs, h.api
     mavros.heartbeat(18)  # MAVROS identity differs: sysid 1, compid 191 on a real setup; here 255/190 on both
     qgc.heartbeat(6)
-    qgc.command_long(512, 148)  # for us (1/1): answered, never forwarded
+    qgc.command_long(MavCmd.REQUEST_MESSAGE, 148)  # for us (1/1): answered, never forwarded
     h.io()
     forwarded = [m for m in mavros.received if m.get_srcSystem() == 255]
     assert [m.get_type() for m in forwarded] == ["HEARTBEAT"]
     assert forwarded[0].type == 6 and bytes(forwarded[0].get_msgbuf())[0] == 0xFD
     assert not [m for m in mavros.received if m.get_type() == "COMMAND_LONG"]
-    mavros.send(mavros.mav.command_ack_encode(400, 0, 0, 0, 255, 190))  # to a component heard on the GCS link
-    mavros.send(mavros.mav.command_ack_encode(400, 0, 0, 0, 42, 42))  # to nobody we know
+    arm = MavCmd.COMPONENT_ARM_DISARM
+    mavros.send(mavros.mav.command_ack_encode(arm, 0, 0, 0, 255, 190))  # to a component heard on the GCS link
+    mavros.send(mavros.mav.command_ack_encode(arm, 0, 0, 0, 42, 42))  # to nobody we know
     h.io()
     acks = qgc.of_type("COMMAND_ACK", source=(255, 190))  # forwarded ones, not the vehicle's own
     assert [(a.target_system, a.target_component) for a in acks] == [(255, 190)]

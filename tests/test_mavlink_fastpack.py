@@ -22,7 +22,7 @@ from pymavlink.dialects.v20 import development as dialect
 from sitl_emu.mavlink import fastpack
 from sitl_emu.mavlink.telemetry import BUILDERS, ON_REQUEST
 from sitl_emu.mavlink.version import ProtocolVersionMessage
-from sitl_emu.px4 import NavState
+from sitl_emu.px4 import MavCmd, NavState
 from sitl_emu.types import HomePosition, OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
@@ -139,8 +139,8 @@ def _flight_snapshots() -> list[Any]:
                 shots.append(v.snapshot())
 
     run(2.5)
-    v.handle_command(VehicleCommand(400, (1.0, *(NAN,) * 6)))
-    v.handle_command(VehicleCommand(22, (NAN,) * 7))
+    v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, *(NAN,) * 6)))
+    v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (NAN,) * 7))
     run(5.0)
     v.offboard_input(OffboardControlMode(position=True), TrajectorySetpoint(position_ned_m=(3.0, -2.0, -4.0)))
     run(1.0)
@@ -239,13 +239,13 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
         h.gcs.send(mav.mission_request_list_encode(1, 1, 0))
         h.gcs.send(mav.mission_count_encode(1, 1, 3, 0))
         for msg_id, param2 in ((148, 0), (300, 0), (435, 0), (242, 0), (245, 0), (147, 0)):
-            h.gcs.command_long(512, msg_id, param2)
-        h.gcs.command_long(400, 1.0)  # arm: denied before the estimator is ready -> a status text
+            h.gcs.command_long(MavCmd.REQUEST_MESSAGE, msg_id, param2)
+        h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)  # denied before the estimator is ready: a status text
         h.gcs.send(mav.serial_control_encode(10, 2, 0, 0, 5, list(b"help\n") + [0] * 65))
         run(4.0)
         h.gcs.heartbeat()
-        h.gcs.command_long(400, 1.0)
-        h.gcs.command_long(22, NAN, NAN, NAN, NAN, NAN, NAN, 2.5)
+        h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
+        h.gcs.command_long(MavCmd.NAV_TAKEOFF, NAN, NAN, NAN, NAN, NAN, NAN, 2.5)
         run(3.0)
         seen: set[int] = set()
         for link, datagrams in raw.items():

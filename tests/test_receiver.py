@@ -7,7 +7,7 @@ import math
 import pytest
 from fakes import Client, FakeVehicle, Harness
 
-from sitl_emu.px4 import MavResult, NavState
+from sitl_emu.px4 import MavCmd, MavResult, NavState
 
 NAN = math.nan
 
@@ -35,39 +35,39 @@ def _local_ned(client: Client, mask: int, frame: int = 1, pos=(0.0, 0.0, 0.0), v
 ])
 def test_command_long_is_ours_only_for_exactly_our_sysid(h, target, answered):
     """evaluate_target_ok(): target_system must be ours (0 is not enough), target_component ours or 0."""
-    h.api.command_long(400, 1.0, target=target)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0, target=target)
     h.io()
     assert bool(h.vehicle.commands) is answered
-    assert _acks(h.api) == ([(400, MavResult.ACCEPTED)] if answered else [])
+    assert _acks(h.api) == ([(MavCmd.COMPONENT_ARM_DISARM, MavResult.ACCEPTED)] if answered else [])
 
 
 @pytest.mark.parametrize("target", [(0, 0), (1, 0), (1, 5), (0, 99)])
 def test_legacy_capability_requests_accept_broadcast_and_any_component(h, target):
-    h.api.command_long(520, 1.0, target=target)
+    h.api.command_long(MavCmd.REQUEST_AUTOPILOT_CAPABILITIES, 1.0, target=target)
     h.io()
-    assert _acks(h.api) == [(520, MavResult.ACCEPTED)]
+    assert _acks(h.api) == [(MavCmd.REQUEST_AUTOPILOT_CAPABILITIES, MavResult.ACCEPTED)]
     assert h.api.of_type("AUTOPILOT_VERSION")
 
 
 def test_command_params_source_and_external_flag_reach_the_vehicle(h):
-    h.api.command_long(22, NAN, 0.0, 0.0, 1.5, 47.1, 8.2, 500.0)
+    h.api.command_long(MavCmd.NAV_TAKEOFF, NAN, 0.0, 0.0, 1.5, 47.1, 8.2, 500.0)
     h.io()
     (cmd,) = h.vehicle.commands
-    assert cmd.command == 22 and cmd.from_external
+    assert cmd.command == MavCmd.NAV_TAKEOFF and cmd.from_external
     assert (cmd.source_system, cmd.source_component) == (255, 190)
     assert math.isnan(cmd.param(1)) and cmd.param(4) == 1.5 and cmd.param(7) == pytest.approx(500.0)
 
 
 def test_command_long_with_int32_max_lat_lon_is_denied_before_the_vehicle(h):
-    h.api.command_long(192, -1.0, 1.0, 0.0, NAN, 2147483647.0, 2147483647.0, 500.0)
+    h.api.command_long(MavCmd.DO_REPOSITION, -1.0, 1.0, 0.0, NAN, 2147483647.0, 2147483647.0, 500.0)
     h.io()
     assert not h.vehicle.commands
-    assert _acks(h.api) == [(192, MavResult.DENIED)]
+    assert _acks(h.api) == [(MavCmd.DO_REPOSITION, MavResult.DENIED)]
 
 
 def test_no_ack_when_the_vehicle_says_none(h):
-    h.vehicle.acks[400] = None  # ARM_DISARM with param1 not 0/1: PX4 sends no ACK
-    h.api.command_long(400, 2.0)
+    h.vehicle.acks[MavCmd.COMPONENT_ARM_DISARM] = None  # ARM_DISARM with param1 not 0/1: PX4 sends no ACK
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 2.0)
     h.io()
     assert h.vehicle.commands and not _acks(h.api)
 
@@ -75,9 +75,9 @@ def test_no_ack_when_the_vehicle_says_none(h):
 def test_vehicle_ack_goes_to_every_link_that_has_heard_the_sender(h):
     h.gcs.heartbeat()  # same sysid/compid (255/190) heard on the GCS link too
     h.io()
-    h.api.command_long(400, 1.0)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     h.io()
-    assert _acks(h.api) == [(400, 0)] and _acks(h.gcs) == [(400, 0)]
+    assert _acks(h.api) == [(MavCmd.COMPONENT_ARM_DISARM, 0)] and _acks(h.gcs) == [(MavCmd.COMPONENT_ARM_DISARM, 0)]
     ack = h.api.of_type("COMMAND_ACK")[0]
     assert (ack.target_system, ack.target_component) == (255, 190)
 
@@ -87,9 +87,9 @@ def _command_int(client: Client, command: int, frame: int, x: int, y: int, z: fl
 
 
 def test_command_int_x_y_are_degrees_e7_and_int32_max_means_unset(h):
-    _command_int(h.api, 192, 5, 473977420, 85455940)  # GLOBAL_INT: degrees * 1e7
-    _command_int(h.api, 192, 1, 123456, -50000)  # a local frame: PX4 <= v1.17 still divides by 1e7
-    _command_int(h.api, 192, 5, 2147483647, 2147483647)  # INT32_MAX: "not set" -> NaN
+    _command_int(h.api, MavCmd.DO_REPOSITION, 5, 473977420, 85455940)  # GLOBAL_INT: degrees * 1e7
+    _command_int(h.api, MavCmd.DO_REPOSITION, 1, 123456, -50000)  # a local frame: PX4 <= v1.17 still divides by 1e7
+    _command_int(h.api, MavCmd.DO_REPOSITION, 5, 2147483647, 2147483647)  # INT32_MAX: "not set" -> NaN
     h.io()
     c = h.vehicle.commands
     assert (c[0].param(5), c[0].param(6), c[0].param(7)) == pytest.approx((47.397742, 8.545594, 10.0))
@@ -99,9 +99,9 @@ def test_command_int_x_y_are_degrees_e7_and_int32_max_means_unset(h):
 
 
 def test_command_int_with_nan_pattern_xy_is_denied(h):
-    _command_int(h.api, 192, 5, 0x7FF80000, 0x7FF80000)
+    _command_int(h.api, MavCmd.DO_REPOSITION, 5, 0x7FF80000, 0x7FF80000)
     h.io()
-    assert not h.vehicle.commands and _acks(h.api) == [(192, MavResult.DENIED)]
+    assert not h.vehicle.commands and _acks(h.api) == [(MavCmd.DO_REPOSITION, MavResult.DENIED)]
 
 
 def test_set_mode_becomes_do_set_mode_and_is_acked_as_176(h):
@@ -109,8 +109,8 @@ def test_set_mode_becomes_do_set_mode_and_is_acked_as_176(h):
     h.api.send(h.api.mav.set_mode_encode(0, 1, 6 << 16))  # target 0: commander ignores it
     h.io()
     (cmd,) = h.vehicle.commands
-    assert cmd.command == 176 and cmd.params[:3] == (1.0, 4.0, 3.0)
-    assert _acks(h.api) == [(176, MavResult.ACCEPTED)]
+    assert cmd.command == MavCmd.DO_SET_MODE and cmd.params[:3] == (1.0, 4.0, 3.0)
+    assert _acks(h.api) == [(MavCmd.DO_SET_MODE, MavResult.ACCEPTED)]
 
 
 # --- setpoints (4.4, 4.7, 4.8) ---------------------------------------------------------------------------------------
@@ -288,7 +288,7 @@ def test_our_own_looped_back_messages_are_ignored(h):
     own = Client(sysid=1, compid=1)
     own.target = h.api.target
     try:
-        own.command_long(400, 1.0)
+        own.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
         h.io()
         assert not h.vehicle.commands
     finally:

@@ -13,11 +13,11 @@ import pytest
 from fakes import Client, FakeVehicle, Harness
 
 from sitl_emu.api import Sim
+from sitl_emu.px4 import MavCmd
 from sitl_emu.runner import RealTimeRunner, SocketWatch
 from sitl_emu.server import READ_API, READ_GCS
 from sitl_emu.swarm import SwarmRunner
 
-CMD_REQUEST_MESSAGE = 512
 PROTOCOL_VERSION = 300
 
 
@@ -44,8 +44,8 @@ def test_the_watch_names_the_node_and_link_with_data_until_it_is_read():
 def test_step_io_reads_only_the_links_named_and_by_default_both():
     h = Harness(FakeVehicle())
     try:
-        h.api.command_long(400, 1)
-        h.gcs.command_long(400, 0)
+        h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1)
+        h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 0)
         assert h.node.step_io(0, READ_GCS) == 1
         assert [c.params[0] for c in h.vehicle.commands] == [0.0]
         assert h.node.step_io(0, 0) == 0  # told nothing waits: the API command stays in its socket
@@ -60,7 +60,7 @@ def test_lockstep_answers_each_vehicle_at_the_first_tick_after_the_command():
         client = Client()
         client.target = sim.ports(1).gcs
         sim.run_for(0.1)
-        client.command_long(CMD_REQUEST_MESSAGE, PROTOCOL_VERSION, target=(2, 1))
+        client.command_long(MavCmd.REQUEST_MESSAGE, PROTOCOL_VERSION, target=(2, 1))
         sim.run_for(0.004)  # one tick
         acks = [(m.get_srcSystem(), m.result) for m in client.drain() if m.get_type() == "COMMAND_ACK"]
         client.close()
@@ -75,7 +75,7 @@ def _ack_wall_s(runner: RealTimeRunner, h: Harness) -> float:
         time.sleep(0.3)
         h.gcs.drain()
         sent = time.monotonic()
-        h.gcs.command_long(CMD_REQUEST_MESSAGE, PROTOCOL_VERSION)
+        h.gcs.command_long(MavCmd.REQUEST_MESSAGE, PROTOCOL_VERSION)
         while time.monotonic() - sent < 3.0:
             if any(m.get_type() == "COMMAND_ACK" for m in h.gcs.drain()):
                 return time.monotonic() - sent

@@ -14,6 +14,8 @@ import pytest
 from ports import free_udp_ports
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.px4 import MavCmd
+
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -144,7 +146,7 @@ def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
         assert conn.flightmode == "LOITER"
         conn.arducopter_arm()
         ack = conn.recv_match(type="COMMAND_ACK", blocking=True, timeout=5)
-        assert (ack.command, ack.result) == (400, 0)
+        assert (ack.command, ack.result) == (MavCmd.COMPONENT_ARM_DISARM, 0)
         conn.set_mode("TAKEOFF")
         assert conn.recv_match(type="COMMAND_ACK", blocking=True, timeout=5).result == 0
         seen: list[str] = []
@@ -183,7 +185,7 @@ def test_real_time_runner_follows_the_wall_clock_across_a_reboot():
     try:
         thread.start()
         time.sleep(0.8)
-        h.gcs.command_long(246, 1)  # reboot: simulated time starts again at 0
+        h.gcs.command_long(MavCmd.PREFLIGHT_REBOOT_SHUTDOWN, 1)  # reboot: simulated time starts again at 0
         time.sleep(0.5)
         after_s = h.vehicle.time_us / 1e6
     finally:

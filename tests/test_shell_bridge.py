@@ -11,7 +11,7 @@ from sitl_emu.mavlink.shell_bridge import (
     SERIAL_CONTROL_FLAG_REPLY,
     ShellBridge,
 )
-from sitl_emu.px4 import Severity
+from sitl_emu.px4 import MavCmd, Severity
 
 EXCLUSIVE_RESPOND = 6  # what PX4's Tools/mavlink_shell.py sends
 
@@ -64,7 +64,7 @@ def test_commander_arm_goes_to_the_vehicle_and_its_log_line_comes_back(setup):
     out = _read(bridge, ctx)
     assert out == b"commander arm\nINFO  [commander] Armed by internal command\npxh> "
     (cmd,) = vehicle.commands
-    assert cmd.command == 400 and not cmd.from_external
+    assert cmd.command == MavCmd.COMPONENT_ARM_DISARM and not cmd.from_external
 
 
 def test_events_while_open_are_streamed(setup):
@@ -104,7 +104,7 @@ def test_control_bytes_are_ignored(setup):
 def test_message_without_respond_runs_then_closes(setup):
     bridge, ctx, client = setup
     _type(bridge, ctx, client, b"commander land\n", flags=0)
-    assert [c.command for c in ctx.vehicle.commands] == [21]
+    assert [c.command for c in ctx.vehicle.commands] == [MavCmd.NAV_LAND]
     assert not bridge.is_open
     assert _read(bridge, ctx) == b""
 

@@ -9,6 +9,7 @@ import pytest
 from fakes import HOME, Harness
 from pymavlink import mavutil
 
+from sitl_emu.px4 import MavCmd
 from sitl_emu.vehicle import Vehicle
 
 EPOCH_US = 1_700_000_000_000_000
@@ -45,9 +46,9 @@ def test_boot_heartbeat_is_px4_sitl_hold_uninit_then_standby_once_ready(h):
 def test_pymavlink_px4_mode_map_round_trips_through_do_set_mode(h, name):
     base_mode, main, sub = mavutil.px4_map[name]
     h.run(2.5)
-    h.api.command_long(176, base_mode, main, sub)
+    h.api.command_long(MavCmd.DO_SET_MODE, base_mode, main, sub)
     h.run(1.1)
-    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")] == [(176, 0)]
+    assert [(a.command, a.result) for a in h.api.of_type("COMMAND_ACK")] == [(MavCmd.DO_SET_MODE, 0)]
     hb = _last(h.api, "HEARTBEAT")
     assert mavutil.interpret_px4_mode(hb.base_mode, hb.custom_mode) == name
     assert hb.custom_mode == (sub << 24) | (main << 16)
@@ -55,7 +56,7 @@ def test_pymavlink_px4_mode_map_round_trips_through_do_set_mode(h, name):
 
 def test_base_mode_offboard_is_1_without_setpoints_17_with_and_145_armed(h):
     h.run(2.5)
-    h.api.command_long(176, 1, 6, 0)
+    h.api.command_long(MavCmd.DO_SET_MODE, 1, 6, 0)
     h.run(1.0)
     assert _last(h.api, "HEARTBEAT").base_mode == 1
     every = {"n": 0}
@@ -66,7 +67,7 @@ def test_base_mode_offboard_is_1_without_setpoints_17_with_and_145_armed(h):
             _stream_setpoints(h)
     h.run(1.0, stream)
     assert _last(h.api, "HEARTBEAT").base_mode == 17
-    h.api.command_long(400, 1.0)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     h.run(1.0, stream)
     hb = _last(h.api, "HEARTBEAT")
     assert (hb.base_mode, hb.system_status) == (145, 4)
@@ -140,8 +141,8 @@ def test_offboard_flight_reports_setpoint_and_intended_mode(h):
         if n["i"] % 12 == 0:
             _stream_setpoints(h, z=-3.0)
     h.run(2.5, stream)
-    h.api.command_long(400, 1.0)
-    h.api.command_long(176, 1, 6, 0)
+    h.api.command_long(MavCmd.COMPONENT_ARM_DISARM, 1.0)
+    h.api.command_long(MavCmd.DO_SET_MODE, 1, 6, 0)
     h.run(8.0, stream)
     target = _last(h.gcs, "POSITION_TARGET_LOCAL_NED")
     assert target.coordinate_frame == 1 and target.z == pytest.approx(-3.0, abs=0.05)
@@ -167,9 +168,9 @@ def test_imu_and_barometer_at_rest_read_gravity_and_isa_pressure(h):
 def test_reboot_restarts_simulated_time_and_the_streams_carry_on(h):
     h.gcs.heartbeat()
     h.run(3.0)
-    h.gcs.command_long(246, 1)  # PREFLIGHT_REBOOT_SHUTDOWN: reboot autopilot
+    h.gcs.command_long(MavCmd.PREFLIGHT_REBOOT_SHUTDOWN, 1)  # param1 1: reboot the autopilot
     h.run(0.1)
-    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(246, 0)]
+    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(MavCmd.PREFLIGHT_REBOOT_SHUTDOWN, 0)]
     assert h.vehicle.time_us < 200_000, "time starts again at boot"
     n_hb = len(h.api.of_type("HEARTBEAT"))
     h.run(3.0)

@@ -11,15 +11,8 @@ import math
 from typing import Any
 
 from sitl_emu.mavlink.modes_msgs import available_modes
-from sitl_emu.px4 import MavResult
+from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.types import VehicleCommand
-
-CMD_GET_HOME_POSITION = 410
-CMD_GET_MESSAGE_INTERVAL = 510
-CMD_SET_MESSAGE_INTERVAL = 511
-CMD_REQUEST_MESSAGE = 512
-CMD_REQUEST_PROTOCOL_VERSION = 519
-CMD_REQUEST_AUTOPILOT_CAPABILITIES = 520
 
 MSG_HOME_POSITION = 242
 MSG_MESSAGE_INTERVAL = 244
@@ -29,14 +22,14 @@ MSG_AVAILABLE_MODES = 435
 
 # legacy request commands -> the message they ask for (PX4@2024 mavlink_receiver.cpp)
 LEGACY_REQUESTS = {
-    CMD_REQUEST_AUTOPILOT_CAPABILITIES: MSG_AUTOPILOT_VERSION,
-    CMD_REQUEST_PROTOCOL_VERSION: MSG_PROTOCOL_VERSION,
-    CMD_GET_HOME_POSITION: MSG_HOME_POSITION,
+    MavCmd.REQUEST_AUTOPILOT_CAPABILITIES: MSG_AUTOPILOT_VERSION,
+    MavCmd.REQUEST_PROTOCOL_VERSION: MSG_PROTOCOL_VERSION,
+    MavCmd.GET_HOME_POSITION: MSG_HOME_POSITION,
 }
 # commands accepted whatever their target_component (PX4@2024 evaluate_target_ok)
-ANY_COMPONENT = frozenset({CMD_REQUEST_AUTOPILOT_CAPABILITIES, CMD_REQUEST_PROTOCOL_VERSION})
-MAVLINK_MODULE_COMMANDS = frozenset({CMD_GET_MESSAGE_INTERVAL, CMD_SET_MESSAGE_INTERVAL, CMD_REQUEST_MESSAGE,
-                                     *LEGACY_REQUESTS})
+ANY_COMPONENT = frozenset({MavCmd.REQUEST_AUTOPILOT_CAPABILITIES, MavCmd.REQUEST_PROTOCOL_VERSION})
+MAVLINK_MODULE_COMMANDS = frozenset({MavCmd.GET_MESSAGE_INTERVAL, MavCmd.SET_MESSAGE_INTERVAL,
+                                     MavCmd.REQUEST_MESSAGE, *LEGACY_REQUESTS})
 
 
 class CommandHandler:
@@ -56,11 +49,11 @@ class CommandHandler:
         return int(ack.result)
 
     def _mavlink_command(self, cmd: VehicleCommand, ctx: Any) -> int:
-        if cmd.command == CMD_SET_MESSAGE_INTERVAL:
+        if cmd.command == MavCmd.SET_MESSAGE_INTERVAL:
             return self._set_interval(cmd, ctx)
-        if cmd.command == CMD_GET_MESSAGE_INTERVAL:
+        if cmd.command == MavCmd.GET_MESSAGE_INTERVAL:
             return self._get_interval(_msg_id(cmd.param(1)), ctx)
-        if cmd.command == CMD_REQUEST_MESSAGE:
+        if cmd.command == MavCmd.REQUEST_MESSAGE:
             msg_id = _msg_id(cmd.param(1))
             if msg_id == MSG_MESSAGE_INTERVAL:
                 return self._get_interval(_msg_id(cmd.param(2)), ctx)

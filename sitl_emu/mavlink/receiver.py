@@ -18,13 +18,12 @@ from typing import Any
 
 from sitl_emu.mavlink import setpoints
 from sitl_emu.mavlink.commands import ANY_COMPONENT
-from sitl_emu.px4 import MavResult, Severity, decode_custom_mode
+from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
 from sitl_emu.types import VehicleCommand
 
 log = logging.getLogger(__name__)
 
 MAV_TYPE_GCS = 6
-CMD_DO_SET_MODE = 176
 # COMMAND_LONG param5 and param6 within one float32 ulp of INT32_MAX: "INT32_MAX sent in a COMMAND_LONG" -> DENIED
 INT32_MAX_LO, INT32_MAX_HI = float(2**31 - 128), float(2**31 + 256)  # nextafterf((float)INT32_MAX, 0 / +inf)
 COMMAND_INT_NAN_XY = 0x7FF80000  # x == y == this: DENIED (reference 3.1)
@@ -101,7 +100,7 @@ class Receiver:
         if msg.target_system != ctx.sysid:  # commander only takes DO_SET_MODE meant exactly for this system
             return
         main, sub = decode_custom_mode(msg.custom_mode)
-        cmd = VehicleCommand(CMD_DO_SET_MODE, (float(msg.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0),
+        cmd = VehicleCommand(MavCmd.DO_SET_MODE, (float(msg.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0),
                              msg.get_srcSystem(), msg.get_srcComponent(), True)
         ctx.commands.execute(cmd, ctx)
 
