@@ -263,7 +263,7 @@ class VehicleLink:
 
     def _send_command(self, command: int, params: tuple[float, ...], confirmation: int = 0) -> None:
         sysid, compid = self._target()
-        self._mav.command_long_send(sysid, compid, command, confirmation, *params)
+        self._mav.send(self._mav.command_long_encode(sysid, compid, command, confirmation, *params))
 
     def command(self, command: int, *params: float) -> CommandHandle:
         """Send a COMMAND_LONG (unused params 0, which PX4 accepts in every version) and track its ACK."""

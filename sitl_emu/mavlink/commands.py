@@ -8,11 +8,16 @@ REQUEST_PROTOCOL_VERSION (519) and GET_HOME_POSITION (410) as aliases of REQUEST
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink.modes_msgs import available_modes
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.types import VehicleCommand
+
+if TYPE_CHECKING:
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
+    from sitl_emu.mavlink.telemetry import Streams
 
 MSG_HOME_POSITION = 242
 MSG_MESSAGE_INTERVAL = 244
@@ -21,7 +26,7 @@ MSG_PROTOCOL_VERSION = 300
 MSG_AVAILABLE_MODES = 435
 
 # legacy request commands -> the message they ask for (PX4@2024 mavlink_receiver.cpp)
-LEGACY_REQUESTS = {
+LEGACY_REQUESTS: dict[int, int] = {
     MavCmd.REQUEST_AUTOPILOT_CAPABILITIES: MSG_AUTOPILOT_VERSION,
     MavCmd.REQUEST_PROTOCOL_VERSION: MSG_PROTOCOL_VERSION,
     MavCmd.GET_HOME_POSITION: MSG_HOME_POSITION,
@@ -33,9 +38,15 @@ MAVLINK_MODULE_COMMANDS = frozenset({MavCmd.GET_MESSAGE_INTERVAL, MavCmd.SET_MES
 
 
 class CommandHandler:
-    """Runs one command on behalf of a link; returns the MAV_RESULT to ACK, or None when the vehicle answers."""
+    """Runs one command on behalf of a link; returns the MAV_RESULT to ACK, or None when the vehicle answers.
 
-    def execute(self, cmd: VehicleCommand, ctx: Any) -> int | None:
+    `streams` is the link's stream table, which the message-interval and request commands read and configure.
+    """
+
+    def __init__(self, streams: Streams) -> None:
+        self._streams = streams
+
+    def execute(self, cmd: VehicleCommand, ctx: EndpointContext) -> int | None:
         """Mavlink-module commands are answered here (ACK on this link); the rest go to the vehicle."""
         if cmd.command in MAVLINK_MODULE_COMMANDS:
             result = self._mavlink_command(cmd, ctx)
@@ -48,9 +59,9 @@ class CommandHandler:
         ctx.node.route_ack(ack.command, int(ack.result), cmd.source_system, cmd.source_component)
         return int(ack.result)
 
-    def _mavlink_command(self, cmd: VehicleCommand, ctx: Any) -> int:
+    def _mavlink_command(self, cmd: VehicleCommand, ctx: EndpointContext) -> int:
         if cmd.command == MavCmd.SET_MESSAGE_INTERVAL:
-            return self._set_interval(cmd, ctx)
+            return self._set_interval(cmd)
         if cmd.command == MavCmd.GET_MESSAGE_INTERVAL:
             return self._get_interval(_msg_id(cmd.param(1)), ctx)
         if cmd.command == MavCmd.REQUEST_MESSAGE:
@@ -62,8 +73,7 @@ class CommandHandler:
             return self._request(msg_id, ctx)
         return self._request(LEGACY_REQUESTS[cmd.command], ctx)
 
-    @staticmethod
-    def _set_interval(cmd: VehicleCommand, ctx: Any) -> int:
+    def _set_interval(self, cmd: VehicleCommand) -> int:
         # set_message_interval(): param3, param4 and param7 (response target) must be 0 or NaN
         for i in (3, 4, 7):
             p = cmd.param(i)
@@ -73,25 +83,23 @@ class CommandHandler:
         interval_us = cmd.param(2)
         if msg_id is None or math.isnan(interval_us):
             return MavResult.FAILED
-        return MavResult.ACCEPTED if ctx.streams.set_interval(msg_id, interval_us) else MavResult.FAILED
+        return MavResult.ACCEPTED if self._streams.set_interval(msg_id, interval_us) else MavResult.FAILED
 
-    @staticmethod
-    def _get_interval(msg_id: int | None, ctx: Any) -> int:
+    def _get_interval(self, msg_id: int | None, ctx: EndpointContext) -> int:
         if msg_id is None:
             return MavResult.FAILED
-        ctx.send(ctx.mav.message_interval_encode(msg_id, ctx.streams.get_interval(msg_id)))
+        ctx.send(ctx.mav.message_interval_encode(msg_id, self._streams.get_interval(msg_id)))
         return MavResult.ACCEPTED
 
-    @staticmethod
-    def _request(msg_id: int | None, ctx: Any) -> int:
+    def _request(self, msg_id: int | None, ctx: EndpointContext) -> int:
         """REQUEST_MESSAGE: the message goes out on this link before the ACK; DENIED if no stream or no data."""
         if msg_id is None:
             return MavResult.DENIED
-        msg = ctx.streams.build(msg_id, ctx, ctx.node.snapshot())
-        return CommandHandler._send_all(None if msg is None else [msg], ctx)
+        msg = self._streams.build(msg_id, ctx, ctx.node.snapshot())
+        return self._send_all(None if msg is None else [msg], ctx)
 
     @staticmethod
-    def _send_all(msgs: list[Any] | None, ctx: Any) -> int:
+    def _send_all(msgs: Sequence[OutMessage] | None, ctx: EndpointContext) -> int:
         if not msgs:
             return MavResult.DENIED
         for msg in msgs:

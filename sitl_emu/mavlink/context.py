@@ -1,38 +1,76 @@
-"""The contract between a link endpoint and the protocol handlers plugged into it.
+"""The contracts inside a link: what an endpoint offers the protocol handlers and its own parts.
 
-An endpoint (one UDP link: API or GCS) owns a pymavlink encoder, the latched peer and the stream scheduler. For each
-received message whose type a handler lists in MESSAGES, it calls handler.handle(msg, ctx); once per main-loop
-iteration it calls handler.tick(ctx) so handlers can stream (parameter lists, shell output).
-Handlers never touch sockets or clocks: they read ctx.now_us and call ctx.send().
+An endpoint (one UDP link: API or GCS, sitl_emu/mavlink/endpoint.py) owns a pymavlink encoder, the latched peer and
+the stream scheduler. For each received message whose type a handler lists in MESSAGES, it calls
+handler.handle(msg, ctx); once per main-loop iteration it calls handler.tick(ctx) so handlers can stream (parameter
+lists, shell output). Handlers never touch sockets or clocks: they read ctx.now_us and call ctx.send().
+
+- LinkContext: what a plugged-in protocol handler (params, mission, shell) may use.
+- EndpointContext: LinkContext plus what the endpoint's own parts use (receiver, command handler, telemetry
+  builders): the fast encoder, the node's snapshot and ACK routing, the GCS heartbeat bookkeeping.
+Tests implement LinkContext in memory (tests/handler_ctx.py); Endpoint implements both.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, ClassVar, Protocol
 
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.common import MAVLink, MAVLink_message
+    from typing import TypeAlias
 
+    from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
+
+    from sitl_emu.mavlink.fastpack import Encoder, Packed
+    from sitl_emu.types import VehicleSnapshot
     from sitl_emu.vehicle import Vehicle
+
+    # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
+    OutMessage: TypeAlias = MAVLink_message | Packed
 
 
 class LinkContext(Protocol):
-    vehicle: Vehicle
     mav: MAVLink  # encoder with this vehicle's sysid/compid: ctx.mav.param_value_encode(...)
     link_name: str  # "api" or "gcs"
     sysid: int
     compid: int
 
     @property
+    def vehicle(self) -> Vehicle: ...
+
+    @property
     def now_us(self) -> int: ...
 
-    def send(self, msg: MAVLink_message) -> None:
+    def send(self, msg: OutMessage) -> None:
         """Send on this link, to its latched peer (or its initial remote)."""
         ...
 
-    def broadcast(self, msg: MAVLink_message) -> None:
+    def broadcast(self, msg: OutMessage) -> None:
         """Send on every link of this vehicle (PX4 re-broadcasts changed parameters)."""
         ...
+
+
+class NodeView(Protocol):
+    """What an endpoint's parts ask of the node that owns the links (sitl_emu/server.py VehicleNode)."""
+
+    epoch_unix_us: int  # wall time of simulated time 0 (SYSTEM_TIME)
+
+    def snapshot(self) -> VehicleSnapshot: ...
+
+    def invalidate_snapshot(self) -> None:
+        """An input changed the vehicle: the next snapshot() must be a fresh one."""
+        ...
+
+    def route_ack(self, command: int, result: int, target_system: int, target_component: int) -> None:
+        """COMMAND_ACK on every link where the commanding component has been heard."""
+        ...
+
+
+class EndpointContext(LinkContext, Protocol):
+    encoder: Encoder  # fastpack.ENCODER: the same calls as ctx.mav, cheaper messages (telemetry streams)
+    last_gcs_heartbeat_us: int | None  # the receiver sets it on a GCS heartbeat
+
+    @property
+    def node(self) -> NodeView: ...
 
 
 class Handler(Protocol):
@@ -40,6 +78,6 @@ class Handler(Protocol):
     # Optional: a handler whose tick() never sends may set `TICKS: ClassVar[bool] = False`; the endpoint then does
     # not call it (one call less per link and tick). Absent means True.
 
-    def handle(self, msg: Any, ctx: LinkContext) -> None: ...
+    def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None: ...
 
     def tick(self, ctx: LinkContext) -> None: ...

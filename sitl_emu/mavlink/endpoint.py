@@ -1,4 +1,4 @@
-"""One MAVLink link of the vehicle (API/onboard or GCS/normal): parse, dispatch, stream. The LinkContext lives here.
+"""One MAVLink link of the vehicle (API/onboard or GCS/normal): parse, dispatch, stream; the context of its handlers.
 
 PX4 runs one `Mavlink` instance per link (src/modules/mavlink/mavlink_main.cpp), each with its own receiver, its own
 stream list and rates, its own sequence numbers and its own "GCS seen" bookkeeping; so does this class. It holds no
@@ -13,18 +13,23 @@ import struct
 from collections import deque
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.mavlink.commands import CommandHandler
+from sitl_emu.mavlink.context import NodeView
 from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.telemetry import StreamMode, Streams
 
 if TYPE_CHECKING:
-    from sitl_emu.types import VehicleEvent, VehicleSnapshot
+    from pymavlink.dialects.v20.development import MAVLink_message
+
+    from sitl_emu.mavlink.context import Handler, OutMessage
+    from sitl_emu.types import VehicleEvent
+    from sitl_emu.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -53,24 +58,17 @@ def load_handler_classes(spec: Iterable[tuple[str, str]] = HANDLER_CLASSES) -> l
     return classes
 
 
-class NodeServices(Protocol):
-    """What an endpoint needs from the node that owns it."""
+class NodeServices(NodeView, Protocol):
+    """What an endpoint needs from the node that owns it: what its parts use (NodeView) and the links' plumbing."""
 
-    vehicle: Any
-    epoch_unix_us: int
+    vehicle: Vehicle
 
     @property
     def sysid(self) -> int: ...
 
-    def broadcast(self, msg: Any) -> None: ...
+    def broadcast(self, msg: OutMessage) -> None: ...
 
-    def route_ack(self, command: int, result: int, target_system: int, target_component: int) -> None: ...
-
-    def snapshot(self) -> VehicleSnapshot: ...
-
-    def invalidate_snapshot(self) -> None: ...
-
-    def forward(self, msg: Any, origin: Any, target_system: int, target_component: int) -> None: ...
+    def forward(self, msg: MAVLink_message, origin: Endpoint, target_system: int, target_component: int) -> None: ...
 
 
 @dataclass(slots=True)
@@ -94,7 +92,8 @@ class _LinkWriter:
 
 
 class Endpoint:
-    """A link endpoint; also the LinkContext handed to protocol handlers."""
+    """A link endpoint; also the context (sitl_emu/mavlink/context.py) handed to its parts and protocol handlers:
+    a LinkContext for the handlers, an EndpointContext for its receiver, command handler and telemetry."""
 
     GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
 
@@ -112,30 +111,29 @@ class Endpoint:
         self._parser = _new_parser()
         self.stats = EndpointStats()
         self.streams = Streams(mode)
-        self.commands = CommandHandler()
-        self.receiver = Receiver()
+        self.receiver = Receiver(CommandHandler(self.streams))
         self.seen_components: set[tuple[int, int]] = set()
         self.last_gcs_heartbeat_us: int | None = None
         # mavlink_log messages wait (uORB queue of 8) until a GCS is connected; older than 5 s they are dropped
         self._pending_texts: deque[VehicleEvent] = deque(maxlen=MAVLINK_LOG_QUEUE)
         self._now_us = 0
-        self._handlers = [cls() for cls in handler_classes]
+        self._handlers: list[Handler] = [cls() for cls in handler_classes]
         self._tickers = [h for h in self._handlers if getattr(h, "TICKS", True)]  # context.py: TICKS False = idle
-        self._routes: dict[str, list[Any]] = {}
+        self._routes: dict[str, list[Handler]] = {}
         for h in self._handlers:
             for msg_type in h.MESSAGES:
                 self._routes.setdefault(msg_type, []).append(h)
 
     # --- LinkContext ---------------------------------------------------------------------------------------------
     @property
-    def vehicle(self) -> Any:
+    def vehicle(self) -> Vehicle:
         return self.node.vehicle
 
     @property
     def now_us(self) -> int:
         return self._now_us
 
-    def send(self, msg: Any) -> None:
+    def send(self, msg: OutMessage) -> None:
         """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
         mav = self.mav
         try:
@@ -148,7 +146,7 @@ class Endpoint:
         self.link.send(data)
         mav.seq = (mav.seq + 1) % 256
 
-    def broadcast(self, msg: Any) -> None:
+    def broadcast(self, msg: OutMessage) -> None:
         self.node.broadcast(msg)
 
     # --- receive -------------------------------------------------------------------------------------------------
@@ -161,7 +159,7 @@ class Endpoint:
                 self.dispatch(msg)
         return len(datagrams)
 
-    def dispatch(self, msg: Any) -> None:
+    def dispatch(self, msg: MAVLink_message) -> None:
         msg_type = msg.get_type()
         if msg_type == "BAD_DATA":
             self.stats.rx_parse_errors += 1
@@ -182,7 +180,7 @@ class Endpoint:
                       exc_info=log.isEnabledFor(logging.DEBUG))
         self._forward(msg)
 
-    def _forward(self, msg: Any) -> None:
+    def _forward(self, msg: MAVLink_message) -> None:
         """Mavlink::forward_message (both SITL links run with -f): pass on what is not only for us, unchanged.
 
         A message with target (our sysid, our compid) stays here; others go to every other link, if broadcast
@@ -195,7 +193,7 @@ class Endpoint:
             return
         self.node.forward(msg, self, target_system, target_component)
 
-    def pass_message(self, msg: Any) -> None:
+    def pass_message(self, msg: MAVLink_message) -> None:
         """Send a received message on as it is (its own sysid, compid, sequence and checksum)."""
         self.stats.tx_forwarded += 1
         self.link.send(bytes(msg.get_msgbuf()))
@@ -204,7 +202,7 @@ class Endpoint:
         last = self.last_gcs_heartbeat_us
         return last is not None and self._now_us - last <= self.GCS_TIMEOUT_US
 
-    def _parse(self, data: bytes) -> list[Any]:
+    def _parse(self, data: bytes) -> list[MAVLink_message]:
         """Frames in one datagram. A frame cut short at the datagram's end is dropped, so it cannot swallow the
         start of the next datagram (senders put whole frames in each datagram)."""
         try:
@@ -249,7 +247,7 @@ class Endpoint:
         self.link.close()
 
 
-def _new_parser() -> Any:
+def _new_parser() -> dialect.MAVLink:
     parser = dialect.MAVLink(None, srcSystem=0, srcComponent=0)
     parser.robust_parsing = True
     return parser

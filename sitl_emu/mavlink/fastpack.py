@@ -23,9 +23,12 @@ import binascii
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from pymavlink.dialects.v20 import development as dialect
+
+if TYPE_CHECKING:
+    from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
 
 _mcrf4xx: Callable[[bytes, int], int] | None
 try:  # pymavlink's own CRC dependency (a C extension); the stdlib fallback below gives the same numbers
@@ -82,13 +85,13 @@ class Packed:
         """The whole payload, before MAVLink 2's zero truncation."""
         return self.spec.pack(*self.values)
 
-    def pack(self, mav: Any, force_mavlink1: bool = False) -> bytes:
+    def pack(self, mav: MAVLink, force_mavlink1: bool = False) -> bytes:
         if force_mavlink1:
             raise ValueError("Packed messages are MAVLink 2 only")
         return frame_message(self, mav.seq, mav.srcSystem, mav.srcComponent)
 
 
-def frame_message(msg: Any, seq: int, sysid: int, compid: int) -> bytes:
+def frame_message(msg: MAVLink_message | Packed, seq: int, sysid: int, compid: int) -> bytes:
     """The MAVLink 2 frame of a Packed or of any pymavlink message object, exactly as pymavlink's
     MAVLink_message._pack builds it, unsigned (a struct.error etc. for a value out of range)."""
     if type(msg) is Packed:
@@ -163,7 +166,7 @@ def _encode_defaults(cls: Any) -> tuple[Any, ...] | None:
     return source.__defaults__
 
 
-class _Encoder:
+class Encoder:
     """`ENCODER.attitude_encode(...)` -> Packed, the same call as pymavlink's `mav.attitude_encode(...)`."""
 
     def __getattr__(self, attr: str) -> Callable[..., Packed]:
@@ -177,4 +180,4 @@ class _Encoder:
         return encode
 
 
-ENCODER: Any = _Encoder()
+ENCODER = Encoder()

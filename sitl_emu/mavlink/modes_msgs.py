@@ -8,10 +8,15 @@ the ui.hpp name. ADVANCED is set for every mode but Altitude and Position (mode_
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 from sitl_emu import px4
 from sitl_emu.px4 import NavState
+
+if TYPE_CHECKING:
+    from pymavlink.dialects.v20.development import MAVLink_available_modes_message
+
+    from sitl_emu.mavlink.context import LinkContext
 
 # Multicopter modes of PX4 v1.15 in nav_state order (mode_util::getValidNavStates() of that era).
 VALID_MODES: tuple[NavState, ...] = (
@@ -19,6 +24,7 @@ VALID_MODES: tuple[NavState, ...] = (
     NavState.AUTO_RTL, NavState.ACRO, NavState.DESCEND, NavState.TERMINATION, NavState.OFFBOARD, NavState.STAB,
     NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND, NavState.ORBIT,
 )
+# MAV_STANDARD_MODE of the modes that have one (src/lib/modes/standard_modes.hpp); the others are NON_STANDARD (0).
 STANDARD_MODE = {NavState.POSCTL: 1, NavState.ORBIT: 2, NavState.ALTCTL: 4, NavState.AUTO_RTL: 5,
                  NavState.AUTO_MISSION: 6, NavState.AUTO_LAND: 7, NavState.AUTO_TAKEOFF: 8}
 NOT_USER_SELECTABLE = frozenset({NavState.DESCEND, NavState.TERMINATION})  # failsafe-only states
@@ -26,7 +32,7 @@ MODE_PROPERTY_ADVANCED = 1
 MODE_PROPERTY_NOT_USER_SELECTABLE = 2
 
 
-def available_modes(ctx: Any, index_param: float) -> list[Any] | None:
+def available_modes(ctx: LinkContext, index_param: float) -> list[MAVLink_available_modes_message] | None:
     """The AVAILABLE_MODES messages for REQUEST_MESSAGE param2; None (DENIED) for an index past the end."""
     index = round(index_param) if math.isfinite(index_param) else 0
     total = len(VALID_MODES)
@@ -37,7 +43,7 @@ def available_modes(ctx: Any, index_param: float) -> list[Any] | None:
     return None
 
 
-def _mode_message(ctx: Any, index: int, nav: NavState) -> Any:
+def _mode_message(ctx: LinkContext, index: int, nav: NavState) -> MAVLink_available_modes_message:
     standard = STANDARD_MODE.get(nav, 0)
     properties = 0 if nav in (NavState.ALTCTL, NavState.POSCTL) else MODE_PROPERTY_ADVANCED
     if nav in NOT_USER_SELECTABLE:

@@ -20,11 +20,23 @@ import logging
 import math
 import struct
 import zlib
-from typing import Any, ClassVar
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, ClassVar, cast
 
-from sitl_emu.mavlink.fastpack import ENCODER
+from sitl_emu.mavlink.fastpack import ENCODER, Packed
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import Severity
+
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    from pymavlink.dialects.v20 import development as dialect
+    from pymavlink.dialects.v20.development import MAVLink_message
+
+    from sitl_emu.mavlink.context import LinkContext
+
+    _ParamMessage: TypeAlias = (dialect.MAVLink_param_request_list_message | dialect.MAVLink_param_request_read_message
+                                | dialect.MAVLink_param_set_message)
 
 log = logging.getLogger(__name__)
 
@@ -70,8 +82,8 @@ def px4_param_hash(registry: ParamRegistry) -> int:
     return state
 
 
-def _param_id(msg: Any) -> str:
-    raw = msg.param_id
+def _param_id(msg: dialect.MAVLink_param_request_read_message | dialect.MAVLink_param_set_message) -> str:
+    raw: str | bytes = msg.param_id  # str in newer pymavlink releases, bytes in older ones
     if isinstance(raw, bytes):
         raw = raw.decode("ascii", errors="replace")
     return raw.split("\x00", 1)[0]
@@ -87,30 +99,30 @@ class ParamProtocol:
         self._send_hash = False
         self._seen_version: int | None = None
         self._seen_values: dict[str, float] = {}
+        # message type -> its handler, which takes that type's message class (the one place a message is narrowed)
+        self._table: dict[str, Callable[[Any, LinkContext], None]] = {
+            "PARAM_REQUEST_LIST": self._start_list,
+            "PARAM_REQUEST_READ": self._handle_read,
+            "PARAM_SET": self._handle_set,
+        }
 
     # --- receive -----------------------------------------------------------------------------------------------
-    def handle(self, msg: Any, ctx: Any) -> None:
-        if not self._addressed_to_us(msg, ctx):
-            return
-        kind = msg.get_type()
-        if kind == "PARAM_REQUEST_LIST":
-            self._start_list()
-        elif kind == "PARAM_REQUEST_READ":
-            self._handle_read(msg, ctx)
-        elif kind == "PARAM_SET":
-            self._handle_set(msg, ctx)
+    def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None:
+        handler = self._table.get(msg.get_type())
+        if handler is not None and self._addressed_to_us(cast("_ParamMessage", msg), ctx):  # a type of the table
+            handler(msg, ctx)
 
     @staticmethod
-    def _addressed_to_us(msg: Any, ctx: Any) -> bool:
+    def _addressed_to_us(msg: _ParamMessage, ctx: LinkContext) -> bool:
         # PX4 accepts only its own sysid exactly (0 is not a broadcast here) and its compid or 0 (section 10.1).
         return msg.target_system == ctx.sysid and msg.target_component in (ctx.compid, 0)
 
-    def _start_list(self) -> None:
+    def _start_list(self, msg: dialect.MAVLink_param_request_list_message, ctx: LinkContext) -> None:
         # A request during a running list restarts it from index 0 without the hash (section 10.1).
         self._send_hash = self._next_index is None
         self._next_index = 0
 
-    def _handle_read(self, msg: Any, ctx: Any) -> None:
+    def _handle_read(self, msg: dialect.MAVLink_param_request_read_message, ctx: LinkContext) -> None:
         registry: ParamRegistry = ctx.vehicle.params
         if msg.param_index >= 0:
             if msg.param_index < len(registry):
@@ -126,7 +138,7 @@ class ParamProtocol:
         else:
             log.debug("PARAM_REQUEST_READ: unknown parameter %r (no reply, as PX4 <= v1.16)", name)
 
-    def _handle_set(self, msg: Any, ctx: Any) -> None:
+    def _handle_set(self, msg: dialect.MAVLink_param_set_message, ctx: LinkContext) -> None:
         registry: ParamRegistry = ctx.vehicle.params
         name = _param_id(msg)
         if name == HASH_CHECK_NAME:
@@ -157,14 +169,14 @@ class ParamProtocol:
         return "MAV_HASH_CHK_EN" not in registry or int(registry.get("MAV_HASH_CHK_EN")) == 1
 
     # --- transmit ----------------------------------------------------------------------------------------------
-    def tick(self, ctx: Any) -> None:
+    def tick(self, ctx: LinkContext) -> None:
         # Every link, every tick: idle (no list streaming, registry unchanged) must cost next to nothing.
         if self._next_index is None and self._seen_version == ctx.vehicle.params.version:
             return
         self._send_changes(ctx)
         self._stream(ctx)
 
-    def _stream(self, ctx: Any) -> None:
+    def _stream(self, ctx: LinkContext) -> None:
         if self._next_index is None:
             return
         registry: ParamRegistry = ctx.vehicle.params
@@ -180,7 +192,7 @@ class ParamProtocol:
             budget -= 1
         self._next_index = index if index < len(registry) else None
 
-    def _send_changes(self, ctx: Any) -> None:
+    def _send_changes(self, ctx: LinkContext) -> None:
         """Re-send every parameter whose value changed since the last tick (PX4's send_untransmitted)."""
         registry: ParamRegistry = ctx.vehicle.params
         if self._seen_version == registry.version:
@@ -195,7 +207,7 @@ class ParamProtocol:
         self._seen_values = values
 
     @staticmethod
-    def _value_msg(ctx: Any, name: str) -> Any:
+    def _value_msg(ctx: LinkContext, name: str) -> Packed:
         registry: ParamRegistry = ctx.vehicle.params
         definition = registry.definition(name)
         value = registry.get(name)
@@ -207,7 +219,7 @@ class ParamProtocol:
                                           registry.index_of(name))
 
     @staticmethod
-    def _hash_msg(ctx: Any) -> Any:
+    def _hash_msg(ctx: LinkContext) -> Packed:
         registry: ParamRegistry = ctx.vehicle.params
         wire = uint32_to_float_bits(px4_param_hash(registry))
         return ENCODER.param_value_encode(HASH_CHECK_NAME.encode("ascii"), wire, MAV_PARAM_TYPE_UINT32, len(registry),

@@ -14,12 +14,22 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sitl_emu.mavlink import setpoints
-from sitl_emu.mavlink.commands import ANY_COMPONENT
+from sitl_emu.mavlink.commands import ANY_COMPONENT, CommandHandler
 from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
 from sitl_emu.types import VehicleCommand
+
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    from pymavlink.dialects.v20 import development as dialect
+    from pymavlink.dialects.v20.development import MAVLink_message
+
+    from sitl_emu.mavlink.context import EndpointContext
+
+    _CommandMessage: TypeAlias = dialect.MAVLink_command_long_message | dialect.MAVLink_command_int_message
 
 log = logging.getLogger(__name__)
 
@@ -32,10 +42,13 @@ ERROR_TEXT_INTERVAL_US = 1_000_000  # one copy of the same complaint per second,
 
 
 class Receiver:
-    """One per link; `handle(msg, ctx)` for every message (it ignores types it does not know)."""
+    """One per link; `handle(msg, ctx)` for every message (it ignores types it does not know). Commands go on to
+    the link's CommandHandler."""
 
-    def __init__(self) -> None:
-        self._table: dict[str, Callable[[Any, Any], None]] = {
+    def __init__(self, commands: CommandHandler) -> None:
+        self._commands = commands
+        # message type -> its handler, which takes that type's message class (the one place a message is narrowed)
+        self._table: dict[str, Callable[[Any, EndpointContext], None]] = {
             "HEARTBEAT": self._heartbeat,
             "COMMAND_LONG": self._command_long,
             "COMMAND_INT": self._command_int,
@@ -50,31 +63,31 @@ class Receiver:
         self.setpoints_accepted = 0
         self.setpoints_refused = 0
 
-    def handle(self, msg: Any, ctx: Any) -> None:
+    def handle(self, msg: MAVLink_message, ctx: EndpointContext) -> None:
         fn = self._table.get(msg.get_type())
         if fn is not None:
             fn(msg, ctx)
 
     # --- bookkeeping -------------------------------------------------------------------------------------------
     @staticmethod
-    def _heartbeat(msg: Any, ctx: Any) -> None:
+    def _heartbeat(msg: dialect.MAVLink_heartbeat_message, ctx: EndpointContext) -> None:
         if msg.type == MAV_TYPE_GCS and msg.get_srcSystem() != ctx.sysid:
             ctx.last_gcs_heartbeat_us = ctx.now_us
 
     @staticmethod
-    def _ping(msg: Any, ctx: Any) -> None:
+    def _ping(msg: dialect.MAVLink_ping_message, ctx: EndpointContext) -> None:
         """Echo pings addressed to everyone (target 0/0), back to the sender (reference 1.9)."""
         if msg.target_system == 0 and msg.target_component == 0:
             ctx.send(ctx.mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(), msg.get_srcComponent()))
 
     @staticmethod
-    def _timesync(msg: Any, ctx: Any) -> None:
+    def _timesync(msg: dialect.MAVLink_timesync_message, ctx: EndpointContext) -> None:
         """mavlink_timesync.cpp: answer requests (tc1 == 0) with our boot time in ns."""
         if msg.tc1 == 0:
             ctx.send(ctx.mav.timesync_encode(ctx.now_us * 1000, msg.ts1))
 
     # --- commands ----------------------------------------------------------------------------------------------
-    def _command_long(self, msg: Any, ctx: Any) -> None:
+    def _command_long(self, msg: dialect.MAVLink_command_long_message, ctx: EndpointContext) -> None:
         if not _command_for_us(msg, ctx):
             return
         params = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
@@ -82,9 +95,9 @@ class Receiver:
         if _is_int32_max(msg.param5) and _is_int32_max(msg.param6):
             _ack_here(ctx, cmd, MavResult.DENIED)
             return
-        ctx.commands.execute(cmd, ctx)
+        self._commands.execute(cmd, ctx)
 
-    def _command_int(self, msg: Any, ctx: Any) -> None:
+    def _command_int(self, msg: dialect.MAVLink_command_int_message, ctx: EndpointContext) -> None:
         if not _command_for_us(msg, ctx):
             return
         x, y = int(msg.x), int(msg.y)
@@ -93,31 +106,32 @@ class Receiver:
                       MavResult.DENIED)
             return
         p5, p6 = _command_int_xy(x, y)
-        ctx.commands.execute(_command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z)), ctx)
+        self._commands.execute(_command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z)), ctx)
 
-    def _set_mode(self, msg: Any, ctx: Any) -> None:
+    def _set_mode(self, msg: dialect.MAVLink_set_mode_message, ctx: EndpointContext) -> None:
         """SET_MODE -> DO_SET_MODE(base_mode, main, sub); the ACK is for command 176 (reference 3.4)."""
         if msg.target_system != ctx.sysid:  # commander only takes DO_SET_MODE meant exactly for this system
             return
         main, sub = decode_custom_mode(msg.custom_mode)
         cmd = VehicleCommand(MavCmd.DO_SET_MODE, (float(msg.base_mode), float(main), float(sub), 0.0, 0.0, 0.0, 0.0),
                              msg.get_srcSystem(), msg.get_srcComponent(), True)
-        ctx.commands.execute(cmd, ctx)
+        self._commands.execute(cmd, ctx)
 
     # --- offboard setpoints ------------------------------------------------------------------------------------
-    def _local_ned(self, msg: Any, ctx: Any) -> None:
+    def _local_ned(self, msg: dialect.MAVLink_set_position_target_local_ned_message, ctx: EndpointContext) -> None:
         if _targets_us(msg, ctx):
             self._apply(setpoints.decode_local_ned(msg, ctx.node.snapshot()), ctx)
 
-    def _global_int(self, msg: Any, ctx: Any) -> None:
+    def _global_int(self, msg: dialect.MAVLink_set_position_target_global_int_message, ctx: EndpointContext
+                    ) -> None:
         if _targets_us(msg, ctx):
             self._apply(setpoints.decode_global_int(msg, ctx.node.snapshot()), ctx)
 
-    def _attitude_target(self, msg: Any, ctx: Any) -> None:
+    def _attitude_target(self, msg: dialect.MAVLink_set_attitude_target_message, ctx: EndpointContext) -> None:
         if _targets_us(msg, ctx):
             self._apply(setpoints.decode_attitude_target(msg), ctx)
 
-    def _apply(self, decoded: setpoints.Decoded, ctx: Any) -> None:
+    def _apply(self, decoded: setpoints.Decoded, ctx: EndpointContext) -> None:
         if decoded.mode is None:
             self.setpoints_refused += 1
             if decoded.error is not None:
@@ -127,7 +141,7 @@ class Receiver:
         ctx.vehicle.offboard_input(decoded.mode, decoded.trajectory, decoded.attitude)
         ctx.node.invalidate_snapshot()
 
-    def _complain(self, text: str, ctx: Any) -> None:
+    def _complain(self, text: str, ctx: EndpointContext) -> None:
         last = self._last_error_us.get(text)
         if last is not None and ctx.now_us - last < ERROR_TEXT_INTERVAL_US:
             return
@@ -135,24 +149,24 @@ class Receiver:
         ctx.vehicle.report(Severity.CRITICAL, "mavlink", text, is_event=True)
 
 
-def _targets_us(msg: Any, ctx: Any) -> bool:
+def _targets_us(msg: setpoints.SetpointMessage, ctx: EndpointContext) -> bool:
     """Setpoint messages: target_system 0 or ours, target_component 0 or ours."""
     return msg.target_system in (0, ctx.sysid) and msg.target_component in (0, ctx.compid)
 
 
-def _command_for_us(msg: Any, ctx: Any) -> bool:
+def _command_for_us(msg: _CommandMessage, ctx: EndpointContext) -> bool:
     """evaluate_target_ok(): exact sysid for commands, except the two legacy broadcast requests."""
     if msg.command in ANY_COMPONENT:
         return msg.target_system in (0, ctx.sysid)
     return msg.target_system == ctx.sysid and msg.target_component in (0, ctx.compid)
 
 
-def _command(msg: Any, params: tuple[float, ...]) -> VehicleCommand:
+def _command(msg: _CommandMessage, params: tuple[float, ...]) -> VehicleCommand:
     values = tuple(float(p) for p in params)
-    return VehicleCommand(int(msg.command), values, msg.get_srcSystem(), msg.get_srcComponent(), True)  # type: ignore
+    return VehicleCommand(int(msg.command), values, msg.get_srcSystem(), msg.get_srcComponent(), True)  # type: ignore[arg-type]
 
 
-def _ack_here(ctx: Any, cmd: VehicleCommand, result: int) -> None:
+def _ack_here(ctx: EndpointContext, cmd: VehicleCommand, result: int) -> None:
     ctx.send(ctx.mav.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
 
 

@@ -10,10 +10,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink.telemetry_msgs import rotate_body_to_ned
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, VehicleSnapshot
+
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    from pymavlink.dialects.v20 import development as dialect
+
+    SetpointMessage: TypeAlias = (dialect.MAVLink_set_position_target_local_ned_message
+                                  | dialect.MAVLink_set_position_target_global_int_message
+                                  | dialect.MAVLink_set_attitude_target_message)
 
 NAN = math.nan
 # POSITION_TARGET_TYPEMASK
@@ -47,7 +56,7 @@ class Decoded:
 DROPPED = Decoded()
 
 
-def decode_local_ned(msg: Any, snap: VehicleSnapshot) -> Decoded:
+def decode_local_ned(msg: dialect.MAVLink_set_position_target_local_ned_message, snap: VehicleSnapshot) -> Decoded:
     """SET_POSITION_TARGET_LOCAL_NED: frames LOCAL_NED (1) and BODY_NED (8) only."""
     frame = int(msg.coordinate_frame)
     mask = int(msg.type_mask)
@@ -66,7 +75,8 @@ def decode_local_ned(msg: Any, snap: VehicleSnapshot) -> Decoded:
                        msg.yaw, msg.yaw_rate)
 
 
-def decode_global_int(msg: Any, snap: VehicleSnapshot) -> Decoded:
+def decode_global_int(msg: dialect.MAVLink_set_position_target_global_int_message, snap: VehicleSnapshot
+                      ) -> Decoded:
     """SET_POSITION_TARGET_GLOBAL_INT: lat/lon projected into the local frame; z per frame as PX4 codes it."""
     frame = int(msg.coordinate_frame)
     mask = int(msg.type_mask)
@@ -87,7 +97,7 @@ def decode_global_int(msg: Any, snap: VehicleSnapshot) -> Decoded:
                        msg.yaw_rate)
 
 
-def decode_attitude_target(msg: Any) -> Decoded:
+def decode_attitude_target(msg: dialect.MAVLink_set_attitude_target_message) -> Decoded:
     """SET_ATTITUDE_TARGET: attitude and/or body rates, with thrust; otherwise dropped."""
     mask = int(msg.type_mask)
     use_attitude = not mask & ATTITUDE_IGNORE
@@ -148,7 +158,7 @@ def _global_z(frame: int, alt_m: float, snap: VehicleSnapshot) -> float | None:
     return None  # GLOBAL_TERRAIN_ALT_INT needs terrain data, which SIH does not estimate
 
 
-def _thrust_body(msg: Any, mask: int) -> Vec3 | None:
+def _thrust_body(msg: dialect.MAVLink_set_attitude_target_message, mask: int) -> Vec3 | None:
     if mask & THRUST_BODY_SET:
         tx, ty, tz = (float(v) for v in getattr(msg, "thrust_body", (0.0, 0.0, 0.0)))
         return (tx, ty, tz) if all(math.isfinite(v) for v in (tx, ty, tz)) else None

@@ -16,10 +16,16 @@ The target_system/target_component extension fields are not in pymavlink's diale
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar, cast
 
 from sitl_emu.mavlink.fastpack import ENCODER
 from sitl_emu.shell import Shell
+
+if TYPE_CHECKING:
+    from pymavlink.dialects.v20.development import MAVLink_message, MAVLink_serial_control_message
+
+    from sitl_emu.mavlink.context import LinkContext
+    from sitl_emu.vehicle import Vehicle
 
 SERIAL_CONTROL_DEV_SHELL = 10
 SERIAL_CONTROL_FLAG_REPLY = 1
@@ -48,7 +54,8 @@ class ShellBridge:
         return self._shell is not None
 
     # --- receive -----------------------------------------------------------------------------------------------
-    def handle(self, msg: Any, ctx: Any) -> None:
+    def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None:
+        msg = cast("MAVLink_serial_control_message", msg)  # MESSAGES: the endpoint sends only SERIAL_CONTROL
         if not _accepted(msg, ctx):
             return
         if self._shell is None:
@@ -58,7 +65,7 @@ class ShellBridge:
         if not msg.flags & SERIAL_CONTROL_FLAG_RESPOND:
             self._close()
 
-    def _open(self, ctx: Any) -> None:
+    def _open(self, ctx: LinkContext) -> None:
         self._shell = Shell(ctx.vehicle, self._on_shutdown)
         self._line.clear()
         self._out.clear()
@@ -69,7 +76,7 @@ class ShellBridge:
         self._line.clear()
         self._out.clear()
 
-    def _write(self, data: bytes, ctx: Any) -> None:
+    def _write(self, data: bytes, ctx: LinkContext) -> None:
         for byte in data:
             if byte == 0x0A:
                 self._run_line(ctx)
@@ -77,7 +84,7 @@ class ShellBridge:
                 self._out.append(byte)  # echo
                 self._line.append(byte)
 
-    def _run_line(self, ctx: Any) -> None:
+    def _run_line(self, ctx: LinkContext) -> None:
         assert self._shell is not None
         line = self._line.decode("utf-8", errors="replace")
         self._line.clear()
@@ -88,7 +95,7 @@ class ShellBridge:
         self._out += PROMPT
 
     # --- transmit ----------------------------------------------------------------------------------------------
-    def tick(self, ctx: Any) -> None:
+    def tick(self, ctx: LinkContext) -> None:
         if self._shell is None:
             return
         self._collect_events(ctx)
@@ -101,7 +108,7 @@ class ShellBridge:
             ctx.send(ENCODER.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
                                                    len(chunk), data))
 
-    def _collect_events(self, ctx: Any) -> None:
+    def _collect_events(self, ctx: LinkContext) -> None:
         events = ctx.vehicle.events_after(self._last_seq)
         if events:
             self._last_seq = events[-1].seq
@@ -110,7 +117,7 @@ class ShellBridge:
             del self._out[: len(self._out) - MAX_PENDING_OUTPUT]
 
 
-def _accepted(msg: Any, ctx: Any) -> bool:
+def _accepted(msg: MAVLink_serial_control_message, ctx: LinkContext) -> bool:
     target_system = getattr(msg, "target_system", 0)
     target_component = getattr(msg, "target_component", 0)
     if target_system not in (0, ctx.sysid) or target_component not in (0, ctx.compid):
@@ -118,6 +125,6 @@ def _accepted(msg: Any, ctx: Any) -> bool:
     return not msg.flags & SERIAL_CONTROL_FLAG_REPLY and msg.device == SERIAL_CONTROL_DEV_SHELL
 
 
-def _latest_event_seq(vehicle: Any) -> int:
+def _latest_event_seq(vehicle: Vehicle) -> int:
     events = vehicle.events_after(-1)
     return events[-1].seq if events else -1

@@ -12,12 +12,15 @@ import enum
 import logging
 from collections.abc import Callable, Sequence
 from heapq import heapify, heapreplace
-from typing import Any
+from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink import telemetry_msgs as tm
 from sitl_emu.mavlink import telemetry_sensors as ts
 from sitl_emu.mavlink.version import autopilot_version, protocol_version
 from sitl_emu.types import VehicleEvent, VehicleSnapshot
+
+if TYPE_CHECKING:
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
 log = logging.getLogger(__name__)
 
@@ -138,12 +141,12 @@ class Streams:
         return self._interval_us.get(msg_id, 0)
 
     # --- sending -----------------------------------------------------------------------------------------------
-    def build(self, msg_id: int, ctx: Any, snap: VehicleSnapshot) -> Any:
+    def build(self, msg_id: int, ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
         """The message now, for REQUEST_MESSAGE; None if we have no such message or no data for it."""
         builder = BUILDERS.get(msg_id) or ON_REQUEST.get(msg_id)
         return builder(ctx, snap) if builder is not None else None
 
-    def emit_due(self, ctx: Any, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
+    def emit_due(self, ctx: EndpointContext, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
         """Send every stream due at ctx.now_us; the snapshot is only taken when something is due.
 
         Hot path (every link, every tick): one comparison when nothing is due; otherwise only the due streams are
@@ -199,7 +202,7 @@ class Streams:
         if self.build_errors == 1:
             log.error("cannot build message %d: %r", msg_id, err, exc_info=log.isEnabledFor(logging.DEBUG))
 
-    def send_statustexts(self, ctx: Any, events: Sequence[VehicleEvent]) -> None:
+    def send_statustexts(self, ctx: EndpointContext, events: Sequence[VehicleEvent]) -> None:
         """STATUSTEXT.hpp: one id per message, chunks of 50 chars with chunk_seq, nothing older than 5 s."""
         for ev in events:
             if not ev.statustext or ctx.now_us - ev.time_us > STATUSTEXT_MAX_AGE_US:

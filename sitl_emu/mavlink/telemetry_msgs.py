@@ -8,11 +8,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 from sitl_emu import px4
+from sitl_emu.mavlink.modes_msgs import STANDARD_MODE
 from sitl_emu.px4 import MavState, NavState
 from sitl_emu.types import VehicleSnapshot
+
+if TYPE_CHECKING:
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
+    from sitl_emu.mavlink.fastpack import Packed
 
 NAN = math.nan
 UINT16_MAX = 0xFFFF
@@ -35,7 +40,8 @@ _POSITION_BITS = S_GPS | S_XY_POSITION | S_AHRS
 _MANUAL_STABILIZED = frozenset({NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
                                 NavState.ALTITUDE_CRUISE, NavState.STAB})
 
-Builder = Callable[[Any, VehicleSnapshot], Any]
+# A stream: the message for this snapshot, or None when PX4 would have no data to send
+Builder = Callable[["EndpointContext", VehicleSnapshot], "OutMessage | None"]
 
 
 def base_mode(snap: VehicleSnapshot) -> int:
@@ -68,12 +74,12 @@ def system_status(snap: VehicleSnapshot) -> int:
     return MavState.STANDBY if snap.pre_flight_checks_pass else MavState.UNINIT
 
 
-def heartbeat(ctx: Any, snap: VehicleSnapshot) -> Any:
+def heartbeat(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return ctx.encoder.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
                                     px4.custom_mode(snap.nav_state), system_status(snap), 3)
 
 
-def sys_status(ctx: Any, snap: VehicleSnapshot) -> Any:
+def sys_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """streams/SYS_STATUS.hpp; MAVSDK reads health from these bits (reference 9a.5)."""
     health = _PRESENT | S_RC
     if not snap.position_valid:
@@ -87,29 +93,29 @@ def sys_status(ctx: Any, snap: VehicleSnapshot) -> Any:
                                      remaining, 0, 0, 0, 0, 0, 0)
 
 
-def extended_sys_state(ctx: Any, snap: VehicleSnapshot) -> Any:
+def extended_sys_state(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return ctx.encoder.extended_sys_state_encode(0, int(snap.landed_state))
 
 
-def attitude(ctx: Any, snap: VehicleSnapshot) -> Any:
+def attitude(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     r, p, y = snap.euler_rad
     wx, wy, wz = snap.rates_frd_rad_s
     return ctx.encoder.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
 
 
-def attitude_quaternion(ctx: Any, snap: VehicleSnapshot) -> Any:
+def attitude_quaternion(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     w, x, y, z = snap.q_wxyz
     wx, wy, wz = snap.rates_frd_rad_s
     return ctx.encoder.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
 
 
-def local_position_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
+def local_position_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     x, y, z = snap.pos_ned_m
     vx, vy, vz = snap.vel_ned_m_s
     return ctx.encoder.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
 
 
-def global_position_int(ctx: Any, snap: VehicleSnapshot) -> Any:
+def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
     """streams/GLOBAL_POSITION_INT.hpp: only with a global position; relative_alt against home (reference 9a.6)."""
     if not snap.position_valid:
         return None
@@ -121,7 +127,7 @@ def global_position_int(ctx: Any, snap: VehicleSnapshot) -> Any:
         _cm_s(vx), _cm_s(vy), _cm_s(vz), hdg_cdeg)
 
 
-def position_target_local_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
+def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
     """streams/POSITION_TARGET_LOCAL_NED.hpp: the controller's setpoint, a type_mask bit for every NaN (ref 4.9)."""
     sp = snap.local_setpoint
     if sp is None:
@@ -139,7 +145,7 @@ def position_target_local_ned(ctx: Any, snap: VehicleSnapshot) -> Any:
                                                     sp.yawspeed_rad_s)
 
 
-def attitude_target(ctx: Any, snap: VehicleSnapshot) -> Any:
+def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
     q = snap.attitude_setpoint_q_wxyz
     if q is None:
         return None
@@ -147,7 +153,7 @@ def attitude_target(ctx: Any, snap: VehicleSnapshot) -> Any:
     return ctx.encoder.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
 
 
-def home_position(ctx: Any, snap: VehicleSnapshot) -> Any:
+def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
     """streams/HOME_POSITION.hpp: only while home is valid."""
     home = snap.home
     if home is None:
@@ -159,7 +165,7 @@ def home_position(ctx: Any, snap: VehicleSnapshot) -> Any:
                                         0.0, 0.0, 0.0, snap.time_us)
 
 
-def gps_raw_int(ctx: Any, snap: VehicleSnapshot) -> Any:
+def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot."""
     vn, ve, _ = snap.vel_ned_m_s
     vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
@@ -168,7 +174,7 @@ def gps_raw_int(ctx: Any, snap: VehicleSnapshot) -> Any:
                                       50, 80, vel_cm_s, cog, 10, _mm(snap.alt_amsl_m), 500, 800, 200, 0, 0)
 
 
-def battery_status(ctx: Any, snap: VehicleSnapshot) -> Any:
+def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     cells = 4  # BAT1_N_CELLS in SITL
     cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
     voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
@@ -177,7 +183,7 @@ def battery_status(ctx: Any, snap: VehicleSnapshot) -> Any:
                                          0, 0)
 
 
-def vfr_hud(ctx: Any, snap: VehicleSnapshot) -> Any:
+def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """streams/VFR_HUD.hpp (reference 11.5)."""
     vn, ve, vd = snap.vel_ned_m_s
     heading_deg = int(math.degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
@@ -185,14 +191,14 @@ def vfr_hud(ctx: Any, snap: VehicleSnapshot) -> Any:
     return ctx.encoder.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
 
 
-def altitude(ctx: Any, snap: VehicleSnapshot) -> Any:
+def altitude(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else NAN
     local_m = -snap.pos_ned_m[2]
     return ctx.encoder.altitude_encode(snap.time_us, snap.alt_amsl_m, snap.alt_amsl_m, local_m, rel_m, NAN,
                                    max(local_m, 0.0))
 
 
-def odometry(ctx: Any, snap: VehicleSnapshot) -> Any:
+def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
     v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
     cov = [NAN] + [0.0] * 20
@@ -200,28 +206,23 @@ def odometry(ctx: Any, snap: VehicleSnapshot) -> Any:
                                    snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
 
 
-def timesync(ctx: Any, snap: VehicleSnapshot) -> Any:
+def timesync(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """streams/TIMESYNC.hpp: PX4's own sync request, tc1=0, ts1=boot time in ns."""
     return ctx.encoder.timesync_encode(0, snap.time_us * 1000)
 
 
-def ping(ctx: Any, snap: VehicleSnapshot) -> Any:
+def ping(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     """streams/PING.hpp: PX4 pings everyone (target 0/0) with its boot time and a sequence; replies are ignored."""
     seq = snap.time_us // 100_000  # unique per ping at any rate up to 10 Hz, from simulated time
     return ctx.encoder.ping_encode(snap.time_us, seq & 0xFFFFFFFF, 0, 0)
 
 
-def system_time(ctx: Any, snap: VehicleSnapshot) -> Any:
+def system_time(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return ctx.encoder.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
 
 
-# CURRENT_MODE.standard_mode (src/lib/modes/standard_modes.hpp); everything else NON_STANDARD (0).
-_STANDARD_MODE = {NavState.POSCTL: 1, NavState.ORBIT: 2, NavState.ALTCTL: 4, NavState.AUTO_RTL: 5,
-                  NavState.AUTO_MISSION: 6, NavState.AUTO_LAND: 7, NavState.AUTO_TAKEOFF: 8}
-
-
-def current_mode(ctx: Any, snap: VehicleSnapshot) -> Any:
-    return ctx.encoder.current_mode_encode(_STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
+def current_mode(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+    return ctx.encoder.current_mode_encode(STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
                                        px4.custom_mode(snap.user_intended_nav_state))
 
 

@@ -8,10 +8,14 @@ gyro = body rates, magnetometer = a fixed Earth field rotated into the body, bar
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink.telemetry_msgs import rotate_ned_to_body
 from sitl_emu.types import VehicleSnapshot
+
+if TYPE_CHECKING:
+    from sitl_emu.mavlink.context import EndpointContext
+    from sitl_emu.mavlink.fastpack import Packed
 
 GRAVITY_M_S2 = 9.80665
 # Earth magnetic field near the SIH default home (Zurich), gauss, NED: ~0.48 G, inclination ~63.5°, declination ~2.5°
@@ -31,7 +35,7 @@ def specific_force_frd(snap: VehicleSnapshot) -> tuple[float, float, float]:
     return rotate_ned_to_body(snap.q_wxyz, (ax, ay, az - GRAVITY_M_S2))
 
 
-def highres_imu(ctx: Any, snap: VehicleSnapshot) -> Any:
+def highres_imu(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     acc = specific_force_frd(snap)
     mag = rotate_ned_to_body(snap.q_wxyz, MAG_NED_GAUSS)
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
@@ -39,7 +43,7 @@ def highres_imu(ctx: Any, snap: VehicleSnapshot) -> Any:
                                       snap.alt_amsl_m, TEMPERATURE_C, HIGHRES_FIELDS_ALL, 0)
 
 
-def scaled_pressure(ctx: Any, snap: VehicleSnapshot) -> Any:
+def scaled_pressure(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
     if not math.isfinite(pressure):
         return None

@@ -7,9 +7,12 @@ Sources: mavlink_main.cpp send_autopilot_capabilities (~l.1263) and send_protoco
 from __future__ import annotations
 
 import struct
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING
 
 from pymavlink.dialects.v20 import development as dialect
+
+if TYPE_CHECKING:
+    from pymavlink.dialects.v20.development import MAVLink, MAVLink_autopilot_version_message
 
 # MAV_PROTOCOL_CAPABILITY: MISSION_FLOAT|PARAM_FLOAT|MISSION_INT|COMMAND_INT|PARAM_ENCODE_BYTEWISE|FTP|
 # SET_ATTITUDE_TARGET|SET_POSITION_TARGET_LOCAL_NED|FLIGHT_TERMINATION|MAVLINK2|MISSION_FENCE|MISSION_RALLY
@@ -28,7 +31,7 @@ def sw_version(major: int, minor: int, patch: int, fw_type: int = FIRMWARE_TYPE_
 FLIGHT_SW_VERSION = sw_version(*FIRMWARE_VERSION)
 
 
-def autopilot_version(mav: Any, sysid: int) -> Any:
+def autopilot_version(mav: MAVLink, sysid: int) -> MAVLink_autopilot_version_message:
     custom = list(GIT_HASH)
     return mav.autopilot_version_encode(
         CAPABILITIES, FLIGHT_SW_VERSION, FLIGHT_SW_VERSION, 0, 0, custom, custom, [0] * 8, 0, 0,
@@ -38,18 +41,20 @@ def autopilot_version(mav: Any, sysid: int) -> Any:
 class ProtocolVersionMessage(dialect.MAVLink_message):
     """PROTOCOL_VERSION (#300): version, min_version, max_version, spec/library hashes (common.xml)."""
 
+    # pymavlink's MAVLink_message declares these as (instance-typed) class attributes, as its generated classes set
+    # them; ClassVar here would be an override mypy refuses.
     id = 300
     msgname = "PROTOCOL_VERSION"
-    fieldnames: ClassVar[list] = ["version", "min_version", "max_version", "spec_version_hash", "library_version_hash"]
-    ordered_fieldnames: ClassVar[list] = fieldnames
-    fieldtypes: ClassVar[list] = ["uint16_t", "uint16_t", "uint16_t", "uint8_t", "uint8_t"]
-    fielddisplays_by_name: ClassVar[dict[str, str]] = {}
-    fieldenums_by_name: ClassVar[dict[str, str]] = {}
-    fieldunits_by_name: ClassVar[dict[str, str]] = {}
-    native_format: ClassVar[bytearray] = bytearray(b"<HHHBB")
-    orders: ClassVar[list] = [0, 1, 2, 3, 4]
-    lengths: ClassVar[list] = [1, 1, 1, 8, 8]
-    array_lengths: ClassVar[list] = [0, 0, 0, 8, 8]
+    fieldnames = ["version", "min_version", "max_version", "spec_version_hash", "library_version_hash"]  # noqa: RUF012
+    ordered_fieldnames = fieldnames
+    fieldtypes = ["uint16_t", "uint16_t", "uint16_t", "uint8_t", "uint8_t"]  # noqa: RUF012
+    fielddisplays_by_name: dict[str, str] = {}  # noqa: RUF012
+    fieldenums_by_name: dict[str, str] = {}  # noqa: RUF012
+    fieldunits_by_name: dict[str, str] = {}  # noqa: RUF012
+    native_format = bytearray(b"<HHHBB")
+    orders = [0, 1, 2, 3, 4]  # noqa: RUF012
+    lengths = [1, 1, 1, 8, 8]  # noqa: RUF012
+    array_lengths = [0, 0, 0, 8, 8]  # noqa: RUF012
     crc_extra = 217
     unpacker = struct.Struct("<HHH8B8B")
     instance_field = None
@@ -67,13 +72,13 @@ class ProtocolVersionMessage(dialect.MAVLink_message):
         self.spec_version_hash = spec_version_hash
         self.library_version_hash = library_version_hash
 
-    def pack(self, mav: Any, force_mavlink1: bool = False) -> bytes:
+    def pack(self, mav: MAVLink, force_mavlink1: bool = False) -> bytes:
         payload = self.unpacker.pack(self.version, self.min_version, self.max_version, *self.spec_version_hash,
                                      *self.library_version_hash)
         return self._pack(mav, self.crc_extra, payload, force_mavlink1=force_mavlink1)
 
 
-def protocol_version(mav: Any) -> Any:
+def protocol_version(mav: MAVLink) -> ProtocolVersionMessage:
     """PX4: {version 200, min_version 100, max_version 203} (MAVLink 2.0, supports 1.0-2.03)."""
     del mav
     return ProtocolVersionMessage(200, 100, 203, [0] * 8, list(GIT_HASH))
