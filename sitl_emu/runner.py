@@ -2,12 +2,12 @@
 
 A runner advances each node's vehicle in fixed steps of simulated time and calls `node.step_io(now_us, readable)`
 after each step (and whenever a datagram arrives), so streams, heartbeats and timeouts all follow simulated time.
-`RealTimeRunner(speed)` keeps simulated time at `speed` x wall time and sleeps in epoll on the sockets, so incoming
+`RealTimeRunner(speed)` keeps simulated time at `speed` x wall time and sleeps in a selector on the sockets, so incoming
 commands are answered without waiting for the next step. In-process lockstep (as fast as possible) is
 `sitl_emu.api.Sim`.
 
 Which links have data waiting comes from one `SocketWatch.ready()` per tick over every socket (the wake-up's own
-epoll serves the first tick after it), so an idle link costs no system call: before, each node tried a recvfrom on
+look serves the first tick after it), so an idle link costs no system call: before, each node tried a recvfrom on
 both links every tick (two syscalls per vehicle per tick, nearly always EAGAIN).
 """
 
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import logging
 import select
+import selectors
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -25,57 +26,58 @@ from sitl_emu.server import READ_API, READ_GCS
 log = logging.getLogger(__name__)
 
 MAX_LAG_US = 500_000  # if the host stalls longer than this, drop the lost time instead of fast-forwarding through it
-FINE_TIMEOUT_S = 0.002  # below this a wait uses select() (µs resolution) on the epoll fd, not epoll's whole ms
+FINE_TIMEOUT_S = 0.002  # below this a wait uses select() (µs resolution), not epoll's or poll's whole ms
+# the selectors whose timeout is counted in whole milliseconds (kqueue's and select()'s are not)
+_MS_TIMEOUT_SELECTORS = tuple(getattr(selectors, name) for name in ("EpollSelector", "DevpollSelector", "PollSelector")
+                              if hasattr(selectors, name))
 NOTHING_READY: dict[int, int] = {}  # ready()'s answer when no socket has data (shared: never mutate it)
 
 
 class SocketWatch:
-    """Which nodes have datagrams waiting, and on which links: one epoll set over all their sockets.
+    """Which nodes have datagrams waiting, and on which links: one selector over all their sockets.
 
     `ready(timeout_s)` returns {node index: READ_API | READ_GCS bits} for the nodes with data, waiting up to
     `timeout_s` for the first datagram (0: just look). Level-triggered: a link that a read budget left with data is
-    reported again next time. epoll times out in whole milliseconds, rounded up, so short waits (high --speed) go
-    through select() on the epoll fd instead; a datagram wakes the runner at once either way. Where epoll is missing
-    (not Linux) select() on the sockets does the same.
+    reported again next time. The selector is the OS's best (selectors.DefaultSelector: epoll on Linux, kqueue on
+    macOS and the BSDs). epoll and poll time out in whole milliseconds, rounded up, so with those short waits (high
+    --speed) go through select() (µs resolution), on the selector's own descriptor where it has one (epoll: one fd
+    however many sockets), else on the sockets; a datagram wakes the runner at once either way.
     """
 
     def __init__(self, nodes: Sequence[Any]) -> None:
-        self._where: dict[int, tuple[int, int]] = {}  # fd -> (node index, link bit)
+        self._selector = selectors.DefaultSelector()
         for index, node in enumerate(nodes):
             for bit, fd in zip((READ_API, READ_GCS), node.filenos(), strict=True):
-                self._where[fd] = (index, bit)
-        self._fds = list(self._where)
-        self._epoll = select.epoll(len(self._fds) or 1) if hasattr(select, "epoll") else None
-        if self._epoll is not None:
-            for fd in self._fds:
-                self._epoll.register(fd, select.EPOLLIN)
-        self._epoll_fd = [self._epoll.fileno()] if self._epoll is not None else []
+                self._selector.register(fd, selectors.EVENT_READ, (index, bit))
+        self._fine_wait_fds = _fine_wait_fds(self._selector)
 
     def ready(self, timeout_s: float = 0.0) -> dict[int, int]:
         try:
-            if self._epoll is not None:
-                if 0 < timeout_s < FINE_TIMEOUT_S:  # epoll would round up to 1 ms: wait on its fd with select()
-                    select.select(self._epoll_fd, (), (), timeout_s)
-                    timeout_s = 0.0
-                events = self._epoll.poll(timeout_s)
-                if not events:  # the common case, every tick: no allocation
-                    return NOTHING_READY
-                fds = [fd for fd, _ in events]
-            else:
-                fds = select.select(self._fds, [], [], timeout_s)[0]
+            if 0 < timeout_s < FINE_TIMEOUT_S and self._fine_wait_fds:  # the selector would round up to 1 ms
+                select.select(self._fine_wait_fds, (), (), timeout_s)
+                timeout_s = 0.0
+            events = self._selector.select(timeout_s)
         except (OSError, ValueError):  # a socket (or the watch) closed under us during shutdown
             time.sleep(min(timeout_s, 0.01))
             return NOTHING_READY
+        if not events:  # the common case, every tick: no dict built
+            return NOTHING_READY
         ready: dict[int, int] = {}
-        where = self._where
-        for fd in fds:
-            index, bit = where[fd]
+        for key, _ in events:
+            index, bit = key.data
             ready[index] = ready.get(index, 0) | bit
         return ready
 
     def close(self) -> None:
-        if self._epoll is not None:
-            self._epoll.close()
+        self._selector.close()
+
+
+def _fine_wait_fds(selector: selectors.BaseSelector) -> list[int]:
+    """What to select() on for waits under FINE_TIMEOUT_S; empty if the selector's own timeout is fine enough."""
+    if not isinstance(selector, _MS_TIMEOUT_SELECTORS):
+        return []  # kqueue and select() take the timeout in µs
+    fileno = getattr(selector, "fileno", None)  # epoll, /dev/poll: readable when a registered socket is
+    return [fileno()] if fileno is not None else list(selector.get_map())
 
 
 class RealTimeRunner:

@@ -1,11 +1,14 @@
 """Runners read a link only when its socket has data, and still answer a datagram at the first tick after it arrives.
 
-One epoll look per tick (SocketWatch) replaces a recvfrom per link per tick; these tests show that nothing a client
-sends is missed or delayed by it: in lockstep, in real time waking every tick, and in real time with batched ticks.
+One look at the sockets per tick (SocketWatch) replaces a recvfrom per link per tick; these tests show that nothing a
+client sends is missed or delayed by it: in lockstep, in real time waking every tick, and in real time with batched
+ticks; and that the watch behaves the same on each kind of selector (epoll on Linux, kqueue on macOS, poll, select).
 """
 
 from __future__ import annotations
 
+import selectors
+import statistics
 import threading
 import time
 
@@ -21,7 +24,18 @@ from sitl_emu.swarm import SwarmRunner
 PROTOCOL_VERSION = 300
 
 
-def test_the_watch_names_the_node_and_link_with_data_until_it_is_read():
+# The selectors this host has besides its default (epoll here; kqueue on macOS, which Linux cannot run): the watch must
+# behave the same on each, so `serve` and joyfly behave the same on every OS.
+SELECTORS = [name for name in ("DefaultSelector", "PollSelector", "SelectSelector") if hasattr(selectors, name)]
+
+
+@pytest.fixture(params=SELECTORS)
+def selector_kind(request, monkeypatch):
+    monkeypatch.setattr(selectors, "DefaultSelector", getattr(selectors, request.param))
+    return request.param
+
+
+def test_the_watch_names_the_node_and_link_with_data_until_it_is_read(selector_kind):
     first, second = Harness(FakeVehicle()), Harness(FakeVehicle(sysid=2))
     watch = SocketWatch([first.node, second.node])
     try:
@@ -39,6 +53,38 @@ def test_the_watch_names_the_node_and_link_with_data_until_it_is_read():
         watch.close()
         first.close()
         second.close()
+
+
+def test_a_wait_shorter_than_a_millisecond_is_not_rounded_up_to_one(selector_kind):
+    """High --speed sleeps 0.1-1 ms between ticks; epoll and poll count their timeouts in whole milliseconds, so the
+    watch must wait such short times another way or a vehicle at --speed 10 would run at a fraction of it."""
+    h = Harness(FakeVehicle())
+    watch = SocketWatch([h.node])
+    try:
+        waits = []
+        for _ in range(40):
+            start = time.perf_counter()
+            assert watch.ready(0.0002) == {}
+            waits.append(time.perf_counter() - start)
+    finally:
+        watch.close()
+        h.close()
+    assert statistics.median(waits) < 0.0008  # rounded up, every wait would take at least 1 ms
+
+
+def test_a_datagram_ends_a_wait_at_once(selector_kind):
+    h = Harness(FakeVehicle())
+    watch = SocketWatch([h.node])
+    try:
+        threading.Timer(0.05, h.gcs.heartbeat).start()
+        start = time.monotonic()
+        assert watch.ready(2.0) == {0: READ_GCS}
+        assert time.monotonic() - start < 1.0
+        h.node.step_io(0)
+        assert watch.ready(0.0005) == {}  # read: a short wait finds nothing
+    finally:
+        watch.close()
+        h.close()
 
 
 def test_step_io_reads_only_the_links_named_and_by_default_both():
