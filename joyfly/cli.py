@@ -50,7 +50,8 @@ def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any
 
 
 @main.command()
-@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO or file of js_event records, script:FILE, replay:FILE.")
+@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
+                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(["velocity", "step"]), "Sticks command a velocity, or a position step (the seed).")
@@ -64,7 +65,7 @@ def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any
 @_opt("--max-alt", float, "Highest setpoint, metres above home.")
 @_opt("--rate", float, "Setpoint stream rate, Hz (at least 10).")
 @_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
-@_opt("--record", str, "Record the joystick's events with timestamps to this file (replay with --joy replay:FILE).")
+@_opt("--record", str, "Record the joystick's states with timestamps to this file (replay with --joy FILE).")
 @_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
 @_opt("--connect-timeout", float, "Seconds to wait for the vehicle's first HEARTBEAT and position.")
 @_opt("--speed", float, "The emulator's speed factor (sitl-emu serve --speed N): joyfly's clock runs as fast.")

@@ -13,11 +13,11 @@ from typing import Any, TextIO
 
 import click
 
+from joyfly.clock import WallClock
 from joyfly.joystick import (
     DeviceInfo,
     JoystickError,
     JsDevice,
-    MonotonicClock,
     default_device,
     list_devices,
     open_joystick,
@@ -70,26 +70,31 @@ def profiles_cmd() -> None:
 
 
 @joystick.command("test")
-@click.option("--joy", "joy", default=None, help="Device, FIFO or file path, script:FILE or replay:FILE "
-              "(default: the first /dev/input/js*).")
+@click.option("--joy", "joy", default=None, help="A /dev/input/js* device, a FIFO of js_event records, a --record "
+              "recording, raw:FILE (a file of js_event records), script:FILE or replay:FILE (default: the first "
+              "/dev/input/js*).")
 @click.option("--profile", "profile_name", default="auto", show_default=True,
               help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
 @click.option("--config", "config_path", default=None, help="TOML file whose [profile] table overrides the profile.")
 @click.option("--duration", type=float, default=None, help="Stop after this many seconds.")
-@click.option("--record", "record_path", default=None, help="Also record the session (JSON lines) for replay:FILE.")
+@click.option("--record", "record_path", default=None, help="Also record the session to this file (JSON lines), to "
+              "replay with --joy FILE.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True)
 def test_cmd(joy: str | None, profile_name: str, config_path: str | None, duration: float | None,
              record_path: str | None, dev_dir: str) -> None:
     """Show the axes and buttons live, and the flying commands the profile makes of them."""
-    clock = MonotonicClock()
+    clock = WallClock()
     try:
         overrides: dict[str, Any] = read_config(config_path) if config_path else {}
         source = open_joystick(joy or default_device(dev_dir), clock, dev_dir=dev_dir)
-        profile = load_profile(profile_name, source.name, overrides)
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None
-    if record_path:
-        source = record_to(source, record_path)
+    try:
+        profile = load_profile(profile_name, source.name, overrides)
+        source = record_to(source, record_path) if record_path else source
+    except JoystickError as exc:
+        source.close()
+        raise click.ClickException(str(exc)) from None
     view = LiveView(sys.stdout) if sys.stdout.isatty() else PlainView(click.echo)
     try:
         watch(source, profile, clock, view, duration)
