@@ -169,3 +169,24 @@ def test_a_fifo_still_waits_for_its_writer(vehicle: Vehicle, tmp_path: Path) -> 
     assert run.stopped and not run.armed, run.stdout + run.stderr  # still waiting when stopped, nothing flew
     assert "Waiting for the joystick" in run.stdout
 
+
+def test_the_example_script_flies_and_lands(vehicle: Vehicle) -> None:
+    """examples/joystick_script.txt as its first line says to run it: joyfly takes off by itself, the script flies
+    the square and the fence push, presses LAND, and the vehicle ends landed and disarmed."""
+    proc = start(vehicle, "script:examples/joystick_script.txt")
+    assert proc.stdout is not None
+    seen: list[str] = []
+    end = time.monotonic() + 90.0  # about 45 simulated seconds at x4, with room for a busy machine
+    while time.monotonic() < end and proc.poll() is None and not any("Landed and disarmed" in ln for ln in seen):
+        seen.append(proc.stdout.readline())
+    proc.send_signal(signal.SIGINT)
+    try:
+        stdout, stderr = proc.communicate(timeout=20.0)
+    finally:
+        proc.kill()
+    out = "".join(seen) + stdout
+    assert proc.returncode == 0 and not vehicle.armed, out + stderr
+    assert "OFFBOARD: you have control" in out and "LAND pressed: landing" in out and "Landed and disarmed" in out
+    assert not any(f"{button} pressed" in out for button in ("ARM", "TAKEOFF", "OFFBOARD"))
+    distance = next(line for line in out.splitlines() if line.startswith("distance flown"))
+    assert float(distance.split()[2]) > 25.0  # climb, the square, the fence push and back
