@@ -215,7 +215,7 @@ def is_recording(path: str) -> bool:
         with open(path, "rb") as fh:
             first = fh.read(HEADER_PEEK_BYTES).split(b"\n", 1)[0]
         header = json.loads(first)
-    except (OSError, ValueError):  # unreadable, not UTF-8, not JSON: the caller's own checks say what it is
+    except (OSError, ValueError, RecursionError):  # unreadable, not JSON: the caller's own checks say what it is
         return False
     return isinstance(header, dict) and header.get(RECORDING_KEY) == 1
 
@@ -325,7 +325,7 @@ def _json_lines(text: str, source: str) -> list[tuple[int, object]]:
             continue
         try:
             out.append((lineno, json.loads(line)))
-        except json.JSONDecodeError:
+        except (ValueError, RecursionError):  # JSONDecodeError, or nested too deep
             raise JoystickError(f"{source} line {lineno} is not JSON: replay a file written by --record.") from None
     return out
 

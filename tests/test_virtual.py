@@ -232,6 +232,7 @@ def test_record_over_the_joystick_file_itself_is_refused(tmp_path):
     ('{"t": NaN, "axes": [0], "buttons": []}', "line 2 is not a joystick record"),
     ('[1, 2]', "line 2 is not a joystick record"),
     ('\n{"t": 0, "axes": [0]', "line 3 is not JSON"),
+    ("[" * 5000, "line 2 is not JSON"),
 ])
 def test_a_damaged_recording_names_its_line(tmp_path, body, fragment):
     rec = tmp_path / "rec.jsonl"
