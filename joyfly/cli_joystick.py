@@ -32,7 +32,8 @@ from joyfly.virtual import TimedSource, record_to
 DEV_DIR = "/dev/input"
 
 
-@click.group("joystick", cls=OneLineGroup, context_settings=CONTEXT)
+@click.group("joystick", cls=OneLineGroup, context_settings=CONTEXT,
+             short_help="List and test joysticks (no vehicle needed).")
 def joystick() -> None:
     """Find joysticks and check what they send (no vehicle needed)."""
 

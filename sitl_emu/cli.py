@@ -19,6 +19,7 @@ import click
 
 from sitl_emu.cli_options import (
     CONTEXT,
+    MAX_SYSID,
     PORT_MAX,
     SEED_MAX,
     SPEED_MAX,
@@ -28,6 +29,7 @@ from sitl_emu.cli_options import (
     OneLineGroup,
     UsageProblem,
     UserError,
+    WholeRange,
     check_host,
     check_instances,
     parse_address,
@@ -45,7 +47,7 @@ log = logging.getLogger(__name__)
 # mavlink_main.cpp): 10 ms keeps telemetry within PX4's own slowest loop period, and every tick is still computed.
 DEFAULT_BATCH_MS = 10.0
 MIN_BATCH_WALL_S = 0.001  # batching never wakes more than 1000 times a wall second (high --speed)
-PORT = click.IntRange(0, PORT_MAX)
+PORT = WholeRange(0, PORT_MAX)
 
 
 def wake_period_s(batch_ms: float, speed: float) -> float:
@@ -145,12 +147,12 @@ def main(verbose: int) -> None:
               help="GCS link listen port; 0 picks a free one.")
 @click.option("--gcs-remote", default="127.0.0.1:14550", show_default=True, help="GCS link initial destination.")
 @click.option("--bind", "bind_host", default="127.0.0.1", show_default=True, help="Address to listen on.")
-@click.option("--instance", type=click.IntRange(0, 250), default=0, show_default=True,
+@click.option("--instance", type=WholeRange(0, MAX_SYSID - 1), default=0, show_default=True,
               help="Vehicle instance N: sysid N+1 and every port offset by N, as PX4's -i.")
 @click.option("--speed", type=FiniteRange(SPEED_MIN, SPEED_MAX), default=1.0, show_default=True,
               help="Simulated seconds per wall second. A joyfly flying this vehicle needs the same factor: "
                    "joyfly fly --speed N (it warns when they differ).")
-@click.option("--count", type=click.IntRange(1, 250), default=1, show_default=True,
+@click.option("--count", type=WholeRange(1, MAX_SYSID - 1), default=1, show_default=True,
               help="Number of vehicles: instances --instance.., sysids and ports offset per vehicle, homes 3 m apart.")
 @click.option("--batch-ms", type=FiniteRange(0, 1000), default=DEFAULT_BATCH_MS, show_default=True,
               help="Wake at most every N ms of simulated time and run the ticks due in one batch (each message "
@@ -162,7 +164,7 @@ def main(verbose: int) -> None:
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
               help="Parameter file: lines 'NAME VALUE' or QGC .params format.")
-@click.option("--seed", type=click.IntRange(0, SEED_MAX), default=0, show_default=True,
+@click.option("--seed", type=WholeRange(0, SEED_MAX), default=0, show_default=True,
               help="Random seed for the sensor noise: the same seed, parameters and inputs fly the same trajectory.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,

@@ -69,6 +69,12 @@ class OneLineGroup(click.Group):
             raise one_line(err) from None
 
 
+class WholeRange(click.IntRange):
+    """click.IntRange that calls its values whole numbers ("not a valid integer", not "integer range")."""
+
+    name = "integer"
+
+
 class FiniteRange(click.FloatRange):
     """click.FloatRange that also refuses nan (nan compares false with both bounds, so FloatRange lets it through)."""
 
