@@ -16,24 +16,28 @@ CONTEXT = {"help_option_names": ["-h", "--help"]}
 
 
 class UserError(click.ClickException):
-    """A mistake the user can fix, shown as one line `joyfly: sentence` on stderr; exit status 2 by default."""
+    """A mistake the user can fix, shown as one line `joyfly: sentence` on stderr; exit status 2."""
 
-    def __init__(self, message: str, exit_code: int = 2) -> None:
-        super().__init__(message)
-        self.exit_code = exit_code
+    exit_code = 2
 
     def show(self, file: IO[Any] | None = None) -> None:
         click.echo(f"{TOOL}: {self.message}", err=True)
 
 
+class UserFailure(UserError):
+    """The same with exit status 1 (click.ClickException's status: a command that could not do its work)."""
+
+    exit_code = 1
+
+
 def one_line(err: click.ClickException) -> UserError:
-    """click's error as a UserError; a usage error says where the help is."""
+    """click's error as a UserError with its exit status; a usage error says where the help is."""
     text = " ".join(err.format_message().split())
     ctx = getattr(err, "ctx", None)
     if isinstance(err, click.UsageError) and ctx is not None:
         hint = f"see '{ctx.command_path} --help'"
         text = f"{text} ({hint})" if text.endswith("?") else f"{text.rstrip('.')} ({hint})."
-    return UserError(text, err.exit_code)
+    return UserFailure(text) if err.exit_code == 1 else UserError(text)
 
 
 class OneLineGroup(click.Group):

@@ -76,8 +76,8 @@ def test_bad_options_end_in_one_sentence(options: dict[str, object], fragment: s
     ("record = 5", 'record = 5 is not text: write it in quotes, for example record = "FILE".'),
     ("control = 1", 'control = 1 is not text: write it in quotes, for example control = "velocity".'),
     ('on-exit = "crash"', 'on-exit = "crash" is not a choice here: use one of land, hold, rtl.'),
-    ('url = "udpin:0.0.0.0:70000"', 'url = "udpin:0.0.0.0:70000": the listen port 70000 is out of range; use 1 '
-                                    "to 65535."),
+    ('url = "udpin:0.0.0.0:70000"', 'url = "udpin:0.0.0.0:70000": the listen port 70000 is out of range; use 0 '
+                                    "to 65535 (0: any free port)."),
     ("rate = true", "rate = true is not a number"),
 ])
 def test_bad_values_in_the_config_file_name_the_file_the_key_and_the_fix(tmp_path: Path, toml: str,

@@ -38,7 +38,7 @@ def feed(watch: SpeedWatch, wall: FakeWall, vehicle_speed: float, seconds: float
     (0.85, 1.0, False),  # a busy machine running the vehicle a little slow is not worth a warning
 ])
 def test_warns_once_when_the_vehicle_runs_at_another_speed(vehicle: float, joyfly: float, warned: bool) -> None:
-    wall, said = FakeWall(), []
+    wall, said = FakeWall(), list[str]()
     watch = SpeedWatch(joyfly, said.append, wall)
     feed(watch, wall, vehicle, 2 * WINDOW_S)
     assert watch.measured == pytest.approx(vehicle, rel=0.02)
@@ -49,7 +49,7 @@ def test_warns_once_when_the_vehicle_runs_at_another_speed(vehicle: float, joyfl
 
 
 def test_judges_only_after_the_window_and_ignores_messages_without_a_timestamp() -> None:
-    wall, said = FakeWall(), []
+    wall, said = FakeWall(), list[str]()
     watch = SpeedWatch(1.0, said.append, wall)
     watch.observe(SimpleNamespace(type=2))  # a HEARTBEAT has no time_boot_ms
     feed(watch, wall, 10.0, WINDOW_S - 0.5)
@@ -57,7 +57,7 @@ def test_judges_only_after_the_window_and_ignores_messages_without_a_timestamp()
 
 
 def test_a_reboot_restarts_the_measurement() -> None:
-    wall, said = FakeWall(), []
+    wall, said = FakeWall(), list[str]()
     watch = SpeedWatch(1.0, said.append, wall)
     feed(watch, wall, 1.0, 1.0, start_ms=900_000)
     feed(watch, wall, 1.0, 2 * WINDOW_S, start_ms=0)  # time_boot_ms went back: the vehicle rebooted

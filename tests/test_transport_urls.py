@@ -93,7 +93,7 @@ def test_a_serial_device_without_permission_says_dialout(tmp_path: Path) -> None
         pytest.skip("root may open anything")
     device = tmp_path / "ttyS_locked"
     device.touch(mode=0o000)
-    with pytest.raises(TransportError, match="No permission to open .* add yourself to the dialout group"):
+    with pytest.raises(TransportError, match=r"No permission to open .* add yourself to the dialout group"):
         open_transport(f"serial://{device}")
 
 
