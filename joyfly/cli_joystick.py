@@ -13,6 +13,7 @@ from typing import Any, TextIO
 
 import click
 
+from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
 from joyfly.clock import WallClock
 from joyfly.joystick import (
     DeviceInfo,
@@ -31,12 +32,13 @@ from joyfly.virtual import TimedSource, record_to
 DEV_DIR = "/dev/input"
 
 
-@click.group("joystick")
+@click.group("joystick", cls=OneLineGroup, context_settings=CONTEXT,
+             short_help="List and test joysticks (no vehicle needed).")
 def joystick() -> None:
     """Find joysticks and check what they send (no vehicle needed)."""
 
 
-@joystick.command("list")
+@joystick.command("list", short_help="List the joysticks and their profiles.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True, help="Where the js* nodes live.")
 def list_cmd(dev_dir: str) -> None:
     """Every /dev/input/js* with its name, axes, buttons and the profile that matches it."""
@@ -58,7 +60,7 @@ def _device_line(item: DeviceInfo | JoystickError) -> str:
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
 
 
-@joystick.command("profiles")
+@joystick.command("profiles", short_help="The built-in controller profiles.")
 def profiles_cmd() -> None:
     """The built-in controller profiles, the device names they match, and their layout."""
     for profile in BUILTIN:
@@ -69,14 +71,14 @@ def profiles_cmd() -> None:
         click.echo(f"    axes {axes}; buttons {buttons}" + (f"; {profile.notes}" if profile.notes else ""))
 
 
-@joystick.command("test")
+@joystick.command("test", short_help="Watch a joystick's axes and buttons live.")
 @click.option("--joy", "joy", default=None, help="A /dev/input/js* device, a FIFO of js_event records, a --record "
               "recording, raw:FILE (a file of js_event records), script:FILE or replay:FILE (default: the first "
               "/dev/input/js*).")
 @click.option("--profile", "profile_name", default="auto", show_default=True,
               help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
 @click.option("--config", "config_path", default=None, help="TOML file whose [profile] table overrides the profile.")
-@click.option("--duration", type=float, default=None, help="Stop after this many seconds.")
+@click.option("--duration", type=FiniteRange(0.1, 86400), default=None, help="Stop after this many seconds.")
 @click.option("--record", "record_path", default=None, help="Also record the session to this file (JSON lines), to "
               "replay with --joy FILE.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True)

@@ -84,7 +84,7 @@ def test_record_then_replay_shows_the_same_session(tmp_path):
 def test_errors_are_one_sentence(tmp_path):
     result = run("test", "--joy", str(tmp_path / "js7"), "--dev-dir", str(tmp_path))
     assert result.exit_code == 1
-    assert result.output.startswith(f"Error: No joystick at {tmp_path / 'js7'}, and none is connected")
+    assert result.output.startswith(f"joyfly: No joystick at {tmp_path / 'js7'}, and none is connected")
     assert "Traceback" not in result.output
     script = tmp_path / "s.txt"
     script.write_text(SCRIPT)
@@ -130,4 +130,4 @@ def test_test_reads_a_raw_file_and_refuses_a_plain_one(tmp_path):
     assert "axes=[0, -32767]" in result.output
     result = run("test", "--joy", str(events), "--duration", "0.2")
     assert result.exit_code == 1 and len(result.output.splitlines()) == 1
-    assert result.output.startswith(f"Error: {events} is a regular file") and f"raw:{events}" in result.output
+    assert result.output.startswith(f"joyfly: {events} is a regular file") and f"raw:{events}" in result.output
