@@ -7,11 +7,8 @@ status; Ctrl-C / SIGTERM perform --on-exit and exit 0; a second Ctrl-C quits at 
 from __future__ import annotations
 
 import logging
-import signal
 import sys
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Callable
 from typing import Any
 
 import click
@@ -20,12 +17,13 @@ from joyfly.cli_joystick import joystick
 from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import BOUNDS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
-from joyfly.dashboard import make_view, summary_lines
-from joyfly.flight import FlightSession, Phase
-from joyfly.flight_session import FlightStats, Note
+from joyfly.dashboard import make_view
+from joyfly.flight import FlightSession
+from joyfly.flight_session import Note
 from joyfly.joystick import JoystickError
 from joyfly.link import VehicleLink
 from joyfly.mapping import open_sticks
+from joyfly.run import fly_session
 from joyfly.speedwatch import SpeedWatch
 from joyfly.transport import TransportError, open_transport
 
@@ -113,45 +111,6 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), "warn", text)))
     session.link.on_message.append(watch.observe)
     return fly_session(session, view, out)
-
-
-def fly_session(session: FlightSession, view: Any, out: Any) -> int:
-    """Run the session with Ctrl-C/SIGTERM handling, print the summary, close everything."""
-    try:
-        with exit_signals(session):
-            session.run(on_view=view.show)
-    except KeyboardInterrupt:
-        out.write("\njoyfly: interrupted twice, quitting at once (the vehicle keeps its last mode).\n")
-        return 130
-    finally:
-        view.close()
-        session.link.close()
-        session.sticks.close()
-    flew = session.stats != FlightStats()  # a session that never flew (no vehicle, refused) has nothing to sum up
-    if flew or session.phase is not Phase.FAILED:
-        for line in summary_lines(session.stats):
-            out.write(line + "\n")
-    if session.phase is Phase.FAILED:
-        click.echo(f"joyfly: {session.error}", err=True)
-        return 1
-    return 0
-
-
-@contextmanager
-def exit_signals(session: FlightSession) -> Iterator[None]:
-    """First SIGINT/SIGTERM: ask the session to perform --on-exit; the second: KeyboardInterrupt, at once."""
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        if session.exit_requested:
-            raise KeyboardInterrupt
-        session.request_exit()
-
-    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
 
 
 @main.command(short_help="A whole flight with no hardware.")

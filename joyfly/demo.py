@@ -114,7 +114,7 @@ def script_source(script_path: str | None, clock: Any) -> MappedSource:
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
              out: TextIO | None = None, options: FlyOptions | None = None) -> int:
     """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed)."""
-    from joyfly.cli import fly_session
+    from joyfly.run import fly_session
 
     out = out or sys.stdout
     opts = options or FlyOptions()
