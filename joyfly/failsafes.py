@@ -11,20 +11,37 @@ from joyfly.link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink
 # PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
 REASON_GRACE_S = 0.25
+BACK_WAIT_S = 2.0  # PX4 stamps ATTITUDE (15-100 Hz) with its boot time from its first seconds on
 WARNING = 4  # MAV_SEVERITY_WARNING: CRITICAL "Arming denied: ..." and friends are below it
 
 
 class LinkWatch:
-    """Reports "lost" once the heartbeat watchdog fails and "back" when it recovers."""
+    """Reports "lost" once the heartbeat watchdog fails and "back" when it recovers.
+
+    After a loss, "back" also waits (at most BACK_WAIT_S) for a message stamped with the vehicle's time since boot,
+    so that a vehicle that restarted is known as such (its boot time went back) before anyone says it is back.
+    """
 
     def __init__(self) -> None:
         self.ok = False
+        self.lost_s: float | None = None
+        self._beats_s: float | None = None  # when heartbeats came back after the loss
 
-    def update(self, ok: bool) -> str | None:
+    def update(self, heartbeat_ok: bool, now_s: float = 0.0, stamped_s: float | None = None) -> str | None:
+        ok = heartbeat_ok and (self.ok or self._boot_time_fresh(now_s, stamped_s))
+        self._beats_s = (self._beats_s if self._beats_s is not None else now_s) if heartbeat_ok else None
         if ok == self.ok:
             return None
         self.ok = ok
+        self.lost_s = None if ok else now_s
         return "back" if ok else "lost"
+
+    def _boot_time_fresh(self, now_s: float, stamped_s: float | None) -> bool:
+        if self.lost_s is None:  # the first connection
+            return True
+        if stamped_s is not None and stamped_s > self.lost_s:
+            return True
+        return self._beats_s is not None and now_s - self._beats_s >= BACK_WAIT_S
 
 
 class JoystickWatch:
@@ -36,7 +53,7 @@ class JoystickWatch:
         self._fired = False
 
     @property
-    def holding(self) -> bool:
+    def lost(self) -> bool:
         return self.lost_since is not None
 
     def update(self, connected: bool, now_s: float) -> str | None:
@@ -130,6 +147,9 @@ class Retry:
         return f"{self.what} failed after {self.attempt} attempt(s). {self.last_refusal}"
 
 
+EXIT_MODES = {"land": "AUTO.LAND", "rtl": "AUTO.RTL", "hold": "AUTO.LOITER"}  # where each --on-exit puts PX4
+
+
 class ExitPlan:
     """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
     until the vehicle is disarmed (land, rtl) or out of OFFBOARD (hold). The caller enforces the overall timeout."""
@@ -137,8 +157,15 @@ class ExitPlan:
     def __init__(self, on_exit: str, link: VehicleLink, now_s: float) -> None:
         self.on_exit = on_exit
         self.link = link
+        self.started_s = now_s
         self.retry = Retry(f"Exit action {on_exit}", 3, now_s, settle_s=math.inf)
         self._gave_up = False
+
+    @property
+    def commanded_mode(self) -> str | None:
+        """The mode the vehicle is in once it ACCEPTED the exit command (PX4 ACKs after switching), else None."""
+        handle = self.retry.handle
+        return EXIT_MODES.get(self.on_exit) if handle is not None and handle.accepted else None
 
     def _send(self) -> CommandHandle:
         if self.on_exit == "land":
@@ -148,8 +175,12 @@ class ExitPlan:
         return self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
 
     def done(self) -> bool:
+        """Out of OFFBOARD (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not
+        show in the 1 Hz HEARTBEAT yet)."""
         st = self.link.state
-        return not st.offboard if self.on_exit == "hold" else not st.armed
+        if self.on_exit == "hold":
+            return not st.offboard
+        return not st.armed and st.last_heartbeat_s is not None and st.last_heartbeat_s > self.started_s
 
     def update(self, now_s: float) -> str | None:
         """"done", a refusal to report, or None while in progress."""
