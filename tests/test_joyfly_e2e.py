@@ -157,8 +157,9 @@ def test_closing_the_fifo_holds_then_lands_after_the_timeout(flight: Flight) -> 
     assert flight.session.phase is Phase.FLYING
     assert max(abs(a - b) for a, b in zip(flight.pos(), held, strict=True)) < 0.5
     flight.wait_for(Phase.LANDING, 3.0)
-    flight.wait_for(Phase.GROUNDED, 30.0)
+    flight.wait_for(Phase.DONE, 30.0)  # landed, disarmed and no joystick: nothing more to fly
     assert not flight.session.link.state.armed
+    assert any("The joystick is gone" in n.text for n in flight.session.notes)
 
 
 
@@ -268,17 +269,24 @@ def test_an_emulator_restarted_mid_flight_is_reported_as_a_restart(tmp_path: Pat
 
 
 def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str:
-    assert proc.stdout is not None
-    seen = ""
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        line = proc.stdout.readline()
-        if not line and proc.poll() is not None:
-            break
-        seen += line
-        if text in line:
-            return seen
-    raise AssertionError(f"never saw {text!r}:\n{seen}")
+    """proc's output up to the line holding `text`; fails after timeout_s even if proc prints nothing more (a
+    reader thread does the blocking reads, and ends at EOF once the caller killed proc)."""
+    stdout = proc.stdout
+    assert stdout is not None
+    seen: list[str] = []
+
+    def read() -> None:
+        for line in iter(stdout.readline, ""):
+            seen.append(line)
+            if text in line:
+                return
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    reader.join(timeout_s)
+    if not seen or text not in seen[-1]:
+        raise AssertionError(f"never saw {text!r}:\n{''.join(seen)}")
+    return "".join(seen)
 
 
 def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> None:
