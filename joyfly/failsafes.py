@@ -28,8 +28,11 @@ class LinkWatch:
         self._beats_s: float | None = None  # when heartbeats came back after the loss
 
     def update(self, heartbeat_ok: bool, now_s: float = 0.0, stamped_s: float | None = None) -> str | None:
+        if not heartbeat_ok:
+            self._beats_s = None
+        elif self._beats_s is None:
+            self._beats_s = now_s
         ok = heartbeat_ok and (self.ok or self._boot_time_fresh(now_s, stamped_s))
-        self._beats_s = (self._beats_s if self._beats_s is not None else now_s) if heartbeat_ok else None
         if ok == self.ok:
             return None
         self.ok = ok

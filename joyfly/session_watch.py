@@ -38,9 +38,7 @@ class SessionWatch(SessionCore):
         if change == "lost":
             self._note("warn", f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
                                f"{self.link.transport.description}.")
-        elif change == "back" and lost_s is not None and self._restart_s >= lost_s:
-            pass  # the restart, reported already, said it all
-        elif change == "back":
+        elif change == "back" and (lost_s is None or self._restart_s < lost_s):  # else the restart note said it
             self._note("info", "Link back: the vehicle answers again.")
             self._on_link_back()
         return self._linkw.ok

@@ -233,10 +233,12 @@ def test_second_sigint_quits_at_once(tmp_path: Path) -> None:
 def test_a_script_joystick_that_ends_after_landing_exits_0_with_a_summary(tmp_path: Path) -> None:
     emu, joy, out = _start_pair(tmp_path, script_text="0 forward=0\n8 land=1\n+0.3 land=0\n+12 end\n")
     try:
-        stdout, stderr = joy.communicate(timeout=60.0)
+        out += _read_until(joy, "highest", 60.0)  # the summary's last line, with no Ctrl-C
+        joy.wait(10.0)
+        assert joy.stderr is not None
+        stderr = joy.stderr.read()
     finally:
         _kill(joy, emu)
-    out += stdout
     assert joy.returncode == 0, out + stderr
     assert "Landed and disarmed" in out and "The joystick is gone" in out and "joyfly is done" in out
     assert "distance flown" in out and "time in OFFBOARD" in out and "Traceback" not in stderr
