@@ -69,7 +69,8 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, **kw: An
 @_opt("--max-climb", float, "Climb/descent rate at full throttle stick, m/s.")
 @_opt("--max-speed", float, "Horizontal speed at full stick, m/s.")
 @_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick, deg/s.")
-@_opt("--fence", float, "Half-width of the square fence around home, metres; 0 disables.")
+@_opt("--fence", float, "Half-width of the square fence around this flight's home (where joyfly arms the vehicle), "
+      "metres; 0 disables.")
 @_opt("--min-alt", float, "Lowest setpoint, metres above home.")
 @_opt("--max-alt", float, "Highest setpoint, metres above home.")
 @_opt("--rate", float, "Setpoint stream rate, Hz.")
