@@ -31,8 +31,11 @@ _CLEAR_LINE = "\r\x1b[K"  # what pxh does before reprinting its prompt on a term
 
 class Console:
     def __init__(self, vehicles: Sequence[Any], on_shutdown: Callable[[], None] | None = None,
-                 stream_in: TextIO = sys.stdin, stream_out: TextIO = sys.stdout,
+                 stream_in: TextIO | None = None, stream_out: TextIO | None = None,
                  use_readline: bool | None = None) -> None:
+        """`stream_in`/`stream_out` default to this process's stdin and stdout (then readline can edit lines)."""
+        stream_in = sys.stdin if stream_in is None else stream_in
+        stream_out = sys.stdout if stream_out is None else stream_out
         self.vehicles = list(vehicles)
         self.vehicle = self.vehicles[0]
         self._on_shutdown = on_shutdown
@@ -62,9 +65,8 @@ class Console:
             self._thread.start()
 
     def stop(self) -> None:
-        """Stop printing, give the terminal back as it was; the reader thread ends with the process."""
-        if self._at_prompt and not self._input.draws_prompt:
-            self._write("\n")
+        """Stop printing, give the terminal back as it was; the reader thread ends with the process. (A prompt
+        line stays open for what follows, as pxh's: "PX4 Exiting..." comes after a newline.)"""
         self._at_prompt = False
         self._stopped = True
         self._stop_reading.set()
@@ -113,7 +115,7 @@ class Console:
 
     def _redraw_prompt(self) -> None:
         if self._input.draws_prompt:
-            if getattr(self._input, "at_prompt", False):
+            if self._input.at_prompt:
                 self._write("\n")
                 self._input.redisplay()
         else:
@@ -166,7 +168,7 @@ class Console:
         if not text:
             return
         reader = self._input
-        if reader.draws_prompt and getattr(reader, "at_prompt", False):
+        if reader.draws_prompt and reader.at_prompt:
             self._write(_CLEAR_LINE + text)
             reader.redisplay()
             return

@@ -115,6 +115,7 @@ class StreamInput:
     """Lines from a text stream: a pipe, a file, or a terminal where readline is missing. The console prompts."""
 
     draws_prompt = False
+    at_prompt = False  # readline's notion; the console keeps its own for this input
 
     def __init__(self, stream: TextIO, stop: threading.Event) -> None:
         self._stream = stream
@@ -135,7 +136,7 @@ class StreamInput:
                 return line.rstrip("\r\n")
             if not self.wait.tty:
                 return None
-            # Ctrl-D on a terminal: ignored, as pxh does
+            self.wait.stop.wait(0.05)  # Ctrl-D on a terminal: ignored, as pxh does (and a hung-up one: no spinning)
         return None
 
     def line_typed_meanwhile(self) -> str | None:
@@ -176,7 +177,9 @@ class ReadlineInput:
                 return input(PROMPT)
             except EOFError:  # Ctrl-D (ignored, as pxh does), or a read that lost a race with `bg`
                 if self.wait.foreground:
-                    sys.stdout.write("\n")
+                    with contextlib.suppress(OSError, ValueError):
+                        sys.stdout.write("\n")
+                        sys.stdout.flush()
                 self.wait.stop.wait(0.05)  # a hung-up terminal answers EOF at once: do not spin
             finally:
                 self.at_prompt = False

@@ -18,18 +18,20 @@ import sys
 import termios
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 
 
 class PtyJob:
-    def __init__(self, serve_args: list[str], foreground: bool) -> None:
+    def __init__(self, serve_args: list[str], foreground: bool, readline: bool = True) -> None:
         self._master, slave = os.openpty()
         control_r, self._control = os.pipe()
         pid_r, pid_w = os.pipe()
         self.helper = subprocess.Popen(
-            [sys.executable, __file__, str(control_r), str(pid_w), "fg" if foreground else "bg", *serve_args],
+            [sys.executable, __file__, str(control_r), str(pid_w), "fg" if foreground else "bg",
+             "readline" if readline else "no-readline", *serve_args],
             stdin=slave, stdout=slave, stderr=slave, pass_fds=(control_r, pid_w), cwd=REPO,
             env={**os.environ, "PYTHONPATH": str(REPO), "TERM": "xterm"})
         os.close(slave)
@@ -66,9 +68,20 @@ class PtyJob:
 
     def fg(self) -> None:
         os.write(self._control, b"fg\n")
+        self._until(lambda: os.tcgetpgrp(self._master) == self.pid)
 
     def bg(self) -> None:
         os.write(self._control, b"bg\n")
+        self._until(lambda: os.tcgetpgrp(self._master) != self.pid)
+
+    @staticmethod
+    def _until(done: Callable[[], bool], timeout: float = 5.0) -> None:
+        """Wait until the shell has moved the job (what is typed next goes to the right process)."""
+        deadline = time.monotonic() + timeout
+        while not done():
+            if time.monotonic() > deadline:
+                raise TimeoutError("the job did not move between foreground and background")
+            time.sleep(0.01)
 
     def wait(self, timeout: float) -> int:
         """serve's exit status (the helper exits with it)."""
@@ -93,7 +106,11 @@ class PtyJob:
             self._chunks.append(data)
 
 
-def _shell(control_fd: int, pid_fd: int, mode: str, serve_args: list[str]) -> int:
+# serve as `sitl-emu serve` runs it, in a Python where `import readline` fails (as where readline does not exist)
+_WITHOUT_READLINE = "import sys; sys.modules['readline'] = None; from sitl_emu.cli import main; main()"
+
+
+def _shell(control_fd: int, pid_fd: int, mode: str, readline: str, serve_args: list[str]) -> int:
     """The helper process: a session leader with the pty as its controlling terminal, serve as its job."""
     os.setsid()
     fcntl.ioctl(0, termios.TIOCSCTTY, 0)
@@ -106,7 +123,8 @@ def _shell(control_fd: int, pid_fd: int, mode: str, serve_args: list[str]) -> in
             os.tcsetpgrp(0, os.getpgrp())
         signal.signal(signal.SIGTTOU, signal.SIG_DFL)
         signal.signal(signal.SIGTTIN, signal.SIG_DFL)
-        os.execv(sys.executable, [sys.executable, "-m", "sitl_emu", "serve", *serve_args])
+        start = ["-m", "sitl_emu"] if readline == "readline" else ["-c", _WITHOUT_READLINE]
+        os.execv(sys.executable, [sys.executable, *start, "serve", *serve_args])
     os.setpgid(pid, pid)
     if mode == "fg":
         os.tcsetpgrp(0, pid)
@@ -139,5 +157,5 @@ def _move_job(control_fd: int, pid: int) -> None:
 
 
 if __name__ == "__main__":
-    code = _shell(int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4:])
+    code = _shell(int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5:])
     sys.exit(code if code >= 0 else 128 - code)

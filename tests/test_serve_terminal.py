@@ -32,8 +32,8 @@ def _ports_args() -> list[str]:
 def jobs():
     started: list[PtyJob] = []
 
-    def start(foreground: bool, *args: str) -> PtyJob:
-        job = PtyJob([*_ports_args(), *args], foreground)
+    def start(foreground: bool, *args: str, readline: bool = True) -> PtyJob:
+        job = PtyJob([*_ports_args(), *args], foreground, readline)
         started.append(job)
         assert job.wait_for("sitl-emu: PX4 quadrotor sysid"), job.output
         return job
@@ -80,6 +80,10 @@ def test_readline_up_arrow_recalls_the_last_command(jobs):
     job.send(UP + "\n")
     assert job.wait_for("HW arch: PX4_SITL", count=2), job.output
     assert "^[[A" not in job.output
+    job.send("\x04")  # Ctrl-D: ignored, as by pxh; the console goes on
+    time.sleep(0.3)
+    job.send("ver\n")
+    assert job.wait_for("HW arch: PX4_SITL", count=3), job.output
 
 
 def test_ctrl_c_on_the_console_prints_the_shutdown_line_and_exits_0(jobs):
@@ -128,3 +132,25 @@ def test_sigterm_to_a_stopped_job_ends_it_with_the_shutdown_line(jobs):
     job.kill(signal.SIGCONT)
     assert job.wait(timeout=5) == 0
     assert job.wait_for(SHUTDOWN_LINE, timeout=2), job.output
+
+
+def test_without_readline_the_console_still_works_and_still_minds_job_control(jobs):
+    job = jobs(False, readline=False)
+    time.sleep(1.0)
+    assert job.state() != "T" and "pxh> " not in job.output
+    job.fg()
+    assert job.wait_for("pxh> "), job.output
+    job.send("ver\n")
+    assert job.wait_for("HW arch: PX4_SITL"), job.output
+    job.send("\x04")  # Ctrl-D: ignored, as by pxh
+    time.sleep(0.3)
+    job.send("ver\n")
+    assert job.wait_for("HW arch: PX4_SITL", count=2), job.output
+    job.bg()
+    time.sleep(0.5)
+    job.send("echo typed-for-the-shell\n")
+    assert job.wait_for("shell read: echo typed-for-the-shell"), job.output
+    job.kill(signal.SIGTERM)
+    assert job.wait(timeout=5) == 0
+    assert job.wait_for(SHUTDOWN_LINE, timeout=2), job.output
+    assert "Invalid command: echo" not in job.output

@@ -76,7 +76,7 @@ class ShellBridge:
     def _write(self, data: bytes, ctx: Any) -> None:
         for i, byte in enumerate(data):
             if self._shell is not None and self._shell.busy:
-                self._waiting_input += data[i:][: MAX_LINE - len(self._waiting_input)]
+                self._waiting_input += data[i:][: max(0, MAX_LINE - len(self._waiting_input))]
                 return
             if byte == 0x0A:
                 self._run_line(ctx)
