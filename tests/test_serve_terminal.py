@@ -28,6 +28,18 @@ def _ports_args() -> list[str]:
             "--gcs-remote", f"127.0.0.1:{remote}"]
 
 
+def _run(job: PtyJob, line: str, expect: str, count: int = 1) -> None:
+    """Type `line` and Enter; `expect` shows up (for the `count`-th time)."""
+    job.send(line + "\n")
+    assert job.wait_for(expect, count=count), job.output
+
+
+def _ctrl_z(job: PtyJob) -> None:
+    job.send("\x1a")  # Ctrl-Z: the terminal stops the foreground job
+    time.sleep(0.5)
+    assert job.state() == "T"
+
+
 @pytest.fixture()
 def jobs():
     started: list[PtyJob] = []
@@ -60,14 +72,12 @@ def test_fg_gives_the_console_and_bg_takes_it_away(jobs):
     time.sleep(0.5)
     job.fg()
     assert job.wait_for("pxh> "), job.output
-    job.send("ver\n")
-    assert job.wait_for("HW arch: PX4_SITL"), job.output
+    _run(job, "ver", "HW arch: PX4_SITL")
     job.bg()
     time.sleep(1.0)
     assert job.state() != "T"
     job.fg()
-    job.send("listener vehicle_status\n")
-    assert job.wait_for("TOPIC: vehicle_status"), job.output
+    _run(job, "listener vehicle_status", "TOPIC: vehicle_status")
 
 
 def test_readline_up_arrow_recalls_the_last_command(jobs):
@@ -75,15 +85,13 @@ def test_readline_up_arrow_recalls_the_last_command(jobs):
     assert job.wait_for("pxh> "), job.output
     job.send("ve")  # the log line that comes meanwhile goes above the prompt, which is drawn again with "ve"
     assert job.wait_for("INFO  [commander] Ready for takeoff!\r\npxh> ve"), job.output
-    job.send("r\n")
-    assert job.wait_for("HW arch: PX4_SITL"), job.output
+    _run(job, "r", "HW arch: PX4_SITL")
     job.send(UP + "\n")
     assert job.wait_for("HW arch: PX4_SITL", count=2), job.output
     assert "^[[A" not in job.output
     job.send("\x04")  # Ctrl-D: ignored, as by pxh; the console goes on
     time.sleep(0.3)
-    job.send("ver\n")
-    assert job.wait_for("HW arch: PX4_SITL", count=3), job.output
+    _run(job, "ver", "HW arch: PX4_SITL", count=3)
 
 
 def test_ctrl_c_on_the_console_prints_the_shutdown_line_and_exits_0(jobs):
@@ -98,36 +106,28 @@ def test_ctrl_c_on_the_console_prints_the_shutdown_line_and_exits_0(jobs):
 def test_console_says_which_vehicle_it_controls_and_switches(jobs):
     job = jobs(True, "--count", "3")
     assert job.wait_for("console controls sysid 1 (vehicle 1 of 3, sysids 1-3)"), job.output
-    job.send("vehicle 2\n")
-    assert job.wait_for("console controls sysid 2"), job.output
-    job.send("listener vehicle_status\n")
-    assert job.wait_for("    system_id: 2"), job.output
+    _run(job, "vehicle 2", "console controls sysid 2")
+    _run(job, "listener vehicle_status", "    system_id: 2")
 
 
 def test_ctrl_z_bg_leaves_the_terminal_to_the_shell_and_fg_brings_the_console_back(jobs):
     job = jobs(True)
     assert job.wait_for("pxh> "), job.output
-    job.send("\x1a")  # Ctrl-Z: the terminal stops the foreground job
-    time.sleep(0.5)
-    assert job.state() == "T"
+    _ctrl_z(job)
     job.bg()
     time.sleep(0.5)
     assert job.state() != "T"
-    job.send("echo typed-for-the-shell\n")
-    assert job.wait_for("shell read: echo typed-for-the-shell"), job.output
+    _run(job, "echo typed-for-the-shell", "shell read: echo typed-for-the-shell")
     time.sleep(0.5)
     assert job.state() != "T" and "Invalid command: echo" not in job.output
     job.fg()
-    job.send("ver\n")
-    assert job.wait_for("HW arch: PX4_SITL"), job.output
+    _run(job, "ver", "HW arch: PX4_SITL")
 
 
 def test_sigterm_to_a_stopped_job_ends_it_with_the_shutdown_line(jobs):
     job = jobs(True)
     assert job.wait_for("pxh> "), job.output
-    job.send("\x1a")
-    time.sleep(0.5)
-    assert job.state() == "T"
+    _ctrl_z(job)
     job.kill(signal.SIGTERM)  # as bash's `kill %1`: SIGTERM, then SIGCONT so the job can act on it
     job.kill(signal.SIGCONT)
     assert job.wait(timeout=5) == 0
@@ -140,16 +140,13 @@ def test_without_readline_the_console_still_works_and_still_minds_job_control(jo
     assert job.state() != "T" and "pxh> " not in job.output
     job.fg()
     assert job.wait_for("pxh> "), job.output
-    job.send("ver\n")
-    assert job.wait_for("HW arch: PX4_SITL"), job.output
+    _run(job, "ver", "HW arch: PX4_SITL")
     job.send("\x04")  # Ctrl-D: ignored, as by pxh
     time.sleep(0.3)
-    job.send("ver\n")
-    assert job.wait_for("HW arch: PX4_SITL", count=2), job.output
+    _run(job, "ver", "HW arch: PX4_SITL", count=2)
     job.bg()
     time.sleep(0.5)
-    job.send("echo typed-for-the-shell\n")
-    assert job.wait_for("shell read: echo typed-for-the-shell"), job.output
+    _run(job, "echo typed-for-the-shell", "shell read: echo typed-for-the-shell")
     job.kill(signal.SIGTERM)
     assert job.wait(timeout=5) == 0
     assert job.wait_for(SHUTDOWN_LINE, timeout=2), job.output
