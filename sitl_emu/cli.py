@@ -12,7 +12,6 @@ import signal
 import sys
 import time
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
 import click
@@ -35,8 +34,9 @@ from sitl_emu.cli_options import (
     parse_address,
     parse_home,
 )
+from sitl_emu.console import attach_console
 from sitl_emu.mavlink.link import PortInUseError
-from sitl_emu.runner import RealTimeRunner
+from sitl_emu.runner import RealTimeRunner, stop_on_signals
 from sitl_emu.server import LinkSettings
 from sitl_emu.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
@@ -48,6 +48,7 @@ log = logging.getLogger(__name__)
 DEFAULT_BATCH_MS = 10.0
 MIN_BATCH_WALL_S = 0.001  # batching never wakes more than 1000 times a wall second (high --speed)
 PORT = WholeRange(0, PORT_MAX)
+SHUTDOWN_LINE = "PX4 Exiting..."  # what PX4 SITL prints on Ctrl-C or SIGTERM (platforms/posix/src/px4/common/main.cpp)
 
 
 def wake_period_s(batch_ms: float, speed: float) -> float:
@@ -117,19 +118,6 @@ def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: in
     return Vehicle(**kwargs)
 
 
-def start_console(vehicle: Any, runner: RealTimeRunner, enabled: bool) -> None:
-    if not enabled or not sys.stdin.isatty():
-        return
-    try:
-        from sitl_emu.console import Console
-    except ImportError:
-        log.info("no console module; running headless")
-        return
-    console = Console(vehicle, runner.stop)
-    console.start()
-    runner.hooks.append(console.pump)
-
-
 @click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
 @click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s (the joyfly package)")
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
@@ -188,23 +176,26 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
-    start_console(nodes[0].vehicle, runner, not no_console)
-    _run_until_signalled(runner)
+    console = attach_console([node.vehicle for node in nodes], runner, not no_console)
+    _run_until_signalled(runner, console)
     for node in nodes:
         node.close()
 
 
-def _run_until_signalled(runner: RealTimeRunner) -> None:
-    def on_term(signum: int, frame: FrameType | None) -> None:
-        runner.stop()
-
-    previous = signal.signal(signal.SIGTERM, on_term)
-    try:
-        runner.run()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:
+    """Run until `shutdown`, SIGTERM or Ctrl-C; on a signal print PX4's "PX4 Exiting..." (main.cpp sig_int_handler,
+    with its leading newline that ends the prompt line)."""
+    with stop_on_signals(runner) as received:
+        try:
+            runner.run()
+        except KeyboardInterrupt:  # Ctrl-C before the handler was in place
+            received.append(signal.SIGINT)
+    if console is not None:
+        console.stop()
+    if received:
+        with contextlib.suppress(OSError, ValueError):  # stdout already gone: nothing to tell
+            click.echo(f"\n{SHUTDOWN_LINE}")
+            sys.stdout.flush()
 
 
 if __name__ == "__main__":
