@@ -11,7 +11,6 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from pathlib import Path
 from typing import Any, TextIO
 
 from joyfly.clock import ScaledClock
@@ -144,7 +143,3 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
             emulator.stop()
     return status
 
-
-def default_script() -> Path:
-    """The repository's example script, for users who want to edit a copy."""
-    return Path(__file__).resolve().parent.parent / "examples" / "joystick_script.txt"

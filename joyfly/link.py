@@ -65,10 +65,6 @@ _AUTO_NAMES = {1: "AUTO.READY", 2: "AUTO.TAKEOFF", 3: "AUTO.LOITER", 4: "AUTO.MI
                6: "AUTO.LAND", 8: "AUTO.FOLLOW_TARGET", 9: "AUTO.PRECLAND", 20: "AUTO.DESCEND"}
 
 
-def custom_mode_of(main: int, sub: int = 0) -> int:
-    return (sub << 24) | (main << 16)
-
-
 def mode_name(custom_mode: int) -> str:
     """MAVROS-style name of a PX4 custom_mode ("OFFBOARD", "AUTO.LOITER"), "CMODE(n)" if unknown."""
     main, sub = (custom_mode >> 16) & 0xFF, (custom_mode >> 24) & 0xFF
