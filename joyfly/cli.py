@@ -18,14 +18,14 @@ from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import BOUNDS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
-from joyfly.flight import FlightSession
-from joyfly.flight_session import Note
-from joyfly.joystick import JoystickError
-from joyfly.link import VehicleLink
-from joyfly.mapping import open_sticks
+from joyfly.link.speedwatch import SpeedWatch
+from joyfly.link.transport import TransportError, open_transport
+from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
-from joyfly.speedwatch import SpeedWatch
-from joyfly.transport import TransportError, open_transport
+from joyfly.session.core import Note
+from joyfly.session.flight_session import FlightSession
+from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.mapping import open_sticks
 
 D = FlyOptions()
 

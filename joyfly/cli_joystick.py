@@ -15,7 +15,7 @@ import click
 
 from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
 from joyfly.clock import WallClock
-from joyfly.joystick import (
+from joyfly.sticks.joystick import (
     DeviceInfo,
     JoystickError,
     JsDevice,
@@ -23,11 +23,11 @@ from joyfly.joystick import (
     list_devices,
     open_joystick,
 )
-from joyfly.mapping import StickMapper
-from joyfly.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.mapping import StickMapper
+from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
-from joyfly.virtual import TimedSource, record_to
 
 DEV_DIR = "/dev/input"
 

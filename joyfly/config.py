@@ -1,7 +1,7 @@
 """`joyfly fly` options: defaults, the TOML config file (`--config`), validation, and the session settings.
 
 A config file sets any option in a `[fly]` table (or at the top level), with the option's name as on the command
-line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile (joyfly/profiles.py).
+line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile (joyfly/sticks/profiles.py).
 Command-line options win over the file, the file over the defaults::
 
     [fly]
@@ -25,10 +25,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from joyfly.flight_session import SessionSettings
-from joyfly.profiles import read_config
-from joyfly.setpoints import Limits
-from joyfly.transport import UrlError, parse_url
+from joyfly.link.transport import UrlError, parse_url
+from joyfly.session.core import SessionSettings
+from joyfly.sticks.profiles import read_config
+from joyfly.sticks.setpoints import Limits
 
 DEFAULT_URL = "udp://:14540@127.0.0.1:14557"
 CONTROLS = ("velocity", "step")

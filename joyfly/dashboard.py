@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import TextIO
 
-from joyfly.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.session.core import FlightStats, Note, Phase, SessionView
 from joyfly.term import LiveBlock
 from joyfly.types import StickCommand
 

@@ -16,15 +16,15 @@ from typing import Any, TextIO
 from joyfly.clock import ScaledClock
 from joyfly.config import FlyOptions
 from joyfly.dashboard import make_view
-from joyfly.flight import FlightSession
-from joyfly.link import VehicleLink
-from joyfly.mapping import MappedSource
-from joyfly.profiles import load_profile
-from joyfly.transport import UdpTransport, open_transport
-from joyfly.virtual import ScriptSource
+from joyfly.link.transport import UdpTransport, open_transport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession
+from joyfly.sticks.mapping import MappedSource
+from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.virtual import ScriptSource
 
 # The demo flight (joyfly takes off by itself at the start; the sticks then fly a square and push the fence).
-# Format: joyfly/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.
+# Format: joyfly/sticks/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.
 DEMO_SCRIPT = """\
 8      forward=0.5               # north, 2.5 m/s
 +1.6   forward=0

@@ -15,7 +15,7 @@ from typing import Any
 import click
 
 from joyfly.dashboard import summary_lines
-from joyfly.flight import FlightSession, Phase
+from joyfly.session.flight_session import FlightSession, Phase
 
 
 def fly_session(session: FlightSession, view: Any, out: Any) -> int:

@@ -15,7 +15,7 @@ import joyfly.cli
 import joyfly.config
 import sitl_emu.cli
 import sitl_emu.cli_options
-from joyfly.profiles import read_config
+from joyfly.sticks.profiles import read_config
 
 REPO = Path(__file__).resolve().parent.parent
 TOOLS = {"joyfly": joyfly.cli.main, "sitl-emu": sitl_emu.cli.main}

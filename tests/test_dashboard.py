@@ -6,8 +6,8 @@ import io
 from dataclasses import replace
 
 from joyfly.dashboard import LiveDashboard, PlainLog, bar, make_view, render, summary_lines
-from joyfly.flight import FlightStats, Note, Phase, SessionView
-from joyfly.setpoints import Fence, Setpoint
+from joyfly.session.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.sticks.setpoints import Fence, Setpoint
 from joyfly.types import Action, StickCommand
 
 

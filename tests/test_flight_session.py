@@ -13,9 +13,9 @@ from joyfly_fakes import LAND, LOITER, OFFBOARD, RTL, FakeVehicle, TimedSticks
 
 from joyfly.clock import SimClock
 from joyfly.dashboard import render
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.link import VehicleLink
-from joyfly.transport import memory_pair
+from joyfly.link.transport import memory_pair
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.types import Action, StickCommand
 
 

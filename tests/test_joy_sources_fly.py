@@ -22,9 +22,9 @@ import pytest
 from ports import free_udp_port
 
 from joyfly.demo import EmbeddedVehicle
-from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.virtual import JoyRecorder
 from joyfly.types import JoyState
-from joyfly.virtual import JoyRecorder
 
 SPEED = 4.0
 ROOT = Path(__file__).resolve().parents[1]

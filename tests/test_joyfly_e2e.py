@@ -22,11 +22,11 @@ import pytest
 from ports import free_udp_port, free_udp_ports
 
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
-from joyfly.link import VehicleLink
-from joyfly.mapping import open_sticks
-from joyfly.transport import UdpTransport
+from joyfly.link.transport import UdpTransport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
+from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.mapping import open_sticks
 
 SPEED = 8.0
 AXIS_FULL = 32767

@@ -14,10 +14,10 @@ from joyfly_fakes import FakeVehicle, TimedSticks
 
 from joyfly.clock import SimClock
 from joyfly.dashboard import LiveDashboard, PlainLog
-from joyfly.flight import FlightSession, SessionSettings, SessionView
-from joyfly.link import VehicleLink
+from joyfly.link.transport import memory_pair
+from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
-from joyfly.transport import memory_pair
+from joyfly.session.flight_session import FlightSession, SessionSettings, SessionView
 from joyfly.types import StickCommand
 
 

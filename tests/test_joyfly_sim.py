@@ -10,9 +10,9 @@ from collections.abc import Iterator
 import pytest
 from joyfly_fakes import TimedSticks
 
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.link import VehicleLink
-from joyfly.transport import UdpTransport
+from joyfly.link.transport import UdpTransport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.types import Action, StickCommand
 from sitl_emu.api import Sim
 

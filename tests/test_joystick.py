@@ -9,8 +9,8 @@ import tty
 
 import pytest
 
-from joyfly import joystick
-from joyfly.joystick import (
+from joyfly.sticks import joystick
+from joyfly.sticks.joystick import (
     EVENT_SIZE,
     JS_EVENT_AXIS,
     JS_EVENT_BUTTON,

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import pytest
 from ports import free_udp_ports
 
-from joyfly.speedwatch import WINDOW_S, SpeedWatch, mismatch_sentence
+from joyfly.link.speedwatch import WINDOW_S, SpeedWatch, mismatch_sentence
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from joyfly.transport import Endpoint, TransportError, UrlError, _serial_problem, open_transport, parse_url
+from joyfly.link.transport import Endpoint, TransportError, UrlError, _serial_problem, open_transport, parse_url
 
 
 @pytest.mark.parametrize(("url", "endpoint"), [

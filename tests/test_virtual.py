@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from joyfly.joystick import JoystickError, open_joystick
-from joyfly.mapping import StickMapper
-from joyfly.profiles import load_profile
+from joyfly.sticks.joystick import JoystickError, open_joystick
+from joyfly.sticks.mapping import StickMapper
+from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.virtual import JoyRecorder, ReplaySource, ScriptSource, parse_script, record_to
 from joyfly.types import Action
-from joyfly.virtual import JoyRecorder, ReplaySource, ScriptSource, parse_script, record_to
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "joystick_script.txt"
 
@@ -95,8 +95,8 @@ def test_script_mistakes_name_the_line(text, fragment):
 
 
 def test_example_script_leaves_the_take_off_to_joyfly_flies_a_square_pushes_the_fence_and_lands():
-    """`joyfly fly` arms, takes off and enters OFFBOARD itself (joyfly/flight.py): the example presses only LAND, and
-    keeps the sticks centred for the take-off's first 8 s."""
+    """`joyfly fly` arms, takes off and enters OFFBOARD itself (joyfly/session/flight_session.py): the example
+    presses only LAND, and keeps the sticks centred for the take-off's first 8 s."""
     clock = FakeClock(0.0)
     src = open_joystick(f"script:{EXAMPLE}", clock)
     mapper = StickMapper(load_profile("auto", src.name, {}))

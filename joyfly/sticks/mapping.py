@@ -18,10 +18,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from joyfly.joystick import AXIS_MAX, JoystickError, open_joystick
-from joyfly.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.sticks.joystick import AXIS_MAX, JoystickError, open_joystick
+from joyfly.sticks.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.sticks.virtual import record_to
 from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
-from joyfly.virtual import record_to
 
 HOLD_EPS_S = 1e-6  # held times are float sums of poll intervals: 10 x 0.1 s must count as 1 s
 

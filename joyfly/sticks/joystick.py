@@ -1,4 +1,4 @@
-"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS (the record format: joyfly/js_events.py).
+"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS (the record format: joyfly/sticks/js_events.py).
 
 `open_joystick(spec, clock)` returns a `JoystickSource` for what `--joy` names:
   - a js device: name and axis/button counts come from the JSIOCGNAME/JSIOCGAXES/JSIOCGBUTTONS ioctls; a read error
@@ -9,7 +9,7 @@
   - a recording written by `--record` (its first line says so): replayed, as `replay:FILE` does;
   - `raw:FILE`: a file of js_event records the user vouches for (e.g. `cat /dev/input/js0 > FILE`), read like
     `tail -f` (events appended later are picked up); raw: also takes a character device that is no joystick;
-  - `script:FILE` and `replay:FILE`: virtual joysticks, see joyfly/virtual.py.
+  - `script:FILE` and `replay:FILE`: virtual joysticks, see joyfly/sticks/virtual.py.
 Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (a text file, a
 binary: joyfly cannot tell records from bytes that merely parse), a directory, a character device that answers
 neither the js ioctls nor is a pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer.
@@ -28,7 +28,7 @@ import stat
 from dataclasses import dataclass
 
 from joyfly.clock import WallClock
-from joyfly.js_events import (
+from joyfly.sticks.js_events import (
     AXIS_MAX,
     EVENT_FORMAT,
     EVENT_SIZE,
@@ -46,8 +46,8 @@ from joyfly.js_events import (
     permission_error,
     vanished_error,
 )
+from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
-from joyfly.virtual import ReplaySource, ScriptSource, is_recording
 
 __all__ = [  # the record format is re-exported: callers import the joystick side from here
     "AXIS_MAX", "EVENT_FORMAT", "EVENT_SIZE", "JS_EVENT_AXIS", "JS_EVENT_BUTTON", "JS_EVENT_INIT", "DeviceInfo",

@@ -14,8 +14,8 @@ import logging
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.failsafes import ExitPlan, Retry
-from joyfly.flight_session import (
+from joyfly.link.vehicle_link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER
+from joyfly.session.core import (
     MIN_SEND_GAP_S,
     FlightStats,
     Note,
@@ -26,10 +26,10 @@ from joyfly.flight_session import (
     left_offboard_message,
     no_vehicle_message,
 )
-from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER
-from joyfly.mapping import fired
-from joyfly.session_watch import SessionWatch
-from joyfly.setpoints import initial_setpoint, next_setpoint
+from joyfly.session.retry import ExitPlan, Retry
+from joyfly.session.watch import SessionWatch
+from joyfly.sticks.mapping import fired
+from joyfly.sticks.setpoints import initial_setpoint, next_setpoint
 from joyfly.types import Action
 
 __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "SessionView", "StickSource"]

@@ -3,7 +3,7 @@ records (include/uapi/linux/joystick.h), the state they build, and the joystick 
 
 Axes run -32767..32767 (up on a stick is negative), buttons 1/0. On open, and again after the kernel's 64-event queue
 overflows, the driver re-sends the whole state as events flagged JS_EVENT_INIT (buttons first, then axes).
-No I/O here: joyfly/joystick.py reads devices, joyfly/virtual.py plays scripts and recordings.
+No I/O here: joyfly/sticks/joystick.py reads devices, joyfly/sticks/virtual.py plays scripts and recordings.
 """
 
 from __future__ import annotations

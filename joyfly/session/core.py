@@ -1,6 +1,6 @@
 """The flight session's vocabulary and state: phases, settings, notes to the user, flight statistics, the view
 snapshot the live view draws, and `SessionCore`, the session's state with its small helpers. The behaviour (loop,
-watchdogs, buttons, phases) is `FlightSession` in joyfly/flight.py."""
+watchdogs, buttons, phases) is `FlightSession` in joyfly/session/flight_session.py."""
 
 from __future__ import annotations
 
@@ -11,12 +11,13 @@ from dataclasses import dataclass, field
 from enum import Enum
 from typing import Protocol
 
-from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
-from joyfly.link import VehicleLink, VehicleState
-from joyfly.setpoints import Fence, Limits, Setpoint, hold_setpoint
+from joyfly.link.vehicle_link import VehicleLink, VehicleState
+from joyfly.session.retry import ExitPlan, Retry
+from joyfly.session.watchdogs import JoystickWatch, LinkWatch
+from joyfly.sticks.setpoints import Fence, Limits, Setpoint, hold_setpoint
 from joyfly.types import Action, Clock, StickCommand
 
-log = logging.getLogger("joyfly.flight")
+log = logging.getLogger("joyfly.session.flight_session")
 
 MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
 STALE_S = 0.5  # the vehicle's state is news while it keeps sending (PX4's ATTITUDE: 15-100 Hz); older is a guess

@@ -1,7 +1,7 @@
 """joyfly's MAVLink client: heartbeats as a GCS, commands with retries, setpoints out, the vehicle's state in.
 
 It speaks plain MAVLink 2 as any PX4 client does, so the same code flies real PX4 SITL and sitl-emu. The bytes go
-through a `Transport` (joyfly/transport.py: UDP in MAVROS fcu_url style, pymavlink connection strings, or an
+through a `Transport` (joyfly/link/transport.py: UDP in MAVROS fcu_url style, pymavlink connection strings, or an
 in-memory pair for tests).
 """
 
@@ -15,8 +15,8 @@ from typing import Any
 
 from pymavlink.dialects.v20 import common as mavlink2
 
-from joyfly.setpoints import FRAME_LOCAL_NED, Setpoint
-from joyfly.transport import Transport
+from joyfly.link.transport import Transport
+from joyfly.sticks.setpoints import FRAME_LOCAL_NED, Setpoint
 from joyfly.types import Clock
 
 log = logging.getLogger(__name__)

@@ -1,12 +1,13 @@
 """The flight session's watchdogs, run every tick once connected: the vehicle (did it restart? is it armed? the home
 of a flight joyfly took over), the link (lost, back) and the joystick (lost, back, lost too long). `FlightSession`
-(joyfly/flight.py) runs them; the state they keep is `SessionCore`'s."""
+(joyfly/session/flight_session.py) runs them; the state they keep is `SessionCore`'s."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from joyfly.flight_session import STREAMING_PHASES, Phase, SessionCore, restarted_message
+from joyfly.session.core import STREAMING_PHASES, Phase, SessionCore, restarted_message
+from joyfly.session.watchdogs import Change
 
 
 class SessionWatch(SessionCore):
@@ -35,10 +36,10 @@ class SessionWatch(SessionCore):
         st = self.link.state
         lost_s = self._linkw.lost_s
         change = self._linkw.update(st.link_ok(now), now, st.stamped_s)
-        if change == "lost":
+        if change is Change.LOST:
             self._note("warn", f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
                                f"{self.link.transport.description}.")
-        elif change == "back" and (lost_s is None or self._restart_s < lost_s):  # else the restart note said it
+        elif change is Change.BACK and (lost_s is None or self._restart_s < lost_s):  # else the restart note said it
             self._note("info", "Link back: the vehicle answers again.")
             self._on_link_back()
         return self._linkw.ok
@@ -56,15 +57,15 @@ class SessionWatch(SessionCore):
 
     def _watch_joystick(self, now: float) -> None:
         change = self._joy.update(self.cmd.connected, now)
-        if change == "lost" and self.phase is Phase.FLYING:
+        if change is Change.LOST and self.phase is Phase.FLYING:
             self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
                                "unless it comes back.")
             self.sp = self._hold_here()
-        elif change == "lost" and self.phase is Phase.LANDING:
+        elif change is Change.LOST and self.phase is Phase.LANDING:
             self._note("warn", "Joystick lost: the vehicle keeps landing; joyfly quits once it has disarmed.")
-        elif change == "lost" and self.phase is not Phase.GROUNDED:  # landed: _grounded says it
+        elif change is Change.LOST and self.phase is not Phase.GROUNDED:  # landed: _grounded says it
             self._note("warn", "Joystick lost.")
-        elif change == "back":
+        elif change is Change.BACK:
             self._note("info", "Joystick back: you have control again.")
         if self._joy.expired(now) and self.phase is Phase.FLYING:
             self._note("warn", f"Joystick still lost after {self.s.joy_timeout_s:g} s: landing.")
