@@ -85,6 +85,7 @@ def q_from_dcm_columns(bx: Vec3, by: Vec3, bz: Vec3) -> Vec4:
 
 
 def q_from_yaw(yaw_rad: float) -> Vec4:
+    """A level attitude with the given heading."""
     return math.cos(yaw_rad / 2.0), 0.0, 0.0, math.sin(yaw_rad / 2.0)
 
 
@@ -101,11 +102,11 @@ def euler_from_q(q: Vec4) -> Vec3:
     w, x, y, z = q
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    return roll, pitch, yaw
+    return roll, pitch, yaw_from_q(q)
 
 
 def yaw_from_q(q: Vec4) -> float:
+    """Heading in radians (the yaw of the ZYX Euler angles)."""
     w, x, y, z = q
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
@@ -116,8 +117,30 @@ def tilt_from_q(q: Vec4) -> float:
 
 
 def rotate_world_to_body(q: Vec4, v: Vec3) -> Vec3:
-    """R^T v."""
-    return q_mul(q_mul(q_inv(q), (0.0, *v)), q)[1:]  # type: ignore[return-value]
+    """R^T v: a world-frame (NED) vector in the body frame (FRD), R being the rotation matrix of q."""
+    w, x, y, z = q
+    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
+    r10, r11, r12 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)
+    r20, r21, r22 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)
+    return (r00 * v[0] + r10 * v[1] + r20 * v[2], r01 * v[0] + r11 * v[1] + r21 * v[2],
+            r02 * v[0] + r12 * v[1] + r22 * v[2])
+
+
+def add(a: Vec3, b: Vec3) -> Vec3:
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2]
+
+
+def sub(a: Vec3, b: Vec3) -> Vec3:
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
+
+
+def scale(a: Vec3, k: float) -> Vec3:
+    return a[0] * k, a[1] * k, a[2] * k
+
+
+def emult(a: Vec3, b: Vec3) -> Vec3:
+    """Element-wise product (PX4 Vector3f::emult)."""
+    return a[0] * b[0], a[1] * b[1], a[2] * b[2]
 
 
 def dot(a: Vec3, b: Vec3) -> float:
@@ -133,10 +156,24 @@ def norm(a: Vec3) -> float:
 
 
 def normalized(a: Vec3) -> Vec3:
-    n = norm(a)
+    n = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
     return (a[0] / n, a[1] / n, a[2] / n) if n > 0.0 else (0.0, 0.0, 0.0)
+
+
+def isfinite(x: float) -> bool:
+    """math.isfinite for a float. Written as arithmetic because `make speedups` (mypyc) has no primitive for
+    math.isfinite: a call would box the float into a Python object on every use. x - x is 0.0 for every finite x and
+    NaN for inf and NaN."""
+    return x - x == 0.0
 
 
 def constrain(v: float, lo: float, hi: float) -> float:
     """Like PX4's math::constrain: NaN passes through."""
     return lo if v < lo else (hi if v > hi else v)
+
+
+def constrain3(v: Vec3, lo: Vec3, hi: Vec3) -> Vec3:
+    """Element-wise constrain (PX4 matrix::constrain)."""
+    return (lo[0] if v[0] < lo[0] else (hi[0] if v[0] > hi[0] else v[0]),
+            lo[1] if v[1] < lo[1] else (hi[1] if v[1] > hi[1] else v[1]),
+            lo[2] if v[2] < lo[2] else (hi[2] if v[2] > hi[2] else v[2]))
