@@ -276,6 +276,19 @@ def test_mixer_gives_the_plain_mix_exactly_when_nothing_saturates(torque, thrust
         assert all(0.0 <= m <= 1.0 for m in motors)
 
 
+def test_mixer_unsaturates_roll_and_pitch_before_adding_yaw():
+    # ControlAllocationSequentialDesaturation::mixAirmodeDisabled: the roll/pitch/thrust mix puts the front-left
+    # motor above 1, so thrust is reduced by the excess first; the yaw added afterwards would have brought that motor
+    # back below 1 on its own, but PX4 does not look ahead.
+    roll = pitch = 0.03
+    thrust, yaw = 0.97, 0.02
+    excess = thrust + math.sqrt(2.0) * roll - 1.0  # front-left: T + 0.707 roll + 0.707 pitch
+    motors, sat_pos, sat_neg = mix((roll, pitch, yaw), thrust)
+    assert sum(motors) / 4.0 == pytest.approx(thrust - excess, abs=1e-9)
+    assert allocated_torque(motors) == pytest.approx((roll, pitch, yaw), abs=1e-9)
+    assert sat_pos == sat_neg == (False, False, False)  # every torque is delivered, only thrust gave way
+
+
 def test_attitude_control_gives_finite_limited_rates_for_any_attitude_pair():
     att = AttitudeControl()
     limits = att.settings.rate_max_rad_s
