@@ -29,6 +29,7 @@ from sitl_emu.types import Vec3, Vec4
 GRAVITY_M_S2: Final = 9.80665  # PX4 CONSTANTS_ONE_G
 DEFAULT_DT_S: Final = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
 MAX_RATE_RAD_S: Final = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
+# not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183)
 _RATE_MAX: Vec3 = (MAX_RATE_RAD_S, MAX_RATE_RAD_S, MAX_RATE_RAD_S)
 _RATE_MIN: Vec3 = (-MAX_RATE_RAD_S, -MAX_RATE_RAD_S, -MAX_RATE_RAD_S)
 

@@ -20,10 +20,11 @@ from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3, Vec4
 
 _K: Final = 1.0 / math.sqrt(2.0)
-ROLL: Final = (-_K, _K, _K, -_K)
-PITCH: Final = (_K, -_K, _K, -_K)
-YAW: Final = (1.0, 1.0, -1.0, -1.0)
-THRUST: Final = (1.0, 1.0, 1.0, 1.0)
+# The effectiveness columns. Not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183).
+ROLL: Vec4 = (-_K, _K, _K, -_K)
+PITCH: Vec4 = (_K, -_K, _K, -_K)
+YAW: Vec4 = (1.0, 1.0, -1.0, -1.0)
+THRUST: Vec4 = (1.0, 1.0, 1.0, 1.0)
 YAW_HEADROOM: Final = 1.15  # mixYaw: some yaw authority above full thrust
 SATURATION_TOLERANCE: Final = 1e-4
 Flags3 = tuple[bool, bool, bool]
