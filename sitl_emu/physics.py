@@ -145,13 +145,13 @@ def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:
 
 def _attitude_step(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:
     """q <- q (x) exp(omega dt / 2), with the rates at the start of the step, normalised."""
-    p, q_, r = rates
-    n = sqrt(p * p + q_ * q_ + r * r)
+    w_x, w_y, w_z = rates
+    n = sqrt(w_x * w_x + w_y * w_y + w_z * w_z)  # |omega|
     if n < 1e-12:
         return q
     half = 0.5 * n * dt_s
     k = sin(half) / n
-    qw, qx, qy, qz = q_mul(q, (cos(half), rates[0] * k, rates[1] * k, rates[2] * k))
+    qw, qx, qy, qz = q_mul(q, (cos(half), w_x * k, w_y * k, w_z * k))
     inv = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
     return qw * inv, qx * inv, qy * inv, qz * inv
 
