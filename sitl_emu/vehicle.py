@@ -26,6 +26,7 @@ from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
+from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
 from sitl_emu.px4 import AUTO_MODES, LandedState, MavState, NavState, Severity
@@ -86,7 +87,7 @@ class Vehicle:
         self._state = RigidBodyState()
         self._estimate = self._state
         self._sih_version = -1
-        self._sih = SihConfig.from_params(self.params)
+        self._sih = sih_config(self.params)
         self.commander = Commander(self.params, self._emit, self._ned_of)
         self.parts = Parts(self.params)
         self._setpoint_type = "none"
@@ -149,7 +150,7 @@ class Vehicle:
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:
-            self._sih, self._sih_version = SihConfig.from_params(self.params), self.params.version
+            self._sih, self._sih_version = sih_config(self.params), self.params.version
         return self._sih
 
     def _estimate_from(self, truth: RigidBodyState) -> RigidBodyState:
