@@ -42,9 +42,9 @@ class SocketWatch:
     `ready(timeout_s)` returns {node index: READ_API | READ_GCS bits} for the nodes with data, waiting up to
     `timeout_s` for the first datagram (0: just look). Level-triggered: a link that a read budget left with data is
     reported again next time. The selector is the OS's best (selectors.DefaultSelector: epoll on Linux, kqueue on
-    macOS and the BSDs). epoll and poll time out in whole milliseconds, rounded up, so with those short waits (high
-    --speed) go through select() (µs resolution), on the selector's own descriptor where it has one (epoll: one fd
-    however many sockets), else on the sockets; a datagram wakes the runner at once either way.
+    macOS and the BSDs). epoll and poll time out in whole milliseconds, rounded up; with them a short wait (high
+    --speed) goes through select() (µs resolution) instead, on the selector's own descriptor where it has one (epoll:
+    one fd however many sockets), else on the sockets. A datagram wakes the runner at once either way.
     """
 
     def __init__(self, nodes: Sequence[Any]) -> None:
