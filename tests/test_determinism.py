@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from sitl_emu.px4 import NavState, custom_mode, decode_custom_mode
+from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
@@ -28,16 +28,16 @@ def _script(v: Vehicle) -> list[tuple]:
                             s.motors, s.thrust_setpoint))
 
     run(2.5)
-    v.handle_command(VehicleCommand(400, (1.0, 0.0) + (NAN,) * 5))
-    v.handle_command(VehicleCommand(22, (NAN,) * 7))
+    v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0) + (NAN,) * 5))
+    v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (NAN,) * 7))
     run(12.0)
     sp = TrajectorySetpoint(position_ned_m=(0.0, 0.0, -2.5))
     run(0.5, sp)
     main, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
-    v.handle_command(VehicleCommand(176, (1.0, main, sub) + (NAN,) * 4))
+    v.handle_command(VehicleCommand(MavCmd.DO_SET_MODE, (1.0, main, sub) + (NAN,) * 4))
     run(6.0, TrajectorySetpoint(position_ned_m=(5.0, 3.0, -4.0), yaw_rad=1.0))
     run(3.0)  # stream lost -> Return
-    v.handle_command(VehicleCommand(21, (NAN,) * 7))
+    v.handle_command(VehicleCommand(MavCmd.NAV_LAND, (NAN,) * 7))
     run(10.0)
     out.extend((e.seq, e.time_us, e.text) for e in v.events_after(0))
     return out

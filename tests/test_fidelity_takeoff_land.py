@@ -13,14 +13,14 @@ from dataclasses import dataclass
 import pytest
 
 from sitl_emu.control.metrics import step_metrics
-from sitl_emu.px4 import LandedState, NavState
+from sitl_emu.px4 import LandedState, MavCmd, NavState
 from sitl_emu.types import VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
 NAN7 = (math.nan,) * 7
-ARM = VehicleCommand(400, (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-TAKEOFF = VehicleCommand(22, NAN7)
-LAND = VehicleCommand(21, NAN7)
+ARM = VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+TAKEOFF = VehicleCommand(MavCmd.NAV_TAKEOFF, NAN7)
+LAND = VehicleCommand(MavCmd.NAV_LAND, NAN7)
 
 PX4_TAKEOFF = {"liftoff_delay_s": 4.305, "peak_climb_rate_ms": 0.902, "t_mode_hold_s": 7.07, "t10_s": 4.577,
                "rise_time_s": 3.792, "settling_time_s": 10.737, "final_alt_m": 2.471}

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import pytest
 
-from sitl_emu.px4 import LandedState, MavResult, MavState, NavState, custom_mode, decode_custom_mode
+from sitl_emu.px4 import LandedState, MavCmd, MavResult, MavState, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import NAN3, OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
 from sitl_emu.vehicle import Vehicle
 
@@ -33,7 +33,7 @@ class Flight:
 
     def set_mode(self, nav: NavState) -> int | None:
         main, sub = decode_custom_mode(custom_mode(nav))
-        return self.cmd(176, 1 | 128, main, sub)
+        return self.cmd(MavCmd.DO_SET_MODE, 1 | 128, main, sub)
 
     def run(self, seconds: float, until: Callable[[VehicleSnapshot], bool] | None = None, every: int = 25) -> None:
         end = self.v.time_us + int(seconds * S)
@@ -62,8 +62,8 @@ class Flight:
 
     def takeoff(self) -> None:
         self.run(2.5)
-        assert self.cmd(400, 1.0) == MavResult.ACCEPTED
-        assert self.cmd(22) == MavResult.ACCEPTED
+        assert self.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.ACCEPTED
+        assert self.cmd(MavCmd.NAV_TAKEOFF) == MavResult.ACCEPTED
         self.run(14.0)
 
     def hover_in_offboard(self) -> None:
@@ -95,10 +95,10 @@ def test_boot_hold_uninit_then_ready() -> None:
 def test_arming_refused_before_ready_and_in_return() -> None:
     f = Flight()
     f.run(1.0)
-    assert f.cmd(400, 1.0) == MavResult.TEMPORARILY_REJECTED
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.TEMPORARILY_REJECTED
     f.run(1.5)
-    assert f.cmd(20) == MavResult.ACCEPTED  # disarmed: any mode accepted
-    assert f.cmd(400, 1.0) == MavResult.TEMPORARILY_REJECTED
+    assert f.cmd(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED  # disarmed: any mode accepted
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.TEMPORARILY_REJECTED
     assert "Arming denied: Resolve system health failures first" in f.texts()
 
 
@@ -123,7 +123,7 @@ def test_land_then_disarm_two_seconds_later() -> None:
     f = Flight()
     f.takeoff()
     f.log.clear()
-    assert f.cmd(21) == MavResult.ACCEPTED
+    assert f.cmd(MavCmd.NAV_LAND) == MavResult.ACCEPTED
     f.run(15.0, until=lambda s: not s.armed)
     s = f.snap
     assert not s.armed and s.nav_state == NavState.AUTO_LOITER
@@ -138,7 +138,7 @@ def test_land_then_disarm_two_seconds_later() -> None:
 def test_preflight_auto_disarm_after_11_s() -> None:
     f = Flight()
     f.run(2.5)
-    f.cmd(400, 1.0)
+    f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     f.run(10.9)
     assert f.snap.armed
     f.run(0.2)
@@ -148,9 +148,9 @@ def test_preflight_auto_disarm_after_11_s() -> None:
 def test_disarm_refused_in_air_unless_forced() -> None:
     f = Flight()
     f.takeoff()
-    assert f.cmd(400, 0.0) == MavResult.TEMPORARILY_REJECTED
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 0.0) == MavResult.TEMPORARILY_REJECTED
     assert "Disarming denied: not landed" in f.texts()
-    assert f.cmd(400, 0.0, 21196) == MavResult.ACCEPTED and not f.snap.armed
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 0.0, 21196) == MavResult.ACCEPTED and not f.snap.armed
 
 
 def test_offboard_position_step_10_m() -> None:
@@ -211,7 +211,7 @@ def test_offboard_takeoff_from_ground() -> None:
     f.stream = (POS, TrajectorySetpoint(position_ned_m=(0.0, 0.0, -3.0)))
     f.run(0.3)
     assert f.set_mode(NavState.OFFBOARD) == MavResult.ACCEPTED
-    assert f.cmd(400, 1.0) == MavResult.ACCEPTED
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.ACCEPTED
     f.run(12.0)
     s = f.snap
     assert _alt(s) == pytest.approx(3.0, abs=0.15) and s.landed_state == LandedState.IN_AIR
@@ -221,7 +221,7 @@ def test_offboard_arming_needs_the_stream() -> None:
     f = Flight()
     f.run(2.5)
     assert f.set_mode(NavState.OFFBOARD) == MavResult.ACCEPTED
-    assert f.cmd(400, 1.0) == MavResult.TEMPORARILY_REJECTED
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.TEMPORARILY_REJECTED
 
 
 def test_return_lands_at_home_and_disarms() -> None:
@@ -231,7 +231,7 @@ def test_return_lands_at_home_and_disarms() -> None:
     f.stream = (POS, TrajectorySetpoint(position_ned_m=(15.0, 10.0, z)))
     f.run(8.0)
     f.stream = None
-    assert f.cmd(20) == MavResult.ACCEPTED and "Returning to launch" in f.texts()
+    assert f.cmd(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED and "Returning to launch" in f.texts()
     f.log.clear()
     f.run(90.0, until=lambda s: not s.armed)
     s = f.snap
@@ -243,7 +243,7 @@ def test_return_lands_at_home_and_disarms() -> None:
 def test_reboot_command_resets_at_next_step() -> None:
     f = Flight()
     f.run(3.0)
-    assert f.cmd(246, 1.0) == MavResult.ACCEPTED
+    assert f.cmd(MavCmd.PREFLIGHT_REBOOT_SHUTDOWN, 1.0) == MavResult.ACCEPTED
     assert f.v.time_us == 3 * S
     f.v.step()
     assert f.v.time_us == 0 and f.snap.nav_state == NavState.AUTO_LOITER and not f.snap.pre_flight_checks_pass
@@ -270,10 +270,10 @@ def test_snapshot_local_setpoint_and_geo() -> None:
 def test_takeoff_command_before_arming_keeps_its_altitude() -> None:
     f = Flight()
     f.run(2.5)
-    assert f.cmd(22, NAN, NAN, NAN, NAN, NAN, NAN, 488.0 + 4.0) == MavResult.ACCEPTED  # param7 AMSL
+    assert f.cmd(MavCmd.NAV_TAKEOFF, NAN, NAN, NAN, NAN, NAN, NAN, 488.0 + 4.0) == MavResult.ACCEPTED  # param7 AMSL
     f.run(1.0)
     assert f.snap.nav_state == NavState.AUTO_TAKEOFF and not f.snap.armed
-    assert f.cmd(400, 1.0) == MavResult.ACCEPTED  # like pxh> commander takeoff: takeoff, then arm
+    assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.ACCEPTED  # as pxh> commander takeoff: takeoff, then arm
     f.run(20.0)
     assert _alt(f.snap) == pytest.approx(4.0, abs=0.1) and f.snap.nav_state == NavState.AUTO_LOITER
     assert "Using default takeoff altitude: 2.5 m" not in f.texts()
@@ -282,9 +282,9 @@ def test_takeoff_command_before_arming_keeps_its_altitude() -> None:
 def test_default_takeoff_text_once_at_arming() -> None:
     f = Flight()
     f.run(2.5)
-    f.cmd(22)
+    f.cmd(MavCmd.NAV_TAKEOFF)
     f.run(1.0)
-    f.cmd(400, 1.0)
+    f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0)
     f.run(3.0)
     assert f.texts().count("Using default takeoff altitude: 2.5 m") == 1
     assert f.event_time_s("Using default takeoff altitude: 2.5 m") >= f.event_time_s("Armed by external command")
@@ -296,7 +296,7 @@ def test_reposition_flies_to_the_point_in_hold() -> None:
     f = Flight()
     f.takeoff()
     lat, lon, alt = ned_to_global(f.v.ref, (8.0, -6.0, -5.0))
-    assert f.cmd(192, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
+    assert f.cmd(MavCmd.DO_REPOSITION, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
     f.run(15.0)
     s = f.snap
     assert s.nav_state == NavState.AUTO_LOITER
@@ -311,19 +311,19 @@ def test_reposition_without_yaw_faces_the_target() -> None:
     f = Flight()
     f.takeoff()
     lat, lon, alt = ned_to_global(f.v.ref, (40.0, 30.0, -2.5))
-    assert f.cmd(192, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
+    assert f.cmd(MavCmd.DO_REPOSITION, -1.0, 1.0, NAN, NAN, lat, lon, alt) == MavResult.ACCEPTED
     f.run(25.0)
     assert math.degrees(f.snap.euler_rad[2]) == pytest.approx(math.degrees(math.atan2(30.0, 40.0)), abs=3.0)
 
 def test_change_altitude_in_hold() -> None:
     f = Flight()
     f.takeoff()
-    assert f.cmd(186, 488.0 + 6.0, 0.0) == MavResult.ACCEPTED  # MAV_FRAME_GLOBAL: AMSL
+    assert f.cmd(MavCmd.DO_CHANGE_ALTITUDE, 488.0 + 6.0, 0.0) == MavResult.ACCEPTED  # MAV_FRAME_GLOBAL: AMSL
     f.run(10.0)
     s = f.snap
     assert _alt(s) == pytest.approx(6.0, abs=0.15) and math.hypot(s.pos_ned_m[0], s.pos_ned_m[1]) < 0.3
     f.set_mode(NavState.AUTO_RTL)
-    assert f.cmd(186, 490.0, 0.0) == MavResult.DENIED  # only in Hold
+    assert f.cmd(MavCmd.DO_CHANGE_ALTITUDE, 490.0, 0.0) == MavResult.DENIED  # only in Hold
 
 
 def test_events_after_returns_the_newer_events_of_the_kept_history() -> None:
