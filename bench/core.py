@@ -10,7 +10,7 @@ import math
 import time
 from collections.abc import Callable
 
-from sitl_emu.px4 import NavState, custom_mode, decode_custom_mode
+from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
@@ -39,20 +39,20 @@ def manoeuvre(v: Vehicle, after_step: Callable[[], None] | None = None) -> None:
                 after_step()
 
     run(2.5)
-    _command(v, 400, 1.0)
-    _command(v, 22)
+    _command(v, MavCmd.COMPONENT_ARM_DISARM, 1.0)
+    _command(v, MavCmd.NAV_TAKEOFF)
     run(12.0)
     z = v.snapshot().pos_ned_m[2]
     stream[0] = TrajectorySetpoint(position_ned_m=(0.0, 0.0, z))
     run(0.5)
     main_mode, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
-    _command(v, 176, 1 | 128, main_mode, sub)
+    _command(v, MavCmd.DO_SET_MODE, 1 | 128, main_mode, sub)
     stream[0] = TrajectorySetpoint(position_ned_m=(10.0, 0.0, z))
     run(8.0)
     main_mode, sub = decode_custom_mode(custom_mode(NavState.AUTO_LOITER))
-    _command(v, 176, 1 | 128, main_mode, sub)
+    _command(v, MavCmd.DO_SET_MODE, 1 | 128, main_mode, sub)
     stream[0] = None
-    _command(v, 21)
+    _command(v, MavCmd.NAV_LAND)
     run(13.0)
 
 

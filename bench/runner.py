@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sitl_emu.mavlink.telemetry import BUILDERS
+from sitl_emu.px4 import MavCmd
 from sitl_emu.runner import RealTimeRunner
 from sitl_emu.server import LinkSettings, VehicleNode
 from sitl_emu.swarm import SwarmRunner
@@ -47,8 +48,8 @@ def hover_snapshot() -> tuple[VehicleSnapshot, Any]:
     v = Vehicle()
     v.run_until(2_100_000)
     nan = math.nan
-    v.handle_command(VehicleCommand(400, (1.0,) + (nan,) * 6))
-    v.handle_command(VehicleCommand(22, (nan,) * 7))
+    v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0,) + (nan,) * 6))
+    v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (nan,) * 7))
     v.run_until(10_100_000)
     return v.snapshot(), v.params
 

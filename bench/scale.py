@@ -64,6 +64,7 @@ def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int
 def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
     from sitl_emu.api import Sim
     from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
+    from sitl_emu.px4 import MavCmd
     from sitl_emu.swarm import SwarmRunner
     from sitl_emu.types import VehicleCommand
 
@@ -74,8 +75,8 @@ def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
         # Boot, arm and take off without I/O (nobody listens yet; it halves the set-up): streams start with the runner
         for v in sim.vehicles:
             v.run_until(2_100_000)  # the simulated estimator warm-up
-            v.handle_command(VehicleCommand(400, (1.0,) + (nan,) * 6))
-            v.handle_command(VehicleCommand(22, (nan,) * 7))
+            v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0,) + (nan,) * 6))
+            v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (nan,) * 7))
             v.run_until(2_100_000 + round(TAKEOFF_S * 1e6))  # climbing; the timed part is the climb's end and hover
         runner = SwarmRunner(sim.nodes, speed=1.0)
         runner.min_wake_s = wake_period_s(DEFAULT_BATCH_MS, 1.0)  # as `sitl-emu serve --count N` runs them

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from sitl_emu.api import ScaledWallClock, Sim
 from sitl_emu.api_client import FlightClient, FlightResult, fly_square
+from sitl_emu.px4 import MavCmd
 
 REPO = Path(__file__).resolve().parent.parent
 TICKS_S = os.sysconf("SC_CLK_TCK")
@@ -93,7 +94,7 @@ def hover_cpu_share(seconds: float, extra: tuple[str, ...] = ()) -> float:
     try:
         c = server.client
         c.wait(lambda: c.healthy, 20.0, "health all good")
-        if c.command(400, 1) != 0 or c.command(22) != 0:
+        if c.command(MavCmd.COMPONENT_ARM_DISARM, 1) != 0 or c.command(MavCmd.NAV_TAKEOFF) != 0:
             raise RuntimeError("the vehicle refused to arm or take off")
         c.wait(lambda: c.seen.pos_ned_m is not None and c.seen.pos_ned_m[2] < -2.3, 30.0, "takeoff")
         c.spin(2.0)

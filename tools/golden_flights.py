@@ -20,7 +20,7 @@ from pathlib import Path
 
 from sitl_emu.control.harness import ClosedLoop, hover_loop
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
-from sitl_emu.px4 import NavState, custom_mode, decode_custom_mode
+from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 
@@ -52,7 +52,7 @@ def _command(v: Vehicle, command: int, *params: float) -> None:
 
 def _offboard(v: Vehicle) -> None:
     main_mode, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
-    _command(v, 176, 1 | 128, main_mode, sub)
+    _command(v, MavCmd.DO_SET_MODE, 1 | 128, main_mode, sub)
 
 
 def _runner(v: Vehicle, h: Hasher) -> Callable[..., None]:
@@ -72,8 +72,8 @@ def _runner(v: Vehicle, h: Hasher) -> Callable[..., None]:
 
 def _takeoff(v: Vehicle, run: Callable[..., None]) -> None:
     run(2.5)
-    _command(v, 400, 1.0)
-    _command(v, 22)
+    _command(v, MavCmd.COMPONENT_ARM_DISARM, 1.0)
+    _command(v, MavCmd.NAV_TAKEOFF)
     run(10.0)
 
 
@@ -91,7 +91,7 @@ def flight_offboard_position(noise: bool) -> str:
     v.params.set("MPC_TILTMAX_AIR", 30.0)
     run(6.0, pos, TrajectorySetpoint(position_ned_m=(-5.0, 5.0, -3.0), yaw_rad=-2.5))
     run(3.0)  # stream lost -> failsafe
-    _command(v, 21)
+    _command(v, MavCmd.NAV_LAND)
     run(12.0)
     return h.hexdigest()
 
@@ -120,7 +120,7 @@ def flight_offboard_kinds() -> str:
     run(0.8, rates, att=AttitudeSetpoint(body_rates_rad_s=(0.3, -0.2, 1.0), thrust_body=(0.0, 0.0, -0.6)))
     run(1.0, att, att=AttitudeSetpoint(q_wxyz=(0.0, 0.0, 0.0, 1.0), thrust_body=(0.0, 0.0, -0.9)))
     run(4.0, OffboardControlMode(position=True), TrajectorySetpoint(position_ned_m=(0.0, 0.0, -4.0)))
-    _command(v, 21)
+    _command(v, MavCmd.NAV_LAND)
     run(15.0)
     return h.hexdigest()
 
