@@ -22,7 +22,7 @@ from sitl_emu.types import VehicleSnapshot
 log = logging.getLogger(__name__)
 
 IO_BUDGET_DATAGRAMS = 200  # per link per step_io: a flood waits in the socket buffer instead of starving physics
-# `readable` bits of step_io: which links have datagrams waiting (runners learn it from one epoll per tick)
+# `readable` bits of step_io: which links have datagrams waiting (runners learn it from one SocketWatch look per tick)
 READ_API = 1
 READ_GCS = 2
 READ_BOTH = READ_API | READ_GCS

@@ -71,7 +71,7 @@ class SwarmRunner(RealTimeRunner):
 
     Tick k of every vehicle runs before tick k+1 of any, so the vehicles stay within one tick of each other however
     far the runner has to catch up, and after each tick every node does its I/O (streams keep their rates). One
-    epoll look per tick over all sockets says which nodes have data; only their links are read. Reads
+    look per tick over all sockets (SocketWatch) says which nodes have data; only their links are read. Reads
     per node are capped at `io_budget` datagrams per link per tick, so a flood costs that node a bounded time and
     the other vehicles' physics are not held back. A vehicle that reboots (its time restarts at 0) keeps its place
     on the shared timeline, so neither it nor the others race or stall.
