@@ -23,12 +23,13 @@ from collections import deque
 import numpy as np
 
 from sitl_emu.flight.commander import Commander
+from sitl_emu.flight.commands import handle_command
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
-from sitl_emu.px4 import AUTO_MODES, LandedState, MavState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
@@ -46,7 +47,6 @@ from sitl_emu.vehicle_parts import Parts, yaw_of
 EVENT_HISTORY = 1000
 COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
 _TERMINATION = NavState.TERMINATION  # a module constant: enum member lookups cost on the per-tick path
-_STATUS_VALUES = {status: float(status) for status in MavState}  # snapshot extras["system_status"]
 
 
 class Vehicle:
@@ -87,12 +87,11 @@ class Vehicle:
         self._estimate = self._state
         self._sih_version = -1
         self._sih = SihConfig.from_params(self.params)
-        self.commander = Commander(self.params, self._emit, self._ned_of)
+        self.commander = Commander(self.params, self._emit, self._ned_of, self._here)
         self.parts = Parts(self.params)
         self._setpoint_type = "none"
         self._task_finished = False
         self._commander_last_us = -COMMANDER_PERIOD_US
-        self._here_fn = self._here  # bound once: handed to the commander every cycle
         self._nav_fn = self._nav_input
 
     # ---- time ---------------------------------------------------------------------------------------------------
@@ -116,7 +115,7 @@ class Vehicle:
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now
-            c.observe_state(now, now >= self._ready_delay_us, self._here_fn, self._task_finished)
+            c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             c.update(now)
         parts = self.parts
         out = parts.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
@@ -165,7 +164,7 @@ class Vehicle:
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
         self._snap = None
-        return self.commander.handle_command(cmd, self._time_us)
+        return handle_command(self.commander, cmd, self._time_us)
 
     def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
                        attitude: AttitudeSetpoint | None = None) -> None:
@@ -241,14 +240,13 @@ class Vehicle:
         if q is not self._euler_of:
             self._euler_of, self._euler = q, _euler(q)
         ctrl = self.parts.control
-        pre_flight_ok, offboard, status = c.telemetry_status()
         ref = self.ref
         return _new_snapshot((  # the fields in _SNAPSHOT_FIELDS order
             self._time_us, c.armed, c.nav_state, c.intention.user_intended, c.failsafe, self.landed_state(),
-            pre_flight_ok, c.estimator_ready, c.have_taken_off, offboard, pos, s.vel_ned_m_s,
+            c.pre_flight_checks_pass(), c.estimator_ready, c.have_taken_off, c.offboard_mode, pos, s.vel_ned_m_s,
             s.acc_ned_m_s2, q, s.rates_frd_rad_s, self._euler, lat, lon, alt, ref.lat_deg, ref.lon_deg,
             ref.alt_amsl_m, c.home, ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s,
-            ctrl.thrust_setpoint, self._state.motors, {"system_status": _STATUS_VALUES[status]},
+            ctrl.thrust_setpoint, self._state.motors, {"system_status": float(c.system_status())},
         ))
 
 

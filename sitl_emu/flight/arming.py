@@ -77,23 +77,16 @@ class CheckInputs:
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
-        return available_bits(self.estimator_ready, self.home_valid, self.offboard_signal, self.manual_control,
-                              self.mission_valid)
-
-
-def available_bits(estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
-                   mission_valid: bool = False) -> int:
-    """The requirement bits satisfied by these inputs (CheckInputs.available, without building a CheckInputs)."""
-    have = (Req.ATTITUDE | Req.POSITION) if estimator_ready else 0
-    if home_valid:
-        have |= Req.HOME
-    if mission_valid:
-        have |= Req.MISSION
-    if offboard_signal:
-        have |= Req.OFFBOARD
-    if manual_control:
-        have |= Req.MANUAL
-    return have
+        have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else Req.NONE
+        if self.home_valid:
+            have |= Req.HOME
+        if self.mission_valid:
+            have |= Req.MISSION
+        if self.offboard_signal:
+            have |= Req.OFFBOARD
+        if self.manual_control:
+            have |= Req.MANUAL
+        return have
 
 
 def requirements(nav_state: NavState) -> int:
@@ -133,23 +126,3 @@ def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> 
 
 def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
     return arming_failure(nav_state, c, armed) is None
-
-
-def can_run_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool) -> bool:
-    """can_run(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal)), without the allocation (the
-    commander asks every cycle)."""
-    return not (requirements(nav_state) & ~(available_bits(estimator_ready, home_valid, offboard_signal)
-                                            | Req.PREVENT_ARMING))
-
-
-_CAN_ARM_MEMO: dict[tuple[NavState, bool, bool, bool, bool], bool] = {}
-
-
-def can_arm_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool,
-                armed: bool) -> bool:
-    """can_arm(nav_state, CheckInputs(...), armed), memoised (a pure function of a few booleans and the mode)."""
-    key = (nav_state, estimator_ready, home_valid, offboard_signal, armed)
-    ok = _CAN_ARM_MEMO.get(key)
-    if ok is None:
-        ok = _CAN_ARM_MEMO[key] = can_arm(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal), armed)
-    return ok

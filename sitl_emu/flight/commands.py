@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from sitl_emu.flight.commander import Commander, NavCommand
+from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
 from sitl_emu.px4 import (
     MODE_FLAG_AUTO_ENABLED,
     MODE_FLAG_CUSTOM_MODE_ENABLED,
@@ -58,6 +58,7 @@ def _ack(cmd: VehicleCommand, result: MavResult) -> CommandAck:
 
 
 def handle_command(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck | None:
+    """The commander acts on `cmd` now; the ACK to send, or None where PX4 sends none."""
     handler = _HANDLERS.get(cmd.command)
     if handler is None:
         return _ack(cmd, MavResult.UNSUPPORTED)  # Commander.cpp default: -> UNSUPPORTED
@@ -131,7 +132,7 @@ def _takeoff(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     ack = _switch(c, cmd, now_us, NavState.AUTO_TAKEOFF, None)
     if ack.result == MavResult.ACCEPTED:
         # navigator: param7 = target altitude AMSL (NaN -> MIS_TAKEOFF_ALT above here), param5/6 lat/lon; yaw ignored
-        c.nav_commands.append(NavCommand("takeoff", cmd.param(5), cmd.param(6), cmd.param(7)))
+        c.nav_commands.append(NavCommand(NavCommandKind.TAKEOFF, cmd.param(5), cmd.param(6), cmd.param(7)))
     return ack
 
 
@@ -152,8 +153,8 @@ def _reposition(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     ack = _switch(c, cmd, now_us, NavState.AUTO_LOITER, None)
     if ack.result == MavResult.ACCEPTED and c.armed:
         # navigator_main.cpp: lat p5, lon p6, alt p7 AMSL (NaN -> current), yaw p4 rad, ground speed p1
-        c.nav_commands.append(NavCommand("reposition", cmd.param(5), cmd.param(6), cmd.param(7), cmd.param(4),
-                                         cmd.param(1)))
+        c.nav_commands.append(NavCommand(NavCommandKind.REPOSITION, cmd.param(5), cmd.param(6), cmd.param(7),
+                                         cmd.param(4), cmd.param(1)))
     return ack
 
 
@@ -164,7 +165,7 @@ def _change_altitude(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandA
     if _uint8(cmd.param(2)) == 3 and c.home is not None:  # MAV_FRAME_GLOBAL_RELATIVE_ALT: above home
         alt += c.home.alt_amsl_m
     if c.armed:
-        c.nav_commands.append(NavCommand("change_altitude", alt_amsl_m=alt))
+        c.nav_commands.append(NavCommand(NavCommandKind.CHANGE_ALTITUDE, alt_amsl_m=alt))
     return _ack(cmd, MavResult.ACCEPTED)
 
 

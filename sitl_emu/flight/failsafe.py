@@ -14,17 +14,10 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from enum import Enum
 
+from sitl_emu.flight.arming import CheckInputs, can_run
 from sitl_emu.px4 import NavState
-
-
-class Action(Enum):
-    NONE = "none"
-    MODE = "mode"
-    DISARM = "disarm"
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,11 +61,11 @@ def _initial_fallback(user: NavState, s: FallbackSettings) -> NavState | None:
     return NavState.AUTO_LAND
 
 
-def resolve_fallback(user: NavState, s: FallbackSettings, can_run: Callable[[NavState], bool]) -> NavState | None:
+def resolve_fallback(user: NavState, s: FallbackSettings, inputs: CheckInputs) -> NavState | None:
     """Walk the fallback chain until a mode can run; None means disarm (DESCEND needs only an attitude)."""
     mode = _initial_fallback(user, s)
     for _ in range(8):  # every chain ends in DESCEND, TERMINATION or disarm within a few steps
-        if mode is None or mode in (NavState.TERMINATION, NavState.DESCEND) or can_run(mode):
+        if mode is None or mode in (NavState.TERMINATION, NavState.DESCEND) or can_run(mode, inputs):
             return mode
         if mode in _MANUAL_CHAIN:
             idx = _MANUAL_CHAIN.index(mode)
@@ -96,17 +89,18 @@ class Failsafe:
     def reset(self) -> None:
         self.active = False
 
-    def update(self, *, armed: bool, user: NavState, can_run: Callable[[NavState], bool], settings: FallbackSettings,
+    def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False) -> Decision:
+        """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.active = False
             return Decision(user, False)
         if terminated:
             return self._enter(NavState.TERMINATION)
-        if can_run(user):
+        if can_run(user, inputs):
             self.active = False
             return Decision(user, False)
-        fallback = resolve_fallback(user, settings, can_run)
+        fallback = resolve_fallback(user, settings, inputs)
         if fallback is None:
             decision = self._enter(user)
             return Decision(user, True, disarm=True, activated=decision.activated)

@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from sitl_emu.flight import tasks
-from sitl_emu.flight.commander import NavCommand
+from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
@@ -122,9 +122,9 @@ class ModeExecutor:
         navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
         the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
         for cmd in commands:
-            if cmd.kind == "takeoff":
+            if cmd.kind is NavCommandKind.TAKEOFF:
                 self._pending_takeoff = cmd
-        command = commands[-1] if commands and commands[-1].kind != "takeoff" else None
+        command = commands[-1] if commands and commands[-1].kind is not NavCommandKind.TAKEOFF else None
         commands.clear()
         if nav_state not in _TASK_MODES or not armed:
             self.task, self._task_mode, self._held = None, None, None
@@ -153,18 +153,19 @@ class ModeExecutor:
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None
-        if command is not None and command.kind == "takeoff" and math.isfinite(command.alt_amsl_m):
+        if command is not None and command.kind is NavCommandKind.TAKEOFF and math.isfinite(command.alt_amsl_m):
             alt_up = command.alt_amsl_m - ref.alt_amsl_m  # param7 is AMSL; the local origin is at ref altitude
         return tasks.make_takeoff(nav, self.params, alt_up)
 
     def _make_loiter(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
                      takeoff_target: Vec3 | None) -> tasks.Task:
-        if command is not None and command.kind in ("reposition", "change_altitude") and nav.armed:
+        moves = (NavCommandKind.REPOSITION, NavCommandKind.CHANGE_ALTITUDE)
+        if command is not None and command.kind in moves and nav.armed:
             target = _command_target(command, nav, ref)
             speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
             # DO_REPOSITION with yaw NaN: PX4 passes NaN on and the vehicle faces the target (MPC_YAW_MODE 0,
             # navigator_main.cpp); a change of altitude keeps the current heading.
-            keep = nav.yaw_rad if command.kind == "change_altitude" else math.nan
+            keep = nav.yaw_rad if command.kind is NavCommandKind.CHANGE_ALTITUDE else math.nan
             yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else keep
             return tasks.make_reposition(nav, self.params, target, yaw, speed)
         if takeoff_target is not None:
