@@ -65,9 +65,9 @@ _REASONS: tuple[tuple[int, str], ...] = (
 )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class CheckInputs:
-    """What the checks look at, at one instant."""
+    """What the checks look at, at one instant (made every commander cycle, so not frozen: treat it as read-only)."""
 
     estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
     home_valid: bool

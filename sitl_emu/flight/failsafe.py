@@ -20,8 +20,10 @@ from sitl_emu.flight.arming import CheckInputs, can_run
 from sitl_emu.px4 import NavState
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Decision:
+    """The mode in force and what to do (made every commander cycle, so not frozen: treat it as read-only)."""
+
     nav_state: NavState
     failsafe: bool
     disarm: bool = False

@@ -10,19 +10,18 @@ from __future__ import annotations
 import math
 
 from sitl_emu.flight.smoothing import braking_distance
-from sitl_emu.flight.tasks_core import AutoSettings, NavInput, Task, Waypoint
+from sitl_emu.flight.tasks_core import AutoSettings, NavInput, SetpointType, Task, Waypoint
 from sitl_emu.flight.tasks_rtl import RtlTask
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3
 
-__all__ = ["NavInput", "Task", "make_land", "make_loiter", "make_reposition", "make_rtl", "make_takeoff"]
+__all__ = ["NavInput", "SetpointType", "Task", "make_land", "make_loiter", "make_reposition", "make_rtl",
+           "make_takeoff"]
 
 
 class TakeoffTask(Task):
     """AUTO.TAKEOFF (navigator takeoff.cpp): climb straight up to the target, then loiter there."""
-
-    kind = "takeoff"
 
     def __init__(self, nav: NavInput, params: ParamRegistry, target_alt_up_m: float | None) -> None:
         super().__init__(nav, params)
@@ -38,9 +37,9 @@ class TakeoffTask(Task):
         self._alt_acceptance_m = min(self._settings.nav_mc_alt_rad, 0.5 * (target_alt_up_m - current_up))
         self._finished = False
         # the three waypoints this task can give (frozen, so built once)
-        self._wp_climb = Waypoint("takeoff", self._target)
-        self._wp_idle = Waypoint("idle", self._target)
-        self._wp_hold = Waypoint("position", self._target)
+        self._wp_climb = Waypoint(SetpointType.TAKEOFF, self._target)
+        self._wp_idle = Waypoint(SetpointType.IDLE, self._target)
+        self._wp_hold = Waypoint(SetpointType.POSITION, self._target)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -62,8 +61,6 @@ class TakeoffTask(Task):
 class LoiterTask(Task):
     """AUTO.LOITER (Hold, loiter.cpp): idle on the ground, else hold the braking point (or the given point)."""
 
-    kind = "loiter"
-
     def __init__(self, nav: NavInput, params: ParamRegistry, hold_at: Vec3 | None, yaw_rad: float | None) -> None:
         super().__init__(nav, params)
         self._yaw = yaw_rad if yaw_rad is not None and math.isfinite(yaw_rad) else nav.yaw_rad
@@ -74,7 +71,10 @@ class LoiterTask(Task):
         else:
             self._target = braking_point(nav, self._settings)
             self._idle = nav.landed or not nav.armed
-        self._wp = Waypoint("idle", self._target) if self._idle else Waypoint("position", self._target, self._yaw)
+        if self._idle:
+            self._wp = Waypoint(SetpointType.IDLE, self._target)
+        else:
+            self._wp = Waypoint(SetpointType.POSITION, self._target, self._yaw)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -87,12 +87,10 @@ class LoiterTask(Task):
 class LandTask(Task):
     """AUTO.LAND (land.cpp): descend at the braking stop point with PX4's land speed profile."""
 
-    kind = "land"
-
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         super().__init__(nav, params)
         self._target = braking_point(nav, self._settings)
-        self._wp = Waypoint("land", self._target)
+        self._wp = Waypoint(SetpointType.LAND, self._target)
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
         return self._wp
@@ -101,15 +99,13 @@ class LandTask(Task):
 class RepositionTask(Task):
     """DO_REPOSITION in Hold (navigator_main.cpp reposition triplet): fly to the point at the given speed."""
 
-    kind = "reposition"
-
     def __init__(self, nav: NavInput, params: ParamRegistry, target_ned_m: Vec3, yaw_rad: float,
                  speed_m_s: float) -> None:
         super().__init__(nav, params)
         self._target = _fill_nan(target_ned_m, nav.pos_ned_m)
         self._yaw = yaw_rad
         self._speed = speed_m_s if math.isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
-        self._wp = Waypoint("position", self._target, self._yaw, self._speed)
+        self._wp = Waypoint(SetpointType.POSITION, self._target, self._yaw, self._speed)
 
     @property
     def target_ned_m(self) -> Vec3:
