@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 from collections import deque
+from typing import Final
 
 import numpy as np
 
@@ -42,8 +43,9 @@ from sitl_emu.types import (
 )
 from sitl_emu.vehicle_parts import ControlChain
 
-EVENT_HISTORY = 1000
-COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
+EVENT_HISTORY: Final = 1000
+# PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
+COMMANDER_PERIOD_US: Final = 8000
 
 
 class Vehicle:
@@ -106,7 +108,7 @@ class Vehicle:
         chain = self.chain
         out = chain.executor.update(c.nav_state, c.armed, now, self._nav_input, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
-        motors_armed = c.armed and c.nav_state != NavState.TERMINATION
+        motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
         motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
         self._estimate = self._estimate_from(self._state)

@@ -8,6 +8,7 @@ the navigator task at the position controller's rate (ModeExecutor), attitude/ra
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.qmath import norm, yaw_from_q
@@ -15,12 +16,13 @@ from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.land_detector import LandDetector, LandDetectorInput, LandDetectorState
 from sitl_emu.flight.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.flight.tasks_core import IDLE_ACC_Z_M_S2, NavInput
+from sitl_emu.floats import isfinite
 from sitl_emu.geo import GeoRef
 from sitl_emu.params import ParamRegistry
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.types import TrajectorySetpoint, Vec4
 
-LAND_DETECTOR_PERIOD_US = 20_000
+LAND_DETECTOR_PERIOD_US: Final = 20_000
 
 
 class ControlChain:
@@ -80,6 +82,6 @@ def descent_vz(sp: TrajectorySetpoint | None) -> float:
     if sp is None:
         return math.nan
     acc_z = sp.acceleration_ned_m_s2[2]
-    if math.isfinite(acc_z) and acc_z >= IDLE_ACC_Z_M_S2:
+    if isfinite(acc_z) and acc_z >= IDLE_ACC_Z_M_S2:
         return 1e3
     return sp.velocity_ned_m_s[2]

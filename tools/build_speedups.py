@@ -58,6 +58,7 @@ DEFAULT_MODULES = (
     "sitl_emu/vehicle.py",
     "sitl_emu/vehicle_parts.py",
     "sitl_emu/geo.py",
+    "sitl_emu/floats.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]

@@ -67,13 +67,24 @@ _REASONS: tuple[tuple[int, str], ...] = (
 
 @dataclass(slots=True)
 class CheckInputs:
-    """What the checks look at, at one instant (made every commander cycle, so not frozen: treat it as read-only)."""
+    """What the checks look at, at one instant.
+
+    Made every commander cycle, so not frozen and with its __init__ written out (the same as the generated one:
+    `make speedups` compiles only a written-out __init__, as for NavInput). Treat it as read-only."""
 
     estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
     home_valid: bool
     offboard_signal: bool  # an offboard_control_mode with a setpoint kind, younger than COM_OF_LOSS_T
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # sitl_emu has no mission storage
+
+    def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
+                 mission_valid: bool = False) -> None:
+        self.estimator_ready = estimator_ready
+        self.home_valid = home_valid
+        self.offboard_signal = offboard_signal
+        self.manual_control = manual_control
+        self.mission_valid = mission_valid
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""

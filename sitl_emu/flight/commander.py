@@ -9,7 +9,6 @@ UserModeIntention.cpp, failsafe/failsafe.cpp. See ../shared/reference/px4-behavi
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import Enum
@@ -17,6 +16,7 @@ from enum import Enum
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.mode_intention import ModeIntention
+from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
 from sitl_emu.types import NAN, HomePosition, OffboardControlMode, Vec3
@@ -153,7 +153,7 @@ class Commander:
 
     def system_status(self) -> MavState:
         """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
-        if self.nav_state == NavState.TERMINATION and self.armed:
+        if self.nav_state is NavState.TERMINATION and self.armed:
             return MavState.FLIGHT_TERMINATION
         if self.armed:
             return MavState.CRITICAL if self.failsafe else MavState.ACTIVE
@@ -215,7 +215,7 @@ class Commander:
     def change_mode(self, nav_state: NavState, *, force: bool = False) -> bool:
         """UserModeIntention::change; on success the mode in force follows at once when it can run."""
         ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
-                                   in_termination=self.nav_state == NavState.TERMINATION)
+                                   in_termination=self.nav_state is NavState.TERMINATION)
         if ok:
             self._apply_mode(self.now_us)
         return ok
@@ -226,7 +226,7 @@ class Commander:
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
                                          inputs=self.check_inputs(now_us), settings=self.settings.fallback,
                                          terminated=self.terminated)
-        if not (self.armed and self.nav_state == NavState.TERMINATION):
+        if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
         if decision.activated:
@@ -269,7 +269,7 @@ class Commander:
 
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
-        if self.armed and not self.landed and self.nav_state == NavState.AUTO_TAKEOFF and self._task_finished:
+        if self.armed and not self.landed and self.nav_state is NavState.AUTO_TAKEOFF and self._task_finished:
             self.change_mode(NavState.AUTO_LOITER)
 
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:
@@ -290,7 +290,7 @@ class Commander:
         if not self.estimator_ready or self._ned_of is None:
             return False
         pos = self._ned_of(lat_deg, lon_deg, alt_amsl_m)
-        yaw = yaw_rad if math.isfinite(yaw_rad) else (self.home.yaw_rad if self.home else 0.0)
+        yaw = yaw_rad if isfinite(yaw_rad) else (self.home.yaw_rad if self.home else 0.0)
         self.home = HomePosition(lat_deg, lon_deg, alt_amsl_m, pos, yaw)
         return True
 

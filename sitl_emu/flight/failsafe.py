@@ -22,12 +22,19 @@ from sitl_emu.px4 import NavState
 
 @dataclass(slots=True)
 class Decision:
-    """The mode in force and what to do (made every commander cycle, so not frozen: treat it as read-only)."""
+    """The mode in force and what to do (made every commander cycle, so not frozen and with its __init__ written
+    out, as arming.CheckInputs). Treat it as read-only."""
 
     nav_state: NavState
     failsafe: bool
     disarm: bool = False
     activated: bool = False  # the failsafe started at this update: say "Failsafe activated"
+
+    def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False) -> None:
+        self.nav_state = nav_state
+        self.failsafe = failsafe
+        self.disarm = disarm
+        self.activated = activated
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
@@ -52,7 +59,7 @@ class FallbackSettings:
 
 def _initial_fallback(user: NavState, s: FallbackSettings) -> NavState | None:
     """The first fallback for a user mode that cannot run; None means disarm."""
-    if user == NavState.OFFBOARD:
+    if user is NavState.OFFBOARD:
         return _OBL_ACTIONS.get(s.obl_rc_act, NavState.POSCTL)
     if user in (NavState.POSITION_SLOW, NavState.POSCTL):
         return NavState.ALTCTL

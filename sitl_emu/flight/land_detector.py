@@ -15,19 +15,22 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
+from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 
-FREEFALL_ACC_M_S2 = 2.0  # MulticopterLandDetector::_get_freefall_state
-FREEFALL_TRIGGER_US = 300_000  # LandDetector.h FREEFALL_TRIGGER_TIME_US
-DESCENT_FACTOR = 1.1  # in descent: velocity setpoint z >= 1.1 * LNDMC_Z_VEL_MAX
-WIDEN_FACTOR = 2.5  # thresholds widen once maybe landed
+FREEFALL_ACC_M_S2: Final = 2.0  # MulticopterLandDetector::_get_freefall_state
+FREEFALL_TRIGGER_US: Final = 300_000  # LandDetector.h FREEFALL_TRIGGER_TIME_US
+DESCENT_FACTOR: Final = 1.1  # in descent: velocity setpoint z >= 1.1 * LNDMC_Z_VEL_MAX
+WIDEN_FACTOR: Final = 2.5  # thresholds widen once maybe landed
 
 
 @dataclass(slots=True)
 class LandDetectorInput:
-    """One detector cycle's input (made every cycle, so not frozen, as LandDetectorState: treat both as read-only)."""
+    """One detector cycle's input. Made every cycle, so not frozen and with its __init__ written out (as
+    LandDetectorState and arming.CheckInputs): treat both as read-only."""
 
     time_us: int
     armed: bool
@@ -39,6 +42,19 @@ class LandDetectorInput:
     setpoint_vz_m_s: float  # vertical velocity setpoint (NaN if none)
     in_descent_mode: bool  # climb rate controlled (PX4 flag_control_climb_rate_enabled), e.g. land/idle/position
 
+    def __init__(self, time_us: int, armed: bool, vel_ned_m_s: Vec3, rates_frd_rad_s: Vec3,
+                 specific_force_norm_m_s2: float, thrust_setpoint: float, hover_thrust: float, setpoint_vz_m_s: float,
+                 in_descent_mode: bool) -> None:
+        self.time_us = time_us
+        self.armed = armed
+        self.vel_ned_m_s = vel_ned_m_s
+        self.rates_frd_rad_s = rates_frd_rad_s
+        self.specific_force_norm_m_s2 = specific_force_norm_m_s2
+        self.thrust_setpoint = thrust_setpoint
+        self.hover_thrust = hover_thrust
+        self.setpoint_vz_m_s = setpoint_vz_m_s
+        self.in_descent_mode = in_descent_mode
+
 
 @dataclass(slots=True)
 class LandDetectorState:
@@ -46,6 +62,12 @@ class LandDetectorState:
     maybe_landed: bool
     ground_contact: bool
     freefall: bool
+
+    def __init__(self, landed: bool, maybe_landed: bool, ground_contact: bool, freefall: bool) -> None:
+        self.landed = landed
+        self.maybe_landed = maybe_landed
+        self.ground_contact = ground_contact
+        self.freefall = freefall
 
 
 class Hysteresis:
@@ -152,7 +174,7 @@ class LandDetector:
         contact = inp.thrust_setpoint <= s.thr_min + (inp.hover_thrust - s.thr_min) * share
         if inp.in_descent_mode and not self._maybe_landed.state and not self._landed.state:
             vz_sp = inp.setpoint_vz_m_s
-            contact = contact and math.isfinite(vz_sp) and vz_sp >= DESCENT_FACTOR * s.z_vel_max
+            contact = contact and isfinite(vz_sp) and vz_sp >= DESCENT_FACTOR * s.z_vel_max
         return contact and not horizontal_movement and not vertical_movement
 
     def _maybe_landed_now(self, inp: LandDetectorInput) -> bool:

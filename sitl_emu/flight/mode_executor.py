@@ -15,17 +15,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.flight import tasks
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.tasks import SetpointType
+from sitl_emu.floats import isfinite
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
 # flight_mode_manager runs the task on each estimator update; sitl_emu runs it with the position controller (125 Hz)
-TASK_PERIOD_US = 8000
+TASK_PERIOD_US: Final = 8000
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
                          NavState.AUTO_RTL})
 
@@ -83,7 +85,7 @@ class ModeExecutor:
                commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
-        if nav_state == NavState.OFFBOARD:
+        if nav_state is NavState.OFFBOARD:
             if self._offboard_out is None:
                 self._offboard_out = self._offboard_output()
             return self._offboard_out
@@ -122,14 +124,14 @@ class ModeExecutor:
 
         navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
         the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
-        command = self._take_commands(commands)
+        command = self._take_commands(commands) if commands else None
         if nav_state not in _TASK_MODES or not armed:
             self.task, self._task_mode, self._held = None, None, None
-            if nav_state != NavState.AUTO_TAKEOFF:
+            if nav_state is not NavState.AUTO_TAKEOFF:
                 self._pending_takeoff = None
             return False
-        new_takeoff = nav_state == NavState.AUTO_TAKEOFF and self._pending_takeoff is not None
-        if nav_state == self._task_mode and command is None and not new_takeoff:
+        new_takeoff = nav_state is NavState.AUTO_TAKEOFF and self._pending_takeoff is not None
+        if nav_state is self._task_mode and command is None and not new_takeoff:
             return False  # the running task still fits
         self._start_task(nav_state, nav_fn(), command, ref)
         return True
@@ -148,22 +150,22 @@ class ModeExecutor:
 
     def _start_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
         takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
-        if self._task_mode == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
+        if self._task_mode is NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
         self._task_mode = nav_state
-        if nav_state == NavState.AUTO_TAKEOFF:
+        if nav_state is NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, self._pending_takeoff, ref)
             self._pending_takeoff = None
-        elif nav_state == NavState.AUTO_LOITER:
+        elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
-        elif nav_state == NavState.AUTO_RTL:
+        elif nav_state is NavState.AUTO_RTL:
             self.task = tasks.make_rtl(nav, self.params)
         else:
             self.task = tasks.make_land(nav, self.params)
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None
-        if command is not None and command.kind is NavCommandKind.TAKEOFF and math.isfinite(command.alt_amsl_m):
+        if command is not None and command.kind is NavCommandKind.TAKEOFF and isfinite(command.alt_amsl_m):
             alt_up = command.alt_amsl_m - ref.alt_amsl_m  # param7 is AMSL; the local origin is at ref altitude
         return tasks.make_takeoff(nav, self.params, alt_up)
 
@@ -172,11 +174,11 @@ class ModeExecutor:
         moves = (NavCommandKind.REPOSITION, NavCommandKind.CHANGE_ALTITUDE)
         if command is not None and command.kind in moves and nav.armed:
             target = _command_target(command, nav, ref)
-            speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
+            speed = command.speed_m_s if isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
             # DO_REPOSITION with yaw NaN: PX4 passes NaN on and the vehicle faces the target (MPC_YAW_MODE 0,
             # navigator_main.cpp); a change of altitude keeps the current heading.
             keep = nav.yaw_rad if command.kind is NavCommandKind.CHANGE_ALTITUDE else math.nan
-            yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else keep
+            yaw = command.yaw_rad if isfinite(command.yaw_rad) else keep
             return tasks.make_reposition(nav, self.params, target, yaw, speed)
         if takeoff_target is not None:
             return tasks.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
@@ -186,8 +188,8 @@ class ModeExecutor:
 def _command_target(command: NavCommand, nav: tasks.NavInput, ref: GeoRef) -> Vec3:
     """The reposition target in NED; NaN lat/lon/alt keep the current position's component."""
     x, y, z = nav.pos_ned_m
-    if math.isfinite(command.lat_deg) and math.isfinite(command.lon_deg):
+    if isfinite(command.lat_deg) and isfinite(command.lon_deg):
         x, y, _ = global_to_ned(ref, command.lat_deg, command.lon_deg, ref.alt_amsl_m)
-    if math.isfinite(command.alt_amsl_m):
+    if isfinite(command.alt_amsl_m):
         z = ref.alt_amsl_m - command.alt_amsl_m
     return x, y, z

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Final
 
+from sitl_emu.floats import isfinite
 from sitl_emu.types import Vec3
 
-_EPS = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
+_EPS: Final = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
 
 
 def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_speed: float) -> float:
@@ -179,10 +181,13 @@ class AxisSmoother:
 def synchronize(axes: Sequence[AxisSmoother]) -> None:
     """Make every axis finish its velocity change together with the slowest one (VelocitySmoothing::timeSync)."""
     totals = [axis.total_time for axis in axes]  # each read before its own axis changes
-    desired = max(totals)  # the first of the longest
+    longest = 0
+    for i, total in enumerate(totals):
+        if total > totals[longest]:
+            longest = i
+    desired = totals[longest]
     if desired <= _EPS:
         return
-    longest = totals.index(desired)
     for i, axis in enumerate(axes):
         if i != longest and totals[i] < desired:
             axis.update_durations_given_total_time(desired)
@@ -215,24 +220,24 @@ class PositionSmoother:
         """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis).
         The axes hold the new setpoint; returns the unsmoothed velocity target."""
         vel_sp = self._velocity_target(target, feedforward_vel)
-        if math.isfinite(vel_sp[0]) and math.isfinite(vel_sp[1]) and math.isfinite(vel_sp[2]):
+        if isfinite(vel_sp[0]) and isfinite(vel_sp[1]) and isfinite(vel_sp[2]):
             self._advance(vehicle_pos, vel_sp, dt_s)
         return vel_sp
 
     def _velocity_target(self, target: Vec3, ff: Vec3) -> Vec3:
         out0, out1, out2 = ff
         ax, ay, az = self.axes
-        if math.isfinite(target[0]) and math.isfinite(target[1]):
+        if isfinite(target[0]) and isfinite(target[1]):
             dx, dy = target[0] - ax.x, target[1] - ay.x
             dist = math.hypot(dx, dy)
             speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
-            out0 = ux * speed + (ff[0] if math.isfinite(ff[0]) else 0.0)
-            out1 = uy * speed + (ff[1] if math.isfinite(ff[1]) else 0.0)
-        if math.isfinite(target[2]):
+            out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
+            out1 = uy * speed + (ff[1] if isfinite(ff[1]) else 0.0)
+        if isfinite(target[2]):
             dz = target[2] - az.x
             speed = min(az.max_vel, max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0))
-            out2 = _sign(dz) * speed + (ff[2] if math.isfinite(ff[2]) else 0.0)
+            out2 = _sign(dz) * speed + (ff[2] if isfinite(ff[2]) else 0.0)
         return (out0, out1, out2)
 
     def _advance(self, vehicle_pos: Vec3, vel_sp: Vec3, dt_s: float) -> None:

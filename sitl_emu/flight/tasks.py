@@ -12,6 +12,7 @@ import math
 from sitl_emu.flight.smoothing import braking_distance
 from sitl_emu.flight.tasks_core import AutoSettings, NavInput, SetpointType, Task, Waypoint
 from sitl_emu.flight.tasks_rtl import RtlTask
+from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3
@@ -26,7 +27,7 @@ class TakeoffTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry, target_alt_up_m: float | None) -> None:
         super().__init__(nav, params)
         current_up = -nav.pos_ned_m[2]
-        if target_alt_up_m is None or not math.isfinite(target_alt_up_m):
+        if target_alt_up_m is None or not isfinite(target_alt_up_m):
             target_alt_up_m = current_up + self._settings.takeoff_alt
             self._say(Severity.INFO, f"Using default takeoff altitude: {self._settings.takeoff_alt:.1f} m")
         if target_alt_up_m < current_up:
@@ -63,7 +64,7 @@ class LoiterTask(Task):
 
     def __init__(self, nav: NavInput, params: ParamRegistry, hold_at: Vec3 | None, yaw_rad: float | None) -> None:
         super().__init__(nav, params)
-        self._yaw = yaw_rad if yaw_rad is not None and math.isfinite(yaw_rad) else nav.yaw_rad
+        self._yaw = yaw_rad if yaw_rad is not None and isfinite(yaw_rad) else nav.yaw_rad
         if hold_at is not None:
             self._target = _fill_nan(hold_at, nav.pos_ned_m)
             near = abs(self._target[2] - nav.pos_ned_m[2]) <= self._settings.nav_mc_alt_rad
@@ -104,7 +105,7 @@ class RepositionTask(Task):
         super().__init__(nav, params)
         self._target = _fill_nan(target_ned_m, nav.pos_ned_m)
         self._yaw = yaw_rad
-        self._speed = speed_m_s if math.isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
+        self._speed = speed_m_s if isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
         self._wp = Waypoint(SetpointType.POSITION, self._target, self._yaw, self._speed)
 
     @property
@@ -127,9 +128,9 @@ def braking_point(nav: NavInput, settings: AutoSettings) -> Vec3:
 
 def _fill_nan(target: Vec3, fallback: Vec3) -> Vec3:
     return (
-        target[0] if math.isfinite(target[0]) else fallback[0],
-        target[1] if math.isfinite(target[1]) else fallback[1],
-        target[2] if math.isfinite(target[2]) else fallback[2],
+        target[0] if isfinite(target[0]) else fallback[0],
+        target[1] if isfinite(target[1]) else fallback[1],
+        target[2] if isfinite(target[2]) else fallback[2],
     )
 
 

@@ -14,20 +14,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import Enum
-from typing import Any
+from typing import Any, Final
 
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.smoothing import PositionSmoother
+from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
 
-WANT_TAKEOFF_VZ_M_S = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
-REACTIVATE_VZ_M_S = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
-IDLE_ACC_Z_M_S2 = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
+WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
+REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
+IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
 _NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
-_TWO_PI = 2.0 * math.pi
+_TWO_PI: Final = 2.0 * math.pi
 
 
 class SetpointType(Enum):
@@ -203,7 +204,7 @@ class AutoCore:
     def _set_constraints(self, nav: NavInput, wp: Waypoint) -> None:
         """FlightTaskAuto::_updateTrajConstraints."""
         s, sm = self.s, self.smoother
-        cruise = wp.cruise_m_s if math.isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
+        cruise = wp.cruise_m_s if isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
         vel_max = s.xy_vel_max
         sm.cruise_speed_m_s = min(cruise, vel_max)
         sm.max_xy_error_m = s.xy_err_max
@@ -237,15 +238,15 @@ class AutoCore:
 
     def _yaw_target(self, nav: NavInput, wp: Waypoint) -> float:
         if wp.kind is SetpointType.LAND:
-            if self._kind_prev is not SetpointType.LAND or not math.isfinite(self._land_heading):
-                self._land_heading = wp.yaw_rad if math.isfinite(wp.yaw_rad) else self._yaw_sp_prev
+            if self._kind_prev is not SetpointType.LAND or not isfinite(self._land_heading):
+                self._land_heading = wp.yaw_rad if isfinite(wp.yaw_rad) else self._yaw_sp_prev
             return self._land_heading
-        if math.isfinite(wp.yaw_rad):
+        if isfinite(wp.yaw_rad):
             return wp.yaw_rad
         # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
         dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
         dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
-        if self.s.yaw_mode in (0, 4) and math.isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
+        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
             self._yaw_lock = math.atan2(dy, dx)
         if self._yaw_lock is None:
             self._yaw_lock = nav.yaw_rad
@@ -253,7 +254,7 @@ class AutoCore:
 
     def _limit_yaw_rate(self, nav: NavInput, yaw_sp: float, dt_s: float) -> tuple[float, float]:
         """FlightTaskAuto::_limitYawRate: rate-limit the heading and feed its filtered rate forward."""
-        prev = self._yaw_sp_prev if math.isfinite(self._yaw_sp_prev) else nav.yaw_rad
+        prev = self._yaw_sp_prev if isfinite(self._yaw_sp_prev) else nav.yaw_rad
         max_rate = self.s.yawrate_max_rad_s
         max_step = max_rate * dt_s
         dyaw = min(max(wrap_pi(yaw_sp - prev), -max_step), max_step)
