@@ -27,7 +27,7 @@ Emit = Callable[[Severity, str, str, bool, bool], None]
 NedOf = Callable[[float, float, float], Vec3]
 # the current position as a home candidate, None while the estimator is not ready (called only when home is set:
 # at arming, when first ready, on DO_SET_HOME)
-Here = Callable[[], "HomePosition | None"]
+Here = Callable[[], HomePosition | None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -269,7 +269,7 @@ class Commander:
 
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
-        if self.armed and not self.landed and self.nav_state is NavState.AUTO_TAKEOFF and self._task_finished:
+        if self.armed and not self.landed and self._task_finished and self.nav_state is NavState.AUTO_TAKEOFF:
             self.change_mode(NavState.AUTO_LOITER)
 
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:

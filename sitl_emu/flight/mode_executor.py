@@ -130,23 +130,21 @@ class ModeExecutor:
             if nav_state is not NavState.AUTO_TAKEOFF:
                 self._pending_takeoff = None
             return False
-        new_takeoff = nav_state is NavState.AUTO_TAKEOFF and self._pending_takeoff is not None
+        new_takeoff = self._pending_takeoff is not None and nav_state is NavState.AUTO_TAKEOFF
         if nav_state is self._task_mode and command is None and not new_takeoff:
             return False  # the running task still fits
         self._start_task(nav_state, nav_fn(), command, ref)
         return True
 
     def _take_commands(self, commands: list[NavCommand]) -> NavCommand | None:
-        """Empty the commander's queue: a NAV_TAKEOFF waits for the takeoff to start; the last other command (a
-        reposition or altitude change) is returned."""
-        command = None
+        """Empty the commander's (non-empty) queue: a NAV_TAKEOFF waits for the takeoff to start; the last command is
+        returned unless it is a NAV_TAKEOFF (a reposition or altitude change restarts Hold)."""
         for cmd in commands:
             if cmd.kind is NavCommandKind.TAKEOFF:
                 self._pending_takeoff = cmd
-        if commands and commands[-1].kind is not NavCommandKind.TAKEOFF:
-            command = commands[-1]
+        last = commands[-1]
         commands.clear()
-        return command
+        return None if last.kind is NavCommandKind.TAKEOFF else last
 
     def _start_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
         takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
