@@ -168,3 +168,14 @@ def test_the_inline_finiteness_test_is_exactly_isfinite(x):
     import math
 
     assert (x - x == 0.0) is math.isfinite(x)
+
+
+@pytest.mark.parametrize("x", [0.0, -0.0, 1.5, -2.5e-300, 5e-324, 1.7976931348623157e308, -1.7976931348623157e308,
+                               float("inf"), float("-inf"), float("nan"), 3, -7])
+def test_the_flight_stacks_isfinite_is_exactly_math_isfinite(x):
+    # flight/* tests finiteness with sitl_emu.floats.isfinite (math.isinf/isnan: C tests when compiled)
+    import math
+
+    from sitl_emu.floats import isfinite
+
+    assert isfinite(x) is math.isfinite(x)
