@@ -179,7 +179,8 @@ class AxisSmoother:
 
 
 def synchronize(axes: Sequence[AxisSmoother]) -> None:
-    """Make every axis finish its velocity change together with the slowest one (VelocitySmoothing::timeSync)."""
+    """Make every axis finish its velocity change together with the slowest one
+    (VelocitySmoothing::timeSynchronization)."""
     totals = [axis.total_time for axis in axes]  # each read before its own axis changes
     longest = 0
     for i, total in enumerate(totals):
