@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 from typing import Final
 
+from sitl_emu.control.qmath import constrain
 from sitl_emu.floats import isfinite
 from sitl_emu.types import Vec3
 
@@ -37,9 +38,8 @@ def _sign(x: float) -> int:
 
 
 def _evaluate_poly(j: float, a0: float, v0: float, x0: float, t: float) -> tuple[float, float, float, float]:
-    """(jerk, acceleration, velocity, position) after max(t, 0) seconds of constant jerk j
-    (VelocitySmoothing::evaluatePoly)."""
-    t = max(t, 0.0)
+    """(jerk, acceleration, velocity, position) after t seconds of constant jerk j (VelocitySmoothing::evaluatePoly;
+    update_traj never passes a negative t)."""
     return j, a0 + j * t, v0 + a0 * t + 0.5 * j * t * t, x0 + v0 * t + 0.5 * a0 * t * t + j * t * t * t / 6.0
 
 
@@ -71,7 +71,7 @@ class AxisSmoother:
 
     def update_durations(self, vel_setpoint: float) -> None:
         """Plan the fastest jerk-limited profile from the current state to `vel_setpoint` (clamped to max_vel)."""
-        vel_sp = self._vel_sp = min(max(vel_setpoint, -self.max_vel), self.max_vel)
+        vel_sp = self._vel_sp = constrain(vel_setpoint, -self.max_vel, self.max_vel)
         self._time = 0.0
         a, v = self.a, self.v
         self._a0, self._v0, self._x0 = a, v, self.x
@@ -115,8 +115,9 @@ class AxisSmoother:
         self._t2 = max(total_s - t1 - t3, 0.0)
 
     def update_traj(self, dt_s: float, time_stretch: float = 1.0) -> None:
-        """Advance along the planned profile by `dt_s` scaled by `time_stretch` (0..1) (VelocitySmoothing::updateTraj):
-        T1 at +jerk, T2 at constant acceleration, T3 at -jerk, then constant velocity."""
+        """Advance along the planned profile by `dt_s` (>= 0) scaled by `time_stretch` (0..1)
+        (VelocitySmoothing::updateTraj): T1 at +jerk, T2 at constant acceleration, T3 at -jerk, then constant
+        velocity."""
         rest = self._time = self._time + dt_s * time_stretch
         if self._t1 == 0.0 and self._t2 == 0.0 and self._t3 == 0.0:  # nothing planned: constant velocity
             if rest > 0.0:
@@ -259,7 +260,7 @@ class PositionSmoother:
         ex, ey = ax.x - vehicle_pos[0], ay.x - vehicle_pos[1]
         if self.max_xy_error_m <= _EPS or ex * ax.v + ey * ay.v < 0.0:
             return 1.0
-        return 1.0 - min(max(math.hypot(ex, ey) / self.max_xy_error_m, 0.0), 1.0)
+        return 1.0 - constrain(math.hypot(ex, ey) / self.max_xy_error_m, 0.0, 1.0)
 
     def _stretch_z(self, vehicle_pos: Vec3) -> float:
         ez = self.axes[2].x - vehicle_pos[2]

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any, Final
 
+from sitl_emu.control.qmath import constrain
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.floats import isfinite
@@ -257,13 +258,13 @@ class AutoCore:
         prev = self._yaw_sp_prev if isfinite(self._yaw_sp_prev) else nav.yaw_rad
         max_rate = self.s.yawrate_max_rad_s
         max_step = max_rate * dt_s
-        dyaw = min(max(wrap_pi(yaw_sp - prev), -max_step), max_step)
+        dyaw = constrain(wrap_pi(yaw_sp - prev), -max_step, max_step)
         yaw_sp = wrap_pi(prev + dyaw)
         if dt_s > 0.0:
             alpha = dt_s / (dt_s + 0.2)
             self._yawspeed_filt += alpha * (dyaw / dt_s - self._yawspeed_filt)
         self._yaw_sp_prev = yaw_sp
-        return yaw_sp, min(max(self._yawspeed_filt, -max_rate), max_rate)
+        return yaw_sp, constrain(self._yawspeed_filt, -max_rate, max_rate)
 
 
 class Task:
