@@ -24,12 +24,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from joyfly.clock import WallClock
 from joyfly.demo import EmbeddedVehicle
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
-from joyfly.link import VehicleLink
-from joyfly.mapping import open_sticks
-from joyfly.setpoints import Setpoint
-from joyfly.transport import UdpTransport
+from joyfly.link.transport import UdpTransport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
+from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.setpoints import Setpoint
 
 
 def main() -> None:

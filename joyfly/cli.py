@@ -7,30 +7,31 @@ status; Ctrl-C / SIGTERM perform --on-exit and exit 0; a second Ctrl-C quits at 
 from __future__ import annotations
 
 import logging
-import signal
 import sys
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Callable
 from typing import Any
 
 import click
 
 from joyfly.cli_joystick import joystick
+from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
-from joyfly.config import ConfigError, FlyOptions, build_options, load_file
-from joyfly.dashboard import make_view, summary_lines
-from joyfly.flight import FlightSession, Phase
-from joyfly.flight_session import FlightStats
-from joyfly.joystick import JoystickError
-from joyfly.link import VehicleLink
-from joyfly.mapping import open_sticks
-from joyfly.transport import TransportError, open_transport
+from joyfly.config import BOUNDS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
+from joyfly.dashboard import make_view
+from joyfly.link.speedwatch import SpeedWatch
+from joyfly.link.transport import TransportError, open_transport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.run import fly_session
+from joyfly.session.core import Note
+from joyfly.session.flight_session import FlightSession
+from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.mapping import open_sticks
 
 D = FlyOptions()
 
 
-@click.group()
+@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
+@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s")
 @click.option("-v", "--verbose", count=True, help="More log output on stderr (-v info, -vv debug).")
 def main(verbose: int) -> None:
     """Fly a PX4 quadrotor (PX4 SITL or `sitl-emu serve`) with a joystick over MAVLink."""
@@ -44,38 +45,50 @@ def main(verbose: int) -> None:
 main.add_command(joystick)
 
 
-def _opt(name: str, kind: Any, help_text: str, **kw: Any) -> Callable[[Any], Any]:
-    default = getattr(D, name.lstrip("-").replace("-", "_"))
-    return click.option(name, type=kind, default=None, help=f"{help_text} [default: {default}]", **kw)
+def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, **kw: Any) -> Callable[[Any], Any]:
+    """An option whose default lives in FlyOptions (a --config file may set it too): the help shows the default and
+    the range, and the value stays None unless given, so the file's value is not overridden."""
+    key = name.lstrip("-").replace("-", "_")
+    default = getattr(D, key)
+    shown = [] if default is None else [f"default: {default}"]
+    if key in BOUNDS and show_range:
+        shown.append(f"{BOUNDS[key].lo:g} to {BOUNDS[key].hi:g}")
+    return click.option(name, type=kind, default=None, help=f"{help_text} [{'; '.join(shown)}]" if shown
+                        else help_text, **kw)
 
 
-@main.command()
-@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO or file of js_event records, script:FILE, replay:FILE.")
+@main.command(short_help="Fly a vehicle with a joystick.")
+@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
+                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
-@_opt("--control", click.Choice(["velocity", "step"]), "Sticks command a velocity, or a position step (the seed).")
+@_opt("--control", click.Choice(["velocity", "step"]), "velocity: the sticks set the vehicle's velocity and "
+      "releasing them holds position; step: the setpoint is the vehicle's position plus --step metres x stick.")
 @_opt("--step", float, "Step control: metres per full stick.")
-@_opt("--alt", float, "Take-off altitude, metres above home.")
+@_opt("--alt", float, "Take-off altitude, metres above home, from --min-alt to --max-alt.", show_range=False)
 @_opt("--max-climb", float, "Climb/descent rate at full throttle stick, m/s.")
 @_opt("--max-speed", float, "Horizontal speed at full stick, m/s.")
 @_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick, deg/s.")
-@_opt("--fence", float, "Half-width of the square fence around home, metres; 0 disables.")
+@_opt("--fence", float, "Half-width of the square fence around this flight's home (where joyfly arms the vehicle), "
+      "metres; 0 disables.")
 @_opt("--min-alt", float, "Lowest setpoint, metres above home.")
 @_opt("--max-alt", float, "Highest setpoint, metres above home.")
-@_opt("--rate", float, "Setpoint stream rate, Hz (at least 10).")
+@_opt("--rate", float, "Setpoint stream rate, Hz.")
 @_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
-@_opt("--record", str, "Record the joystick's events with timestamps to this file (replay with --joy replay:FILE).")
+@_opt("--record", str, "Record the joystick's states with timestamps to this file (replay with --joy FILE).")
 @_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
 @_opt("--connect-timeout", float, "Seconds to wait for the vehicle's first HEARTBEAT and position.")
-@_opt("--speed", float, "The emulator's speed factor (sitl-emu serve --speed N): joyfly's clock runs as fast.")
+@_opt("--speed", float, "How many times faster than real time the vehicle runs: the N of its sitl-emu serve "
+      "--speed N (1 for PX4 SITL or a real vehicle). joyfly's rates and timeouts run as fast; it warns when the "
+      "vehicle's clock says otherwise.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 def fly(config_path: str | None, **cli_options: Any) -> None:
     """Connect, take off to --alt in OFFBOARD and fly with the joystick; Ctrl-C lands (see --on-exit)."""
     try:
         file_options, profile_table = load_file(config_path) if config_path else ({}, {})
-        opts = build_options(file_options, cli_options)
+        opts = build_options(file_options, cli_options, source=config_path)
     except (ConfigError, JoystickError) as err:
-        _die(str(err), 2)
+        raise UserError(str(err)) from None
     sys.exit(run_fly(opts, profile_table))
 
 
@@ -86,61 +99,24 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
     try:
         sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
     except JoystickError as err:
-        _die(str(err), 2)
+        raise UserError(str(err)) from None
     try:
         transport = open_transport(opts.url)
     except TransportError as err:
         sticks.close()
-        _die(str(err), 2)
+        raise UserError(str(err)) from None
     view = make_view(out)
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
     session = FlightSession(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
+    watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), "warn", text)))
+    session.link.on_message.append(watch.observe)
     return fly_session(session, view, out)
 
 
-def fly_session(session: FlightSession, view: Any, out: Any) -> int:
-    """Run the session with Ctrl-C/SIGTERM handling, print the summary, close everything."""
-    try:
-        with exit_signals(session):
-            session.run(on_view=view.show)
-    except KeyboardInterrupt:
-        out.write("\njoyfly: interrupted twice, quitting at once (the vehicle keeps its last mode).\n")
-        return 130
-    finally:
-        view.close()
-        session.link.close()
-        session.sticks.close()
-    flew = session.stats != FlightStats()  # a session that never flew (no vehicle, refused) has nothing to sum up
-    if flew or session.phase is not Phase.FAILED:
-        for line in summary_lines(session.stats):
-            out.write(line + "\n")
-    if session.phase is Phase.FAILED:
-        click.echo(f"joyfly: {session.error}", err=True)
-        return 1
-    return 0
-
-
-@contextmanager
-def exit_signals(session: FlightSession) -> Iterator[None]:
-    """First SIGINT/SIGTERM: ask the session to perform --on-exit; the second: KeyboardInterrupt, at once."""
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        if session.exit_requested:
-            raise KeyboardInterrupt
-        session.request_exit()
-
-    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, old in previous.items():
-            signal.signal(sig, old)
-
-
-@main.command()
+@main.command(short_help="A whole flight with no hardware.")
 @click.option("--url", default=None, help="Fly a vehicle already listening there instead of the built-in emulator.")
-@click.option("--speed", type=click.FloatRange(min=0.1, max=20), default=1.0, show_default=True,
+@click.option("--speed", type=FiniteRange(SPEED_MIN, SPEED_MAX), default=1.0, show_default=True,
               help="Run the built-in emulator (and the script) this many times faster than real time; with --url, "
                    "the speed that vehicle runs at.")
 @click.option("--script", "script_path", default=None, help="Joystick script (default: the built-in demo flight).")
@@ -152,12 +128,7 @@ def demo(url: str | None, speed: float, script_path: str | None, live: bool | No
     try:
         sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live))
     except (DemoError, TransportError, JoystickError) as err:
-        _die(str(err), 2)
-
-
-def _die(message: str, status: int) -> Any:
-    click.echo(f"joyfly: {message}", err=True)
-    sys.exit(status)
+        raise UserError(str(err)) from None
 
 
 if __name__ == "__main__":

@@ -13,30 +13,32 @@ from typing import Any, TextIO
 
 import click
 
-from joyfly.joystick import (
+from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
+from joyfly.clock import WallClock
+from joyfly.sticks.joystick import (
     DeviceInfo,
     JoystickError,
     JsDevice,
-    MonotonicClock,
     default_device,
     list_devices,
     open_joystick,
 )
-from joyfly.mapping import StickMapper
-from joyfly.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.mapping import StickMapper
+from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
-from joyfly.virtual import TimedSource, record_to
 
 DEV_DIR = "/dev/input"
 
 
-@click.group("joystick")
+@click.group("joystick", cls=OneLineGroup, context_settings=CONTEXT,
+             short_help="List and test joysticks (no vehicle needed).")
 def joystick() -> None:
     """Find joysticks and check what they send (no vehicle needed)."""
 
 
-@joystick.command("list")
+@joystick.command("list", short_help="List the joysticks and their profiles.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True, help="Where the js* nodes live.")
 def list_cmd(dev_dir: str) -> None:
     """Every /dev/input/js* with its name, axes, buttons and the profile that matches it."""
@@ -58,7 +60,7 @@ def _device_line(item: DeviceInfo | JoystickError) -> str:
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
 
 
-@joystick.command("profiles")
+@joystick.command("profiles", short_help="The built-in controller profiles.")
 def profiles_cmd() -> None:
     """The built-in controller profiles, the device names they match, and their layout."""
     for profile in BUILTIN:
@@ -69,27 +71,32 @@ def profiles_cmd() -> None:
         click.echo(f"    axes {axes}; buttons {buttons}" + (f"; {profile.notes}" if profile.notes else ""))
 
 
-@joystick.command("test")
-@click.option("--joy", "joy", default=None, help="Device, FIFO or file path, script:FILE or replay:FILE "
-              "(default: the first /dev/input/js*).")
+@joystick.command("test", short_help="Watch a joystick's axes and buttons live.")
+@click.option("--joy", "joy", default=None, help="A /dev/input/js* device, a FIFO of js_event records, a --record "
+              "recording, raw:FILE (a file of js_event records), script:FILE or replay:FILE (default: the first "
+              "/dev/input/js*).")
 @click.option("--profile", "profile_name", default="auto", show_default=True,
               help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
 @click.option("--config", "config_path", default=None, help="TOML file whose [profile] table overrides the profile.")
-@click.option("--duration", type=float, default=None, help="Stop after this many seconds.")
-@click.option("--record", "record_path", default=None, help="Also record the session (JSON lines) for replay:FILE.")
+@click.option("--duration", type=FiniteRange(0.1, 86400), default=None, help="Stop after this many seconds.")
+@click.option("--record", "record_path", default=None, help="Also record the session to this file (JSON lines), to "
+              "replay with --joy FILE.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True)
 def test_cmd(joy: str | None, profile_name: str, config_path: str | None, duration: float | None,
              record_path: str | None, dev_dir: str) -> None:
     """Show the axes and buttons live, and the flying commands the profile makes of them."""
-    clock = MonotonicClock()
+    clock = WallClock()
     try:
         overrides: dict[str, Any] = read_config(config_path) if config_path else {}
         source = open_joystick(joy or default_device(dev_dir), clock, dev_dir=dev_dir)
-        profile = load_profile(profile_name, source.name, overrides)
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None
-    if record_path:
-        source = record_to(source, record_path)
+    try:
+        profile = load_profile(profile_name, source.name, overrides)
+        source = record_to(source, record_path) if record_path else source
+    except JoystickError as exc:
+        source.close()
+        raise click.ClickException(str(exc)) from None
     view = LiveView(sys.stdout) if sys.stdout.isatty() else PlainView(click.echo)
     try:
         watch(source, profile, clock, view, duration)

@@ -1,7 +1,7 @@
 """`joyfly fly` options: defaults, the TOML config file (`--config`), validation, and the session settings.
 
 A config file sets any option in a `[fly]` table (or at the top level), with the option's name as on the command
-line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile (joyfly/profiles.py).
+line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile (joyfly/sticks/profiles.py).
 Command-line options win over the file, the file over the defaults::
 
     [fly]
@@ -19,19 +19,24 @@ Command-line options win over the file, the file over the defaults::
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from joyfly.flight_session import SessionSettings
-from joyfly.profiles import read_config
-from joyfly.setpoints import Limits
+from joyfly.link.transport import UrlError, parse_url
+from joyfly.session.core import SessionSettings
+from joyfly.sticks.profiles import read_config
+from joyfly.sticks.setpoints import Limits
 
 DEFAULT_URL = "udp://:14540@127.0.0.1:14557"
 CONTROLS = ("velocity", "step")
 ON_EXIT = ("land", "hold", "rtl")
 MIN_RATE_HZ = 10.0  # PX4 needs a setpoint younger than COM_OF_LOSS_T = 1 s; 10 Hz leaves room for lost datagrams
+# --speed: the vehicle's simulated seconds per wall second; the same range as `sitl-emu serve --speed`
+# (sitl_emu/cli_options.py; a test keeps them equal).
+SPEED_MIN, SPEED_MAX = 0.1, 100.0
 
 
 class ConfigError(Exception):
@@ -71,6 +76,33 @@ class FlyOptions:
 OPTION_NAMES = tuple(f.name for f in fields(FlyOptions))
 
 
+@dataclass(frozen=True, slots=True)
+class Bound:
+    lo: float
+    hi: float
+    unit: str
+    why: str = ""
+
+
+# Every number a user can give, with its range (--alt also lies between --min-alt and --max-alt).
+BOUNDS: dict[str, Bound] = {
+    "step": Bound(0.1, 50.0, "m"),
+    "alt": Bound(0.0, 1000.0, "m"),
+    "max_climb": Bound(0.1, 8.0, "m/s", " (PX4's MPC_Z_VEL_MAX_UP goes up to 8 m/s)"),
+    "max_speed": Bound(0.1, 20.0, "m/s", " (PX4's MPC_XY_VEL_MAX goes up to 20 m/s)"),
+    "max_yaw_rate": Bound(0.0, 400.0, "deg/s", " (PX4's MPC_MAN_Y_MAX goes up to 400 deg/s)"),
+    "fence": Bound(0.0, 10000.0, "m", " (0 turns the fence off)"),
+    "min_alt": Bound(0.0, 1000.0, "m"),
+    "max_alt": Bound(0.1, 1000.0, "m"),
+    "rate": Bound(MIN_RATE_HZ, 200.0, "Hz", " (PX4 leaves OFFBOARD after 1 s without a setpoint; it needs no more "
+                                            "than 50 Hz)"),
+    "joy_timeout": Bound(0.1, 600.0, "s"),
+    "connect_timeout": Bound(1.0, 3600.0, "s"),
+    "speed": Bound(SPEED_MIN, SPEED_MAX, "times real time", " (the vehicle's sitl-emu serve --speed; 1 for PX4 SITL)"),
+}
+CHOICES: dict[str, tuple[str, ...]] = {"control": CONTROLS, "on_exit": ON_EXIT}
+
+
 def load_file(path: str) -> tuple[dict[str, Any], dict[str, Any]]:
     """(fly options, profile table) from a TOML config file."""
     data = read_config(path)
@@ -82,51 +114,99 @@ def load_file(path: str) -> tuple[dict[str, Any], dict[str, Any]]:
     for key, value in table.items():
         name = key.replace("-", "_")
         if name not in OPTION_NAMES:
-            raise ConfigError(f"{path}: unknown option '{key}'; known options: {', '.join(OPTION_NAMES)}.")
+            raise ConfigError(f"{path}: unknown option '{key}'; known options: "
+                              f"{', '.join(n.replace('_', '-') for n in OPTION_NAMES)}.")
         options[name] = value
     return options, dict(profile)
 
 
-def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any]) -> FlyOptions:
-    """Defaults, then the config file, then the options given on the command line; validated."""
-    opts = FlyOptions()
+class _Origins:
+    """Names an option as the user wrote it: `--alt 50` on the command line, `FILE: alt = 50` in the config file."""
+
+    def __init__(self, file_options: Mapping[str, Any], cli_options: Mapping[str, Any], source: str | None) -> None:
+        self.source = source
+        self.from_file = {k for k in file_options if cli_options.get(k) is None}
+        self.from_cli = {k for k, v in cli_options.items() if v is not None}
+
+    def says(self, name: str, value: Any) -> str:
+        key = name.replace("_", "-")
+        if name in self.from_file:
+            return f"{self.source or 'the config file'}: {key} = {_toml(value)}"
+        return ("" if name in self.from_cli else "the default ") + self.example(name, value)
+
+    def example(self, name: str, value: Any) -> str:
+        key = name.replace("_", "-")
+        if name in self.from_file:
+            return f"{key} = {_toml(value)}"
+        return f"--{key} {value:g}" if isinstance(value, float) else f"--{key} {value}"
+
+    def key(self, name: str) -> str:
+        key = name.replace("_", "-")
+        return key if name in self.from_file else f"--{key}"
+
+
+def _toml(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return f"{value:g}"
+    return json.dumps(value) if isinstance(value, str) else str(value)
+
+
+def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any],
+                  source: str | None = None) -> FlyOptions:
+    """Defaults, then the config file (`source`), then the options given on the command line; validated."""
+    origins = _Origins(file_options, cli_options, source)
     merged = {**file_options, **{k: v for k, v in cli_options.items() if v is not None}}
-    try:
-        opts = replace(opts, **{k: _coerce(k, v) for k, v in merged.items()})
-    except (TypeError, ValueError):
-        raise ConfigError(f"Bad option value in {merged}: numbers must be numbers.") from None
-    validate(opts)
+    opts = replace(FlyOptions(), **{k: _coerce(k, v, origins) for k, v in merged.items()})
+    validate(opts, origins)
     return opts
 
 
-def _coerce(name: str, value: Any) -> Any:
+def _coerce(name: str, value: Any, origins: _Origins) -> Any:
     default = getattr(FlyOptions(), name)
     if isinstance(default, float):
-        if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-            raise ConfigError(f"Option {name.replace('_', '-')} must be a number, not {value!r}.")
-        try:
-            return float(value)
-        except ValueError:
-            raise ConfigError(f"Option {name.replace('_', '-')} must be a number, not {value!r}.") from None
-    return None if value is None else str(value)
+        number = _number(value)
+        if number is None:
+            bound = BOUNDS[name]
+            raise ConfigError(f"{origins.says(name, value)} is not a number: write a number from {bound.lo:g} to "
+                              f"{bound.hi:g} {bound.unit}, for example {origins.example(name, default)}.")
+        return number
+    if value is not None and not isinstance(value, str):
+        example = origins.example(name, default if default is not None else "FILE")
+        raise ConfigError(f"{origins.says(name, value)} is not text: write it in quotes, for example {example}.")
+    return value
 
 
-def validate(o: FlyOptions) -> None:
-    checks = [
-        (o.control in CONTROLS, f"--control must be one of {', '.join(CONTROLS)}, not '{o.control}'."),
-        (o.on_exit in ON_EXIT, f"--on-exit must be one of {', '.join(ON_EXIT)}, not '{o.on_exit}'."),
-        (o.rate >= MIN_RATE_HZ, f"--rate must be at least {MIN_RATE_HZ:g} Hz (PX4 drops OFFBOARD after 1 s "
-                                f"without a setpoint), not {o.rate:g}."),
-        (o.rate <= 200, f"--rate {o.rate:g} Hz is more than PX4 needs: use 10-50 Hz."),
-        (o.fence >= 0, "--fence must be 0 (off) or a positive half-width in metres."),
-        (0 <= o.min_alt < o.max_alt, f"--min-alt ({o.min_alt:g}) must be below --max-alt ({o.max_alt:g})."),
-        (o.min_alt <= o.alt <= o.max_alt, f"--alt {o.alt:g} m must lie between --min-alt and --max-alt."),
-        (o.max_speed > 0 and o.max_climb > 0 and o.max_yaw_rate >= 0,
-         "--max-speed, --max-climb must be positive and --max-yaw-rate not negative."),
-        (o.step > 0, "--step must be positive."),
-        (0.1 <= o.speed <= 20, "--speed must be between 0.1 and 20 (the emulator's --speed)."),
-        (o.joy_timeout > 0 and o.connect_timeout > 0, "--joy-timeout and the connect timeout must be positive."),
-    ]
-    for ok, message in checks:
-        if not ok:
-            raise ConfigError(message)
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        return None
+    try:
+        number = float(value)
+    except ValueError:
+        return None
+    return number if math.isfinite(number) else None
+
+
+def validate(o: FlyOptions, origins: _Origins | None = None) -> None:
+    """Raise ConfigError naming the first bad option, its range or choices, and what to write instead."""
+    origins = origins or _Origins({}, {}, None)
+    for name, choices in CHOICES.items():
+        value = getattr(o, name)
+        if value not in choices:
+            raise ConfigError(f"{origins.says(name, value)} is not a choice here: use one of {', '.join(choices)}.")
+    for name, bound in BOUNDS.items():
+        value = getattr(o, name)
+        if not bound.lo <= value <= bound.hi:
+            raise ConfigError(f"{origins.says(name, value)} is out of range: use {bound.lo:g} to {bound.hi:g} "
+                              f"{bound.unit}{bound.why}.")
+    if o.min_alt >= o.max_alt:
+        raise ConfigError(f"{origins.says('min_alt', o.min_alt)} must be below {origins.key('max_alt')} "
+                          f"({o.max_alt:g} m): lower the one or raise the other.")
+    if not o.min_alt <= o.alt <= o.max_alt:
+        raise ConfigError(f"{origins.says('alt', o.alt)} is out of range: use {o.min_alt:g} to {o.max_alt:g} m "
+                          f"(from {origins.key('min_alt')} to {origins.key('max_alt')}), or move those bounds.")
+    try:
+        parse_url(o.url)
+    except UrlError as err:
+        raise ConfigError(f"{origins.says('url', o.url)}: {err.detail}.") from None

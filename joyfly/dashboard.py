@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import TextIO
 
-from joyfly.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.session.core import FlightStats, Note, Phase, SessionView
 from joyfly.term import LiveBlock
 from joyfly.types import StickCommand
 
@@ -42,17 +42,17 @@ def stick_line(cmd: StickCommand) -> str:
 
 
 def _link_word(view: SessionView) -> str:
-    return "ok" if view.link_ok else ("waiting" if view.phase is Phase.CONNECTING else "LOST")
+    return "ok" if view.link_ok else ("waiting" if view.phase is Phase.CONNECTING or not view.heard else "LOST")
 
 
 def render(view: SessionView) -> list[str]:
     """The live block for one view snapshot."""
-    link = _link_word(view).upper() if view.link_ok or view.phase is not Phase.CONNECTING else "waiting"
+    link = "waiting" if _link_word(view) == "waiting" else _link_word(view).upper()
     pos = view.pos_ned_m
     margin = view.fence.margin_m(pos) if pos is not None else math.inf
     sp = view.setpoint
     stream = "streaming" if view.streaming else "not streaming"
-    joy = "ok" if view.joystick_ok else "LOST (holding)"
+    joy = "ok" if view.joystick_ok else "LOST (holding)" if view.phase is Phase.FLYING else "LOST"
     lines = [
         f"t {view.time_s:7.1f} s  {view.phase.value:<28} link {link:<4} ({view.link_description})",
         f"mode {view.mode:<14} {'ARMED' if view.armed else 'disarmed':<9} {_LANDED.get(view.landed_state, '?'):<10}"
@@ -101,9 +101,12 @@ class LiveDashboard:
         self._next_s = view.time_s + LIVE_PERIOD_S
         self._block.draw(render(view))
 
-    def close(self) -> None:
-        if self._last is not None:
+    def close(self, keep: bool = True) -> None:
+        """Leave the last view on the terminal, or (keep False: there was nothing to show) take it away."""
+        if self._last is not None and keep:
             self._block.draw(render(self._last))
+        else:
+            self._block.erase()
         self.out.flush()
 
 
@@ -137,7 +140,7 @@ class PlainLog:
                        f"; fence margin {fmt_margin(margin)}\n")
         self.out.flush()
 
-    def close(self) -> None:
+    def close(self, keep: bool = True) -> None:
         self.out.flush()
 
 

@@ -11,21 +11,20 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from pathlib import Path
 from typing import Any, TextIO
 
 from joyfly.clock import ScaledClock
 from joyfly.config import FlyOptions
 from joyfly.dashboard import make_view
-from joyfly.flight import FlightSession
-from joyfly.link import VehicleLink
-from joyfly.mapping import MappedSource
-from joyfly.profiles import load_profile
-from joyfly.transport import UdpTransport, open_transport
-from joyfly.virtual import ScriptSource
+from joyfly.link.transport import UdpTransport, open_transport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession
+from joyfly.sticks.mapping import MappedSource
+from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.virtual import ScriptSource
 
 # The demo flight (joyfly takes off by itself at the start; the sticks then fly a square and push the fence).
-# Format: joyfly/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.
+# Format: joyfly/sticks/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.
 DEMO_SCRIPT = """\
 8      forward=0.5               # north, 2.5 m/s
 +1.6   forward=0
@@ -114,7 +113,7 @@ def script_source(script_path: str | None, clock: Any) -> MappedSource:
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
              out: TextIO | None = None, options: FlyOptions | None = None) -> int:
     """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed)."""
-    from joyfly.cli import fly_session
+    from joyfly.run import fly_session
 
     out = out or sys.stdout
     opts = options or FlyOptions()
@@ -144,7 +143,3 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
             emulator.stop()
     return status
 
-
-def default_script() -> Path:
-    """The repository's example script, for users who want to edit a copy."""
-    return Path(__file__).resolve().parent.parent / "examples" / "joystick_script.txt"

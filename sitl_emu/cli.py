@@ -12,13 +12,31 @@ import signal
 import sys
 import time
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
 import click
 
+from sitl_emu.cli_options import (
+    CONTEXT,
+    MAX_SYSID,
+    PORT_MAX,
+    SEED_MAX,
+    SPEED_MAX,
+    SPEED_MIN,
+    TOOL,
+    FiniteRange,
+    OneLineGroup,
+    UsageProblem,
+    UserError,
+    WholeRange,
+    check_host,
+    check_instances,
+    parse_address,
+    parse_home,
+)
+from sitl_emu.console import attach_console
 from sitl_emu.mavlink.link import PortInUseError
-from sitl_emu.runner import RealTimeRunner
+from sitl_emu.runner import RealTimeRunner, stop_on_signals
 from sitl_emu.server import LinkSettings
 from sitl_emu.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
@@ -29,6 +47,8 @@ log = logging.getLogger(__name__)
 # mavlink_main.cpp): 10 ms keeps telemetry within PX4's own slowest loop period, and every tick is still computed.
 DEFAULT_BATCH_MS = 10.0
 MIN_BATCH_WALL_S = 0.001  # batching never wakes more than 1000 times a wall second (high --speed)
+PORT = WholeRange(0, PORT_MAX)
+SHUTDOWN_LINE = "PX4 Exiting..."  # what PX4 SITL prints on Ctrl-C or SIGTERM (platforms/posix/src/px4/common/main.cpp)
 
 
 def wake_period_s(batch_ms: float, speed: float) -> float:
@@ -43,42 +63,24 @@ def wake_period_s(batch_ms: float, speed: float) -> float:
     return period_s if period_s > MIN_BATCH_WALL_S else MIN_BATCH_WALL_S
 
 
-class UsageProblem(Exception):
-    """A user mistake; str(err) is one sentence."""
-
-
-def parse_address(text: str, what: str) -> tuple[str, int]:
-    host, sep, port = text.rpartition(":")
-    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise UsageProblem(f"{what} must look like HOST:PORT (for example 127.0.0.1:14540), not '{text}'.")
-    return host, int(port)
-
-
-def parse_home(text: str) -> tuple[float, float, float]:
-    try:
-        lat, lon, alt = (float(p) for p in text.split(","))
-    except ValueError:
-        raise UsageProblem(f"--home must be LAT,LON,ALT in degrees and metres AMSL, not '{text}'.") from None
-    if not (-90 <= lat <= 90 and -180 <= lon <= 180 and -500 <= alt <= 9000):
-        raise UsageProblem(f"--home {text} is out of range (latitude ±90, longitude ±180, altitude -500..9000 m).")
-    return lat, lon, alt
-
-
-def read_params_file(path: Path) -> list[tuple[str, str]]:
-    """Lines `NAME VALUE`, or QGC .params lines `SYSID COMPID NAME VALUE TYPE`; '#' starts a comment."""
+def read_params_file(path: Path) -> list[tuple[str, str, str]]:
+    """(name, value, where) from lines `NAME VALUE`, or QGC .params lines `SYSID COMPID NAME VALUE TYPE`; '#' starts
+    a comment; `where` is FILE:LINE for messages."""
     try:
         lines = path.read_text().splitlines()
     except OSError as err:
         raise UsageProblem(f"Cannot read the parameter file {path}: {err.strerror}.") from None
-    pairs: list[tuple[str, str]] = []
+    except UnicodeDecodeError:
+        raise UsageProblem(f"{path} is not a text file: give --params a file of 'NAME VALUE' lines.") from None
+    pairs: list[tuple[str, str, str]] = []
     for n, raw in enumerate(lines, 1):
         parts = raw.split("#", 1)[0].split()
         if not parts:
             continue
         if len(parts) >= 4 and parts[0].isdigit() and parts[1].isdigit():
-            pairs.append((parts[2], parts[3]))
+            pairs.append((parts[2], parts[3], f"{path}:{n}"))
         elif len(parts) == 2:
-            pairs.append((parts[0], parts[1]))
+            pairs.append((parts[0], parts[1], f"{path}:{n}"))
         else:
             raise UsageProblem(f"{path}:{n}: expected 'NAME VALUE' or a QGC .params line, not '{raw.strip()}'.")
     return pairs
@@ -93,14 +95,14 @@ def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
         name, sep, value = item.partition("=")
         if not sep or not name:
             raise UsageProblem(f"--param must look like NAME=VALUE (for example MIS_TAKEOFF_ALT=5), not '{item}'.")
-        pairs.append((name.strip(), value.strip()))
-    for name, value in pairs:
+        pairs.append((name.strip(), value.strip(), "--param"))
+    for name, value, where in pairs:
         try:
             registry.set(name, float(value))
         except ValueError as err:
             if isinstance(err, ParamError):
-                raise UsageProblem(str(err)) from None
-            raise UsageProblem(f"Parameter {name} needs a number, not '{value}'.") from None
+                raise UsageProblem(f"{where}: {err}") from None
+            raise UsageProblem(f"{where}: parameter {name} needs a number, not '{value}'.") from None
     return registry
 
 
@@ -116,20 +118,8 @@ def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: in
     return Vehicle(**kwargs)
 
 
-def start_console(vehicle: Any, runner: RealTimeRunner, enabled: bool) -> None:
-    if not enabled or not sys.stdin.isatty():
-        return
-    try:
-        from sitl_emu.console import Console
-    except ImportError:
-        log.info("no console module; running headless")
-        return
-    console = Console(vehicle, runner.stop)
-    console.start()
-    runner.hooks.append(console.pump)
-
-
-@click.group()
+@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
+@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s (the joyfly package)")
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
 def main(verbose: int) -> None:
     """A PX4-protocol quadrotor emulator speaking MAVLink over UDP."""
@@ -137,19 +127,22 @@ def main(verbose: int) -> None:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
 
 
-@main.command()
-@click.option("--port", type=int, default=14557, show_default=True, help="API (onboard) link listen port.")
+@main.command(short_help="Run emulated PX4 quadrotors on UDP.")
+@click.option("--port", type=PORT, default=14557, show_default=True,
+              help="API (onboard) link listen port; 0 picks a free one.")
 @click.option("--remote", default="127.0.0.1:14540", show_default=True, help="API link initial destination.")
-@click.option("--gcs-port", type=int, default=18570, show_default=True, help="GCS link listen port.")
+@click.option("--gcs-port", type=PORT, default=18570, show_default=True,
+              help="GCS link listen port; 0 picks a free one.")
 @click.option("--gcs-remote", default="127.0.0.1:14550", show_default=True, help="GCS link initial destination.")
 @click.option("--bind", "bind_host", default="127.0.0.1", show_default=True, help="Address to listen on.")
-@click.option("--instance", type=click.IntRange(0, 250), default=0, show_default=True,
+@click.option("--instance", type=WholeRange(0, MAX_SYSID - 1), default=0, show_default=True,
               help="Vehicle instance N: sysid N+1 and every port offset by N, as PX4's -i.")
-@click.option("--speed", type=click.FloatRange(min=0.01, max=1000), default=1.0, show_default=True,
-              help="Simulation speed factor.")
-@click.option("--count", type=click.IntRange(1, 250), default=1, show_default=True,
+@click.option("--speed", type=FiniteRange(SPEED_MIN, SPEED_MAX), default=1.0, show_default=True,
+              help="Simulated seconds per wall second. A joyfly flying this vehicle needs the same factor: "
+                   "joyfly fly --speed N (it warns when they differ).")
+@click.option("--count", type=WholeRange(1, MAX_SYSID - 1), default=1, show_default=True,
               help="Number of vehicles: instances --instance.., sysids and ports offset per vehicle, homes 3 m apart.")
-@click.option("--batch-ms", type=click.FloatRange(0, 1000), default=DEFAULT_BATCH_MS, show_default=True,
+@click.option("--batch-ms", type=FiniteRange(0, 1000), default=DEFAULT_BATCH_MS, show_default=True,
               help="Wake at most every N ms of simulated time and run the ticks due in one batch (each message "
                    "still stamped at its own tick; input wakes the vehicle at once). The default wakes ~100 times a "
                    "simulated second, as PX4's mavlink loop at its slowest (MAVLINK_MAX_INTERVAL 10 ms), for about a "
@@ -159,47 +152,50 @@ def main(verbose: int) -> None:
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
               help="Parameter file: lines 'NAME VALUE' or QGC .params format.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Random seed for sensor noise.")
+@click.option("--seed", type=WholeRange(0, SEED_MAX), default=0, show_default=True,
+              help="Random seed for the sensor noise: the same seed, parameters and inputs fly the same trajectory.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
           seed: int, no_console: bool) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
+        check_host(bind_host, "--bind")
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
                                 parse_address(gcs_remote, "--gcs-remote"))
         home_lla = parse_home(home) if home else DEFAULT_HOME
-        if instance + count > 251:
-            raise UsageProblem(f"--instance {instance} with --count {count} needs sysids above 251; use fewer.")
+        check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
         build_params(params_file, assignments)  # report a bad --param once, before any port is opened
         nodes = build_nodes(count, settings, lambda i, h: build_vehicle(
             build_params(params_file, assignments), h, seed + i - instance, i + 1), first_instance=instance,
             home=home_lla, epoch_unix_us=int(time.time() * 1e6))
     except (UsageProblem, PortInUseError) as err:
-        click.echo(f"sitl-emu: {err}", err=True)
-        sys.exit(2)
+        raise UserError(str(err)) from None
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
-    start_console(nodes[0].vehicle, runner, not no_console)
-    _run_until_signalled(runner)
+    console = attach_console([node.vehicle for node in nodes], runner, not no_console)
+    _run_until_signalled(runner, console)
     for node in nodes:
         node.close()
 
 
-def _run_until_signalled(runner: RealTimeRunner) -> None:
-    def on_term(signum: int, frame: FrameType | None) -> None:
-        runner.stop()
-
-    previous = signal.signal(signal.SIGTERM, on_term)
-    try:
-        runner.run()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:
+    """Run until `shutdown`, SIGTERM or Ctrl-C; on a signal print PX4's "PX4 Exiting..." (main.cpp sig_int_handler,
+    with its leading newline that ends the prompt line)."""
+    with stop_on_signals(runner) as received:
+        try:
+            runner.run()
+        except KeyboardInterrupt:  # Ctrl-C before the handler was in place
+            received.append(signal.SIGINT)
+    if console is not None:
+        console.stop()
+    if received:
+        with contextlib.suppress(OSError, ValueError):  # stdout already gone: nothing to tell
+            click.echo(f"\n{SHUTDOWN_LINE}")
+            sys.stdout.flush()
 
 
 if __name__ == "__main__":

@@ -23,13 +23,15 @@ from dataclasses import dataclass
 from math import cos, sin, sqrt
 from typing import Final
 
-from sitl_emu.params import ParamRegistry
+from sitl_emu.control.qmath import constrain3, dcm_z, q_from_yaw, q_mul, rotate_world_to_body, yaw_from_q
 from sitl_emu.types import Vec3, Vec4
 
 GRAVITY_M_S2: Final = 9.80665  # PX4 CONSTANTS_ONE_G
 DEFAULT_DT_S: Final = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
 MAX_RATE_RAD_S: Final = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
-_MIN_RATE: Final = -MAX_RATE_RAD_S
+# not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183)
+_RATE_MAX: Vec3 = (MAX_RATE_RAD_S, MAX_RATE_RAD_S, MAX_RATE_RAD_S)
+_RATE_MIN: Vec3 = (-MAX_RATE_RAD_S, -MAX_RATE_RAD_S, -MAX_RATE_RAD_S)
 
 
 @dataclass(slots=True)
@@ -82,105 +84,83 @@ class SihConfig:
     wind_n_m_s: float = 0.0
     wind_e_m_s: float = 0.0
 
-    @classmethod
-    def from_params(cls, registry: ParamRegistry) -> SihConfig:
-        g = registry.get
-        return cls(
-            mass_kg=g("SIH_MASS"), ixx=g("SIH_IXX"), iyy=g("SIH_IYY"), izz=g("SIH_IZZ"),
-            t_max_n=g("SIH_T_MAX"), q_max_nm=g("SIH_Q_MAX"), l_roll_m=g("SIH_L_ROLL"), l_pitch_m=g("SIH_L_PITCH"),
-            kdv=g("SIH_KDV"), kdw=g("SIH_KDW"), t_tau_s=g("SIH_T_TAU"),
-            wind_n_m_s=g("SIH_WIND_N"), wind_e_m_s=g("SIH_WIND_E"),
-        )
-
     @property
     def hover_command(self) -> float:
         """Motor command (all four equal) that balances weight: m g / (4 T_MAX)."""
         return self.mass_kg * GRAVITY_M_S2 / (4.0 * self.t_max_n)
 
 
-def _level_q(q: Vec4) -> Vec4:
-    """The attitude with roll and pitch removed, yaw kept."""
-    w, x, y, z = q
-    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    return math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)
-
-
 def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig) -> RigidBodyState:
-    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
+    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed."""
+    u = _motor_lag(state.motors, motor_cmd, dt_s, cfg.t_tau_s)
+    thrust_n = cfg.t_max_n * (u[0] + u[1] + u[2] + u[3])  # along body -z
+    acc = _acceleration_ned(state.q_wxyz, state.vel_ned_m_s, thrust_n, cfg)
+    pos, vel = state.pos_ned_m, state.vel_ned_m_s
+    if state.on_ground and acc[2] >= 0.0:
+        return _grounded(state, u, (pos[0], pos[1], 0.0))
+    # forward Euler on the velocity, trapezoidal position
+    new_vel = (vel[0] + acc[0] * dt_s, vel[1] + acc[1] * dt_s, vel[2] + acc[2] * dt_s)
+    new_pos = (pos[0] + 0.5 * (vel[0] + new_vel[0]) * dt_s, pos[1] + 0.5 * (vel[1] + new_vel[1]) * dt_s,
+               pos[2] + 0.5 * (vel[2] + new_vel[2]) * dt_s)
+    if new_pos[2] >= 0.0:  # touchdown: stop in one step, never sink, never bounce
+        return _grounded(state, u, (new_pos[0], new_pos[1], 0.0))
+    specific_force = rotate_world_to_body(state.q_wxyz, (acc[0], acc[1], acc[2] - GRAVITY_M_S2))  # accelerometer
+    return RigidBodyState(new_pos, new_vel, _attitude_step(state.q_wxyz, state.rates_frd_rad_s, dt_s),
+                          _rates_step(state.rates_frd_rad_s, u, dt_s, cfg), u, acc, specific_force, False)
 
-    Runs every tick: the motor lag (sih.cpp read_motors: u += dt/tau (u_sp - u), commands clamped to 0..1, NaN -> 0),
-    the rate clamp (+-6 pi rad/s), the accelerometer rotation R^T v and the quaternion exponential are inlined here.
-    """
-    tau = cfg.t_tau_s
-    k = 1.0 if tau <= dt_s else dt_s / tau
-    c0, c1, c2, c3 = motor_cmd
+
+def _motor_lag(motors: Vec4, cmd: Sequence[float], dt_s: float, tau_s: float) -> Vec4:
+    """sih.cpp read_motors: u += dt / tau (u_sp - u) for each motor, the commands clamped to 0..1 (NaN -> 0)."""
+    k = 1.0 if tau_s <= dt_s else dt_s / tau_s
+    c0, c1, c2, c3 = cmd
     c0 = 0.0 if not c0 >= 0.0 else (1.0 if c0 > 1.0 else c0)  # `not c >= 0` also catches NaN
     c1 = 0.0 if not c1 >= 0.0 else (1.0 if c1 > 1.0 else c1)
     c2 = 0.0 if not c2 >= 0.0 else (1.0 if c2 > 1.0 else c2)
     c3 = 0.0 if not c3 >= 0.0 else (1.0 if c3 > 1.0 else c3)
-    m0, m1, m2, m3 = state.motors
-    u0, u1, u2, u3 = m0 + k * (c0 - m0), m1 + k * (c1 - m1), m2 + k * (c2 - m2), m3 + k * (c3 - m3)
-    u = (u0, u1, u2, u3)
-    t_max = cfg.t_max_n
-    thrust_n = t_max * (u0 + u1 + u2 + u3)  # along body -z
-    q_wxyz = state.q_wxyz
-    w, x, y, z = q_wxyz
-    # third column of R (body z axis in NED), times -thrust
-    bzx, bzy, bzz = 2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)
-    vn, ve, vd = state.vel_ned_m_s
+    m0, m1, m2, m3 = motors
+    return m0 + k * (c0 - m0), m1 + k * (c1 - m1), m2 + k * (c2 - m2), m3 + k * (c3 - m3)
+
+
+def _acceleration_ned(q: Vec4, vel: Vec3, thrust_n: float, cfg: SihConfig) -> Vec3:
+    """sih.cpp generate_force_and_torques: thrust along body -z, linear drag on the air-relative velocity, gravity."""
+    body_z = dcm_z(q)
     m, kdv = cfg.mass_kg, cfg.kdv
-    fn = -thrust_n * bzx - kdv * (vn - cfg.wind_n_m_s)
-    fe = -thrust_n * bzy - kdv * (ve - cfg.wind_e_m_s)
-    fd = -thrust_n * bzz - kdv * vd + m * GRAVITY_M_S2
-    an, ae, ad = fn / m, fe / m, fd / m
-    pn, pe, pd = state.pos_ned_m
-    if state.on_ground and ad >= 0.0:
-        return _grounded(state, u, (pn, pe, 0.0), thrust_n, cfg)
-    # moments (sih.cpp generate_force_and_torques), damping, gyroscopic term, diagonal inertia
-    p, q, r = state.rates_frd_rad_s
-    kdw = cfg.kdw
-    mx = cfg.l_roll_m * t_max * (-u0 + u1 + u2 - u3) - kdw * p
-    my = cfg.l_pitch_m * t_max * (u0 - u1 + u2 - u3) - kdw * q
-    mz = cfg.q_max_nm * (u0 + u1 - u2 - u3) - kdw * r
+    return ((-thrust_n * body_z[0] - kdv * (vel[0] - cfg.wind_n_m_s)) / m,
+            (-thrust_n * body_z[1] - kdv * (vel[1] - cfg.wind_e_m_s)) / m,
+            (-thrust_n * body_z[2] - kdv * vel[2] + m * GRAVITY_M_S2) / m)
+
+
+def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:
+    """Quad-X moments with angular damping, the gyroscopic term, diagonal inertia; rates clamped to +-6 pi rad/s."""
+    p, q, r = rates
+    m_x = cfg.l_roll_m * cfg.t_max_n * (-u[0] + u[1] + u[2] - u[3]) - cfg.kdw * p
+    m_y = cfg.l_pitch_m * cfg.t_max_n * (u[0] - u[1] + u[2] - u[3]) - cfg.kdw * q
+    m_z = cfg.q_max_nm * (u[0] + u[1] - u[2] - u[3]) - cfg.kdw * r
     ixx, iyy, izz = cfg.ixx, cfg.iyy, cfg.izz
-    dp = (mx + (iyy - izz) * q * r) / ixx
-    dq = (my + (izz - ixx) * r * p) / iyy
-    dr = (mz + (ixx - iyy) * p * q) / izz
-    np_, nq, nr = p + dp * dt_s, q + dq * dt_s, r + dr * dt_s
-    np_ = MAX_RATE_RAD_S if np_ > MAX_RATE_RAD_S else (_MIN_RATE if np_ < _MIN_RATE else np_)
-    nq = MAX_RATE_RAD_S if nq > MAX_RATE_RAD_S else (_MIN_RATE if nq < _MIN_RATE else nq)
-    nr = MAX_RATE_RAD_S if nr > MAX_RATE_RAD_S else (_MIN_RATE if nr < _MIN_RATE else nr)
-    nvn, nve, nvd = vn + an * dt_s, ve + ae * dt_s, vd + ad * dt_s
-    npd = pd + 0.5 * (vd + nvd) * dt_s
-    pos = (pn + 0.5 * (vn + nvn) * dt_s, pe + 0.5 * (ve + nve) * dt_s, npd)
-    if npd >= 0.0:  # touchdown: stop in one step, never sink, never bounce
-        return _grounded(state, u, (pos[0], pos[1], 0.0), thrust_n, cfg)
-    # accelerometer: R^T (a - g) in FRD; R's third column is (bzx, bzy, bzz) above
-    fz = ad - GRAVITY_M_S2
-    r00, r01 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z)
-    r10, r11 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z)
-    r20, r21 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x)
-    sf = (r00 * an + r10 * ae + r20 * fz, r01 * an + r11 * ae + r21 * fz, bzx * an + bzy * ae + bzz * fz)
-    # attitude: q <- q (x) exp(omega dt / 2) with the rates at the start of the step, normalised
-    n = sqrt(p * p + q * q + r * r)
+    dp = (m_x + (iyy - izz) * q * r) / ixx
+    dq = (m_y + (izz - ixx) * r * p) / iyy
+    dr = (m_z + (ixx - iyy) * p * q) / izz
+    return constrain3((p + dp * dt_s, q + dq * dt_s, r + dr * dt_s), _RATE_MIN, _RATE_MAX)
+
+
+def _attitude_step(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:
+    """q <- q (x) exp(omega dt / 2), with the rates at the start of the step, normalised."""
+    w_x, w_y, w_z = rates
+    n = sqrt(w_x * w_x + w_y * w_y + w_z * w_z)  # |omega|
     if n < 1e-12:
-        q_new = q_wxyz
-    else:
-        half = 0.5 * n * dt_s
-        dw, k = cos(half), sin(half) / n
-        dx, dy, dz = p * k, q * k, r * k
-        qw = w * dw - x * dx - y * dy - z * dz
-        qx = w * dx + x * dw + y * dz - z * dy
-        qy = w * dy - x * dz + y * dw + z * dx
-        qz = w * dz + x * dy - y * dx + z * dw
-        inv = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-        q_new = (qw * inv, qx * inv, qy * inv, qz * inv)
-    return RigidBodyState(pos, (nvn, nve, nvd), q_new, (np_, nq, nr), u, (an, ae, ad), sf, False)
+        return q
+    half = 0.5 * n * dt_s
+    k = sin(half) / n
+    qw, qx, qy, qz = q_mul(q, (cos(half), w_x * k, w_y * k, w_z * k))
+    inv = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    return qw * inv, qx * inv, qy * inv, qz * inv
 
 
-def _grounded(state: RigidBodyState, u: Vec4, pos: Vec3, thrust_n: float, cfg: SihConfig) -> RigidBodyState:
-    """Resting on the ground: still, level, the accelerometer reads the ground's reaction."""
-    q = state.q_wxyz if state.on_ground and state.q_wxyz[1] == 0.0 == state.q_wxyz[2] else _level_q(state.q_wxyz)
+def _grounded(state: RigidBodyState, u: Vec4, pos: Vec3) -> RigidBodyState:
+    """Resting on the ground: still, level (yaw kept), the accelerometer reads the ground's reaction."""
+    q = state.q_wxyz
+    if not (state.on_ground and q[1] == 0.0 == q[2]):
+        q = q_from_yaw(yaw_from_q(q))
     return RigidBodyState(pos, (0.0, 0.0, 0.0), q, (0.0, 0.0, 0.0), u, (0.0, 0.0, 0.0),
                           (0.0, 0.0, -GRAVITY_M_S2), True)
 
@@ -189,5 +169,5 @@ def hover_state(altitude_m: float, cfg: SihConfig | None = None, yaw_rad: float 
     """A vehicle hovering at `altitude_m` above the ground, motors at the hover command (for tests and tools)."""
     cfg = cfg or SihConfig()
     h = cfg.hover_command
-    q = (math.cos(yaw_rad / 2.0), 0.0, 0.0, math.sin(yaw_rad / 2.0))
-    return RigidBodyState(pos_ned_m=(0.0, 0.0, -altitude_m), q_wxyz=q, motors=(h, h, h, h), on_ground=False)
+    return RigidBodyState(pos_ned_m=(0.0, 0.0, -altitude_m), q_wxyz=q_from_yaw(yaw_rad), motors=(h, h, h, h),
+                          on_ground=False)

@@ -4,6 +4,9 @@ What each command sends and prints follows PX4 (v1.15):
 - `commander ...`: src/modules/commander/Commander.cpp custom_command(): every subcommand publishes an internal
   vehicle_command (from_external false, source = own sysid/compid); results appear later as log lines (events).
 - `param ...`: src/systemcmds/param/param.cpp (show/set formats); `param get` is our addition (= `param show -q`).
+- `listener ...`: src/systemcmds/topic_listener/listener_main.cpp (see sitl_emu/listener.py). With -n N the messages
+  come one by one as the topic is published, so the command keeps running after `execute` returns: the caller prints
+  `poll()`'s output each loop and shows the next prompt once `busy` is False, as pxh does when the command returns.
 - line handling and errors: platforms/posix/src/px4/common/px4_daemon/pxh.cpp process_line().
 Log-style output uses PX4's console format "%-5s [%s] %s" (platforms/common/px4_log.cpp).
 """
@@ -16,6 +19,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from sitl_emu import listener
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavResult, NavState, main_sub
 from sitl_emu.types import VehicleCommand
@@ -66,26 +70,66 @@ def log_line(level: str, module: str, text: str) -> str:
     return f"{level:<5} [{module}] {text}\n"
 
 
-class Shell:
-    """Runs one pxh> command line at a time; `execute` returns the text the command prints."""
+App = Callable[[list[str]], tuple[int, str]]  # arguments -> (status, output)
 
-    def __init__(self, vehicle: Any, on_shutdown: Callable[[], None] | None = None) -> None:
+
+class Shell:
+    """Runs one pxh> command line at a time; `execute` returns the text the command prints.
+
+    `extra_apps` adds commands of one front end (the terminal console's `vehicle`); `help` lists them too.
+    `vehicle` may be changed between commands (the console switches vehicles that way).
+    """
+
+    def __init__(self, vehicle: Any, on_shutdown: Callable[[], None] | None = None,
+                 extra_apps: dict[str, App] | None = None) -> None:
         self.vehicle = vehicle
         self.on_shutdown = on_shutdown
-        self._apps: dict[str, Callable[[list[str]], tuple[int, str]]] = {
+        self._job: listener.ListenerJob | None = None
+        self._apps: dict[str, App] = {
             "commander": self._commander,
+            "listener": self._listener,
             "param": self._param,
             "shutdown": self._shutdown,
             "ver": self._ver,
+            **(extra_apps or {}),
         }
+
+    @property
+    def commands(self) -> list[str]:
+        """The command names `help` lists."""
+        return sorted([*self._apps, "help"])
+
+    @property
+    def busy(self) -> bool:
+        """A command is still printing (`listener -n N`): no prompt yet."""
+        return self._job is not None
+
+    def poll(self) -> str:
+        """What the running command prints now (its next message, if one is due)."""
+        job = self._job
+        if job is None:
+            return ""
+        try:
+            out = job.poll()
+        except Exception as err:  # as in execute: end the command with one line, keep the shell
+            log.exception("pxh> listener")
+            job.printed, out = job.count, log_line("ERROR", "listener", f"internal error: {err}")
+        if job.done:
+            self._job = None
+        return out
+
+    def cancel(self) -> None:
+        """Stop the running command (PX4's listener stops on a key press)."""
+        self._job = None
 
     def execute(self, line: str) -> str:
         words = line.split()
         if not words or words[0].startswith("#"):
             return ""
+        self.cancel()
         command = words[0]
         if command == "help":
-            return "Builtin Commands:\n" + "".join(f"  {name}\n" for name in sorted([*self._apps, "help"]))
+            return "Builtin Commands:\n" + "".join(f"  {name}\n" for name in self.commands)
         app = self._apps.get(command)
         if app is None:
             return f"Invalid command: {command}\ntype 'help' for a list of commands\n"
@@ -158,6 +202,25 @@ class Shell:
                              source_system=self.vehicle.sysid, source_component=1, from_external=False)
         return self.vehicle.handle_command(cmd)
 
+    # --- listener ----------------------------------------------------------------------------------------------
+    def _listener(self, args: list[str]) -> tuple[int, str]:
+        if not args or args[0].startswith("-"):
+            return 1, listener.usage()
+        topic = listener.TOPICS.get(args[0])
+        options = _listener_options(args[1:])
+        if options is None:
+            return 1, listener.usage()
+        instance, count, rate_hz = options
+        if topic is None:
+            return -1, listener.unknown_topic(args[0])
+        if instance not in (-1, 0):
+            return 0, "never published\n"
+        if instance == -1 and count == 1 and rate_hz == 0:  # listener_main.cpp: one message, no instance number
+            return 0, listener.format_message(topic, self.vehicle, f"TOPIC: {topic.name}")
+        count = count or 30 * rate_hz  # listener_main.cpp: -r without -n prints 30 s worth
+        self._job = listener.ListenerJob(topic, self.vehicle, count, 1_000_000 // rate_hz if rate_hz else 0)
+        return 0, self.poll()
+
     # --- param -------------------------------------------------------------------------------------------------
     def _param(self, args: list[str]) -> tuple[int, str]:
         registry: ParamRegistry = self.vehicle.params
@@ -184,6 +247,20 @@ class Shell:
 
     def _ver(self, args: list[str]) -> tuple[int, str]:
         return 0, "HW arch: PX4_SITL\nPX4 version: emulated by sitl_emu (PX4 v1.15 behaviour)\nOS: Linux\n"
+
+
+def _listener_options(args: list[str]) -> tuple[int, int, int] | None:
+    """-i instance, -n messages, -r rate (listener_main.cpp getopt "i:r:n:"); None on anything else."""
+    values = {"-i": -1, "-n": 0, "-r": 0}
+    if len(args) % 2:
+        return None
+    for flag, text in zip(args[::2], args[1::2], strict=True):
+        if flag not in values or not text.isdigit():
+            return None
+        values[flag] = int(text)
+    if values["-n"] > listener.MAX_MESSAGES or values["-r"] > 1000:
+        return None
+    return values["-i"], values["-n"] or (0 if values["-r"] else 1), values["-r"]
 
 
 def _nav_name(nav_state: NavState) -> str:

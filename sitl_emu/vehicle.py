@@ -27,6 +27,7 @@ from sitl_emu.flight.commands import handle_command
 from sitl_emu.flight.tasks_core import NavInput, SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
+from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
 from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
@@ -79,7 +80,7 @@ class Vehicle:
         self._state = RigidBodyState()
         self._estimate = self._state
         self._sih_version = -1
-        self._sih = SihConfig.from_params(self.params)
+        self._sih = sih_config(self.params)
         self.commander = Commander(self.params, self._emit, self._ned_of, self._here)
         self.chain = ControlChain(self.params)
         self._setpoint_type = SetpointType.NONE
@@ -133,7 +134,7 @@ class Vehicle:
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:
-            self._sih, self._sih_version = SihConfig.from_params(self.params), self.params.version
+            self._sih, self._sih_version = sih_config(self.params), self.params.version
         return self._sih
 
     def _estimate_from(self, truth: RigidBodyState) -> RigidBodyState:

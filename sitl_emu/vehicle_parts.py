@@ -11,14 +11,14 @@ import math
 from typing import Final
 
 from sitl_emu.control.cascade import MulticopterControl
-from sitl_emu.control.qmath import norm, yaw_from_q
+from sitl_emu.control.qmath import isfinite, norm, yaw_from_q
 from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.land_detector import LandDetector, LandDetectorInput, LandDetectorState
 from sitl_emu.flight.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.flight.tasks_core import IDLE_ACC_Z_M_S2, NavInput
-from sitl_emu.floats import isfinite
 from sitl_emu.geo import GeoRef
 from sitl_emu.params import ParamRegistry
+from sitl_emu.params.settings import cascade_settings
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.types import TrajectorySetpoint, Vec4
 
@@ -31,7 +31,8 @@ class ControlChain:
 
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
-        self.control = MulticopterControl(params)
+        self.control = MulticopterControl(cascade_settings(params))
+        self._control_params_version = params.version
         self.executor = ModeExecutor(params)
         self._detector = LandDetector(params)
         self.ground_contact = False
@@ -50,6 +51,9 @@ class ControlChain:
     def control_update(self, est: RigidBodyState, out: ExecutorOutput, armed: bool, landed: bool, now_us: int,
                        dt_s: float) -> Vec4:
         """The cascade with the task's want_takeoff (auto modes) and the land detector's ground contact."""
+        if self.params.version != self._control_params_version:  # a parameter changed: new controller settings
+            self._control_params_version = self.params.version
+            self.control.settings = cascade_settings(self.params)
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)
 

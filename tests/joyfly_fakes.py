@@ -49,6 +49,7 @@ class FakeVehicle:
     custom_mode: int = LOITER
     intention: int = LOITER
     landed: bool = True
+    home: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])  # PX4 sets it where it arms (COM_HOME_EN)
     log: list[tuple[float, str, Any]] = field(default_factory=list)  # (time, kind, detail) of what it received
     texts: list[str] = field(default_factory=list)
 
@@ -62,7 +63,8 @@ class FakeVehicle:
         self.landed_since = 0.0
         self.sticky_failsafe = False
         self._text_id = 0
-        self._next = {"hb": 0.0, "pos": 0.0, "ess": 0.0}
+        self._next = {"hb": 0.0, "pos": 0.0, "ess": 0.0, "home": 0.0}
+        self.boot_s = 0.0  # when it (re)booted: time_boot_ms counts from here
 
     # --- receive -------------------------------------------------------------------------------------------------
     def _read(self) -> None:
@@ -120,7 +122,7 @@ class FakeVehicle:
             self._ack(msg, 0)
         elif cmd == 512:
             self._ack(msg, 0)
-            self.mav.home_position_send(0, 0, 0, 0.0, 0.0, 0.0, [1, 0, 0, 0], 0, 0, 0)
+            self.mav.home_position_send(0, 0, 0, *self.home, [1, 0, 0, 0], 0, 0, 0)
         else:
             self._ack(msg, 3)
 
@@ -139,6 +141,7 @@ class FakeVehicle:
             return
         self.armed = True
         self.landed_since = self.now
+        self.home = list(self.pos)
         self._ack(msg, 0)
         self._text(6, "Armed by external command")
 
@@ -160,6 +163,15 @@ class FakeVehicle:
 
     def clear_failsafe(self) -> None:
         self.sticky_failsafe = False
+
+    def reboot(self) -> None:
+        """Restart as a PX4 process does: on the ground at the origin, disarmed in Hold, its boot time from 0."""
+        self.pos, self.vel, self.yaw = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], 0.0
+        self.armed, self.landed, self.custom_mode, self.intention = False, True, LOITER, LOITER
+        self.sp, self.sp_time, self.sticky_failsafe = None, -math.inf, False
+        self.home = [0.0, 0.0, 0.0]
+        self.boot_s = self.now
+        self._next = dict.fromkeys(self._next, self.now)
 
     def step(self, now_s: float) -> None:
         dt = now_s - self.now
@@ -222,13 +234,16 @@ class FakeVehicle:
             self.mav.heartbeat_send(2, 12, base, self.custom_mode, 4 if self.armed else 3)
             self._next["hb"] = now + 1.0
         if now >= self._next["pos"]:
-            ms = int(now * 1000)
+            ms = int((now - self.boot_s) * 1000)
             self.mav.local_position_ned_send(ms, *self.pos, *self.vel)
             self.mav.attitude_send(ms, 0.0, 0.0, self.yaw, 0.0, 0.0, 0.0)
             self._next["pos"] = now + 1 / 30
         if now >= self._next["ess"]:
             self.mav.extended_sys_state_send(0, 1 if self.landed else 2)
             self._next["ess"] = now + 0.2
+        if now >= self._next["home"]:
+            self.mav.home_position_send(0, 0, 0, *self.home, [1, 0, 0, 0], 0, 0, 0)
+            self._next["home"] = now + 2.0  # PX4 streams HOME_POSITION at 0.5 Hz (px4-behaviour.md 1.5)
 
     def received(self, kind: str) -> list[tuple[float, Any]]:
         return [(t, m) for t, k, m in self.log if k == kind]

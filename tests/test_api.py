@@ -78,9 +78,9 @@ def test_params_change_the_flight():
 def test_joyfly_session_flies_a_sim_vehicle_on_the_lockstep_clock():
     from joyfly.config import FlyOptions
     from joyfly.demo import script_source
-    from joyfly.flight import FlightSession, Phase
-    from joyfly.link import VehicleLink
-    from joyfly.transport import UdpTransport
+    from joyfly.link.transport import UdpTransport
+    from joyfly.link.vehicle_link import VehicleLink
+    from joyfly.session.flight_session import FlightSession, Phase
 
     with Sim() as sim:
         transport = UdpTransport(("127.0.0.1", 0), sim.ports(0).api)

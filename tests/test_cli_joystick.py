@@ -9,8 +9,8 @@ import threading
 from click.testing import CliRunner
 
 from joyfly.cli_joystick import LiveView, joystick
-from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
-from joyfly.profiles import get_profile
+from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.profiles import get_profile
 from joyfly.types import JoyState, StickCommand
 
 SCRIPT = "0 forward=0.5\n0.05 arm=1\n+0.1 arm=0\n+0.05 end\n"
@@ -84,7 +84,7 @@ def test_record_then_replay_shows_the_same_session(tmp_path):
 def test_errors_are_one_sentence(tmp_path):
     result = run("test", "--joy", str(tmp_path / "js7"), "--dev-dir", str(tmp_path))
     assert result.exit_code == 1
-    assert result.output.startswith(f"Error: No joystick at {tmp_path / 'js7'}, and none is connected")
+    assert result.output.startswith(f"joyfly: No joystick at {tmp_path / 'js7'}, and none is connected")
     assert "Traceback" not in result.output
     script = tmp_path / "s.txt"
     script.write_text(SCRIPT)
@@ -120,3 +120,14 @@ def test_profiles_lists_every_builtin_layout():
     xbox = result.output.split("xbox: ", 1)[1].splitlines()
     assert "forward=4 inverted, right=3, up=1 inverted, yaw=0" in xbox[2] and "arm=7" in xbox[2]
     assert "radio: " in result.output and "generic: " in result.output
+
+
+def test_test_reads_a_raw_file_and_refuses_a_plain_one(tmp_path):
+    events = tmp_path / "events.bin"
+    events.write_bytes(pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, 0, 0) + pack_event(JS_EVENT_AXIS, 1, -32767))
+    result = run("test", "--joy", f"raw:{events}", "--duration", "0.2")
+    assert result.exit_code == 0, result.output
+    assert "axes=[0, -32767]" in result.output
+    result = run("test", "--joy", str(events), "--duration", "0.2")
+    assert result.exit_code == 1 and len(result.output.splitlines()) == 1
+    assert result.output.startswith(f"joyfly: {events} is a regular file") and f"raw:{events}" in result.output

@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 import math
+import random
 
 import pytest
 
@@ -8,10 +9,11 @@ from sitl_emu.control.attitude import AttitudeControl
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.harness import ClosedLoop, hover_loop
 from sitl_emu.control.mixer import allocated_torque, mix
-from sitl_emu.control.position import PositionControl, PositionLimits, input_valid
+from sitl_emu.control.position import PositionControl, input_valid
 from sitl_emu.control.qmath import euler_from_q, q_from_euler, yaw_from_q
 from sitl_emu.control.rate import RateControl
 from sitl_emu.params import default_registry
+from sitl_emu.params.settings import cascade_settings
 from sitl_emu.physics import RigidBodyState, hover_state
 from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint
 
@@ -136,7 +138,7 @@ def test_no_takeoff_without_a_climbing_setpoint():
 
 
 def test_disarmed_motors_are_off_and_idle_setpoint_gives_zero():
-    control = MulticopterControl(default_registry())
+    control = MulticopterControl(cascade_settings(default_registry()))
     state = RigidBodyState()
     assert control.update(state, HOLD, None, False, True, 0, 0.004) == (0.0, 0.0, 0.0, 0.0)
     assert control.takeoff_state == "disarmed"
@@ -212,7 +214,7 @@ def test_rate_integrator_is_frozen_while_landed():
 def test_position_control_handles_acceleration_only_setpoints():
     pc = PositionControl()
     sp = TrajectorySetpoint(acceleration_ned_m_s2=(1.0, 0.0, 0.0), velocity_ned_m_s=(NAN, NAN, 0.0))
-    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, PositionLimits(), 0.004, 0)
+    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, 0.004, 0)
     assert not out.in_failsafe
     assert out.thrust_ned[0] > 0.0 and out.thrust_ned[2] < 0.0
     assert math.degrees(math.atan2(out.thrust_ned[0], -out.thrust_ned[2])) == pytest.approx(
@@ -243,11 +245,11 @@ def test_hover_thrust_estimator_learns_the_true_hover_thrust_and_becomes_valid()
 
 
 def test_horizontal_velocity_limit_keeps_the_position_term_first():
-    from sitl_emu.control.position import constrain_xy
+    from sitl_emu.control.control_math import constrain_xy
 
-    vx, vy = constrain_xy(3.0, 0.0, 0.0, 5.0, 4.0)  # P-term 3 m/s north, feed-forward 5 m/s east, limit 4
+    vx, vy = constrain_xy((3.0, 0.0), (0.0, 5.0), 4.0)  # P-term 3 m/s north, feed-forward 5 m/s east, limit 4
     assert vx == pytest.approx(3.0) and math.hypot(vx, vy) == pytest.approx(4.0)
-    assert constrain_xy(0.0, 0.0, 3.0, 4.0, 0.0) == (0.0, 0.0)  # a zero limit stops, never divides by zero
+    assert constrain_xy((0.0, 0.0), (3.0, 4.0), 0.0) == (0.0, 0.0)  # a zero limit stops, never divides by zero
 
 
 def test_attitude_setpoint_with_nan_quaternion_never_reaches_the_motors(hovering):
@@ -255,3 +257,80 @@ def test_attitude_setpoint_with_nan_quaternion_never_reaches_the_motors(hovering
     att = AttitudeSetpoint(q_wxyz=(NAN, 0.0, 0.0, 0.0), thrust_body=(0.0, 0.0, -0.49))
     tr = loop.run(0.5, lambda t: None, attitude=lambda t: att)
     assert all(math.isfinite(m) for ms in tr.motors for m in ms)
+
+
+@pytest.mark.parametrize("torque,thrust", [((0.0, 0.0, 0.0), 0.5), ((0.1, -0.05, 0.02), 0.45), ((-0.0, 0.0, -0.0), 0.0),
+                                           ((0.0, 0.0, 0.0), 1.0), ((0.3, 0.3, 0.3), 0.95), ((math.nan, 0.1, 0.0), 0.5),
+                                           ((0.1, math.inf, 0.0), 0.5), ((0.0, 0.0, 0.0), math.nan)])
+def test_mixer_gives_the_plain_mix_exactly_when_nothing_saturates(torque, thrust):
+    motors, sat_pos, sat_neg = mix(torque, thrust)
+    roll, pitch, yaw = (t if math.isfinite(t) else 0.0 for t in torque)  # NaN and inf count as no demand
+    thr = thrust if math.isfinite(thrust) else 0.0
+    k = 1.0 / math.sqrt(2.0)  # the mixer's 0.707 roll/pitch scale
+    r, p = k * roll, k * pitch
+    roll_pitch = (thr - r + p, thr + r - p, thr + r + p, thr - r - p)
+    plain = (roll_pitch[0] + yaw, roll_pitch[1] + yaw, roll_pitch[2] - yaw, roll_pitch[3] - yaw)
+    if all(0.0 <= m <= 1.0 for m in roll_pitch + plain):
+        assert repr(motors) == repr(plain) and sat_pos == sat_neg == (False, False, False)
+    else:
+        assert all(0.0 <= m <= 1.0 for m in motors)
+
+
+def test_mixer_unsaturates_roll_and_pitch_before_adding_yaw():
+    # ControlAllocationSequentialDesaturation::mixAirmodeDisabled: the roll/pitch/thrust mix puts the front-left
+    # motor above 1, so thrust is reduced by the excess first; the yaw added afterwards would have brought that motor
+    # back below 1 on its own, but PX4 does not look ahead.
+    roll = pitch = 0.03
+    thrust, yaw = 0.97, 0.02
+    excess = thrust + math.sqrt(2.0) * roll - 1.0  # front-left: T + 0.707 roll + 0.707 pitch
+    motors, sat_pos, sat_neg = mix((roll, pitch, yaw), thrust)
+    assert sum(motors) / 4.0 == pytest.approx(thrust - excess, abs=1e-9)
+    assert allocated_torque(motors) == pytest.approx((roll, pitch, yaw), abs=1e-9)
+    assert sat_pos == sat_neg == (False, False, False)  # every torque is delivered, only thrust gave way
+
+
+def test_attitude_control_gives_finite_limited_rates_for_any_attitude_pair():
+    att = AttitudeControl()
+    limits = att.settings.rate_max_rad_s
+    level = (1.0, 0.0, 0.0, 0.0)
+    half_turns = [(0.0, 0.0, 0.0, 1.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), q_from_euler(math.pi, 0.0, 0.0)]
+    rng = random.Random(4)
+    pairs = [(level, q) for q in half_turns] + [(q, level) for q in half_turns] + [((-1.0, 0.0, 0.0, 0.0), level)]
+
+    def random_q() -> tuple[float, float, float, float]:
+        return q_from_euler(rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1))
+
+    pairs += [(random_q(), random_q()) for _ in range(500)]
+    for q, q_sp in pairs:
+        for ff in (0.0, 0.7, math.nan):
+            rates = att.update(q, q_sp, ff)
+            assert all(math.isfinite(r) and abs(r) <= lim for r, lim in zip(rates, limits, strict=True)), (q, q_sp)
+    assert att.update(level, level) == (0.0, 0.0, 0.0)
+
+
+def test_a_parameter_set_in_flight_reaches_the_controllers_at_the_next_tick():
+    from sitl_emu.vehicle import Vehicle
+
+    v = Vehicle()
+    v.step()
+    v.params.set("MC_ROLL_P", 6.5)
+    v.params.set("MPC_XY_VEL_MAX", 4.0)
+    v.step()
+    control = v.chain.control
+    assert control.attitude.settings.gain_p[0] == 6.5
+    assert control.position.settings.vel_max_xy == 4.0
+
+
+def test_controllers_and_physics_never_read_the_parameter_registry():
+    # PX4 keeps parameter lookups in the module wrappers; here the vehicle (sitl_emu/params/settings.py) builds the
+    # settings. harness.py, a test helper, is the only exception.
+    import ast
+    from pathlib import Path
+
+    package = Path(__file__).resolve().parent.parent / "sitl_emu"
+    sources = [p for p in (package / "control").glob("*.py") if p.name != "harness.py"] + [package / "physics.py"]
+    for path in sources:
+        tree = ast.parse(path.read_text())
+        imported = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+        imported |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+        assert not {m for m in imported if m and m.startswith("sitl_emu.params")}, path.name

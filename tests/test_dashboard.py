@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import io
+from dataclasses import replace
 
 from joyfly.dashboard import LiveDashboard, PlainLog, bar, make_view, render, summary_lines
-from joyfly.flight import FlightStats, Note, Phase, SessionView
-from joyfly.setpoints import Fence, Setpoint
+from joyfly.session.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.sticks.setpoints import Fence, Setpoint
 from joyfly.types import Action, StickCommand
 
 
@@ -69,3 +70,28 @@ def test_make_view_picks_plain_lines_without_a_terminal() -> None:
 def test_summary_reports_distance_fence_and_offboard_time() -> None:
     text = "\n".join(summary_lines(FlightStats(31.5, -0.2, 29.0, 4.1)))
     assert "31.5 m" in text and "0.20 m OUTSIDE" in text and "29.0 s" in text
+
+
+def test_no_vehicle_yet_reads_waiting_not_lost_even_once_joyfly_stops() -> None:
+    quiet = replace(view(phase=Phase.DONE, link_ok=False, pos=None), heard=False)
+    assert "link waiting" in "\n".join(render(quiet))
+    out = io.StringIO()
+    PlainLog(out).show(quiet)
+    assert "link waiting" in out.getvalue()
+    assert "link LOST" in "\n".join(render(replace(quiet, heard=True)))
+
+
+def test_a_lost_joystick_reads_holding_only_while_joyfly_holds_the_vehicle() -> None:
+    lost = replace(view(), joystick_ok=False)
+    assert "joystick LOST (holding)" in "\n".join(render(lost))
+    for phase in (Phase.LANDING, Phase.GROUNDED, Phase.PAUSED, Phase.EXITING):
+        text = "\n".join(render(replace(lost, phase=phase)))
+        assert "joystick LOST" in text and "holding" not in text
+
+
+def test_closing_the_live_view_takes_an_empty_block_away() -> None:
+    out = io.StringIO()
+    live = LiveDashboard(out)
+    live.show(view(pos=None))
+    live.close(keep=False)
+    assert out.getvalue().endswith("\x1b[8F\x1b[J")

@@ -12,9 +12,10 @@ import pytest
 from joyfly_fakes import LAND, LOITER, OFFBOARD, RTL, FakeVehicle, TimedSticks
 
 from joyfly.clock import SimClock
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.link import VehicleLink
-from joyfly.transport import memory_pair
+from joyfly.dashboard import render
+from joyfly.link.transport import memory_pair
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.types import Action, StickCommand
 
 
@@ -136,7 +137,8 @@ def test_lost_joystick_holds_then_lands_after_the_timeout() -> None:
     world.run_until(13.0)
     assert world.vehicle.received("CMD21") and world.vehicle.received("CMD21")[0][0] == pytest.approx(12.6, abs=0.2)
     world.run_until(25.0)
-    assert not world.vehicle.armed and world.session.phase is Phase.GROUNDED
+    assert not world.vehicle.armed and world.session.phase is Phase.DONE  # landed, disarmed, no joystick: done
+    assert "The joystick is gone and the vehicle is on the ground, disarmed" in world.notes()
 
 
 def test_joystick_back_before_the_timeout_cancels_the_landing() -> None:
@@ -288,3 +290,91 @@ def test_a_vehicle_disarmed_under_us_stops_the_stream() -> None:
     sent = len(world.vehicle.received("SETPOINT"))
     world.run_until(10.0)
     assert len(world.vehicle.received("SETPOINT")) == sent
+
+
+def test_the_fence_is_centred_where_the_vehicle_takes_off_not_on_an_old_home() -> None:
+    world = make_world(fence_m=2.0)
+    world.vehicle.pos = [3.0, -1.0, 0.0]  # landed away from its home of an earlier flight (still (0, 0, 0))
+    world.run_until(10.0)
+    assert world.session.phase is Phase.FLYING, world.notes()
+    assert world.session.fence.home_ned_m == pytest.approx((3.0, -1.0, 0.0))
+    assert world.vehicle.pos[:2] == pytest.approx([3.0, -1.0], abs=0.2)  # climbed straight up, no slide
+    assert world.session.stats.min_fence_margin_m > 1.5
+
+
+def test_taking_over_a_flying_vehicle_centres_the_fence_on_its_home() -> None:
+    world = make_world(fence_m=4.0)
+    v = world.vehicle
+    v.home, v.pos, v.landed, v.armed = [10.0, 5.0, 0.0], [11.0, 5.0, -3.0], False, True
+    v.custom_mode = v.intention = LOITER
+    world.run_until(3.0)
+    assert world.session.phase is Phase.PAUSED, world.notes()
+    assert world.session.fence.home_ned_m == pytest.approx((10.0, 5.0, 0.0))
+
+
+def test_a_script_joystick_that_ends_after_landing_finishes_the_session() -> None:
+    press = StickCommand(pressed=frozenset({Action.LAND}))
+    world = airborne([(7.0, press), (7.3, StickCommand()), (9.0, StickCommand(connected=False))])
+    world.run_until(9.5)
+    assert world.session.phase is Phase.LANDING
+    assert "(holding)" not in "\n".join(render(world.session.view()))
+    world.run_until(40.0)
+    assert world.session.phase is Phase.DONE, world.notes()
+    assert world.clock.now() < 25.0 and not world.vehicle.armed
+    assert "The joystick is gone and the vehicle is on the ground, disarmed: joyfly is done." in world.notes()
+
+
+def test_a_joystick_lost_in_flight_shows_holding_until_the_landing_starts() -> None:
+    world = airborne([(7.0, StickCommand(connected=False))], joy_timeout_s=2.0)
+    world.run_until(8.0)
+    assert "LOST (holding)" in "\n".join(render(world.session.view()))
+    world.run_until(9.5)
+    assert world.session.phase is Phase.LANDING
+    text = "\n".join(render(world.session.view()))
+    assert "joystick LOST" in text and "(holding)" not in text
+
+
+def test_a_restarted_vehicle_is_reported_as_restarted_and_not_armed_again() -> None:
+    world = airborne()
+    world.vehicle.speak = False
+    world.run_until(11.0)
+    assert "Link lost" in world.notes()
+    world.vehicle.reboot()
+    world.vehicle.speak = True
+    world.run_until(20.0)
+    notes = world.notes()
+    assert "The vehicle restarted" in notes and "went back" in notes and "Link back" not in notes
+    assert "will not arm it again" in notes
+    assert world.session.phase is Phase.GROUNDED
+    assert not [t for t, _ in world.vehicle.received("CMD400") if t > 11.0] and not world.vehicle.armed
+    assert world.session.stats.offboard_time_s == pytest.approx(6.0 - 1.05, abs=0.6)  # OFFBOARD at 1.05 s, not after
+
+
+def test_a_link_outage_does_not_count_as_time_in_offboard() -> None:
+    world = airborne()
+    world.vehicle.speak = False
+    world.run_until(16.0)
+    world.vehicle.speak = True
+    world.run_until(20.0)
+    assert "Link back" in world.notes() and "restarted" not in world.notes()
+    assert world.session.stats.offboard_time_s == pytest.approx(6.0 - 1.05 + 20.0 - 16.0, abs=0.6)  # 6 s to 16 s out
+
+
+def test_ctrl_c_while_the_arm_command_is_on_its_way_does_not_leave_the_vehicle_armed() -> None:
+    world = make_world()
+    while not world.vehicle.received("CMD400") and world.clock.now() < 5.0:
+        world.session.run_once()
+    assert world.session.phase is Phase.ARMING and not world.session.link.state.armed
+    world.session.request_exit()  # the ARM is accepted a moment later; the HEARTBEAT shows it up to 1 s after
+    world.run_until(20.0)
+    assert world.session.phase is Phase.DONE
+    assert "Exiting: land" in world.notes() and world.vehicle.received("CMD21")
+    assert not world.vehicle.armed
+
+
+def test_a_vehicle_restarted_before_joyfly_connected_is_simply_flown() -> None:
+    world = make_world([(0.0, StickCommand(connected=False)), (4.0, StickCommand())])
+    world.run_until(3.0)
+    world.vehicle.reboot()  # its boot time goes back from 3 s to 0 while joyfly waits for the joystick
+    world.run_until(12.0)
+    assert world.session.phase is Phase.FLYING and "restarted" not in world.notes()

@@ -22,11 +22,11 @@ import pytest
 from ports import free_udp_port, free_udp_ports
 
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
-from joyfly.flight import FlightSession, Phase, SessionSettings
-from joyfly.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
-from joyfly.link import VehicleLink
-from joyfly.mapping import open_sticks
-from joyfly.transport import UdpTransport
+from joyfly.link.transport import UdpTransport
+from joyfly.link.vehicle_link import VehicleLink
+from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
+from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.mapping import open_sticks
 
 SPEED = 8.0
 AXIS_FULL = 32767
@@ -157,20 +157,29 @@ def test_closing_the_fifo_holds_then_lands_after_the_timeout(flight: Flight) -> 
     assert flight.session.phase is Phase.FLYING
     assert max(abs(a - b) for a, b in zip(flight.pos(), held, strict=True)) < 0.5
     flight.wait_for(Phase.LANDING, 3.0)
-    flight.wait_for(Phase.GROUNDED, 30.0)
+    flight.wait_for(Phase.DONE, 30.0)  # landed, disarmed and no joystick: nothing more to fly
     assert not flight.session.link.state.armed
+    assert any("The joystick is gone" in n.text for n in flight.session.notes)
 
 
 
 
-def _start_pair(tmp_path: Path, speed: str = "4") -> tuple[subprocess.Popen[bytes], subprocess.Popen[str], str]:
-    """`sitl-emu serve` and `joyfly fly` (hovering on a script joystick) as a user runs them, flying in OFFBOARD."""
-    joy_port, emu_port, gcs_port = free_udp_ports(3)
-    emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
-                            f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
-                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+def _serve(joy_port: int, emu_port: int, gcs_port: int, speed: str) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
+                             f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+Procs = tuple[subprocess.Popen[bytes], subprocess.Popen[str], str]
+
+
+def _start_pair(tmp_path: Path, speed: str = "4", script_text: str = "0 forward=0\n+60 end\n",
+                ports: tuple[int, int, int] | None = None) -> Procs:
+    """`sitl-emu serve` and `joyfly fly` (on a script joystick) as a user runs them, flying in OFFBOARD."""
+    joy_port, emu_port, gcs_port = ports or free_udp_ports(3)
+    emu = _serve(joy_port, emu_port, gcs_port, speed)
     script = tmp_path / "hover.txt"
-    script.write_text("0 forward=0\n+60 end\n")
+    script.write_text(script_text)
     joy = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", f"script:{script}", "--url",
                             f"udp://127.0.0.1:{joy_port}@127.0.0.1:{emu_port}", "--speed", speed],
                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -208,7 +217,7 @@ def test_second_sigint_quits_at_once(tmp_path: Path) -> None:
     emu, joy, _ = _start_pair(tmp_path)
     try:
         joy.send_signal(signal.SIGINT)
-        time.sleep(0.2)
+        time.sleep(0.5)
         start = time.monotonic()
         joy.send_signal(signal.SIGINT)
         stdout, stderr = joy.communicate(timeout=10.0)
@@ -216,21 +225,70 @@ def test_second_sigint_quits_at_once(tmp_path: Path) -> None:
     finally:
         _kill(joy, emu)
     assert joy.returncode == 130 and quit_s < 2.0
-    assert "interrupted twice" in stdout and "Traceback" not in stderr
+    assert "Traceback" not in stderr
+    assert stdout.count("interrupted twice") == 1
+    assert "the vehicle was left armed in AUTO.LAND: it lands and disarms by itself." in stdout
+
+
+def test_a_script_joystick_that_ends_after_landing_exits_0_with_a_summary(tmp_path: Path) -> None:
+    emu, joy, out = _start_pair(tmp_path, script_text="0 forward=0\n8 land=1\n+0.3 land=0\n+12 end\n")
+    try:
+        out += _read_until(joy, "highest", 60.0)  # the summary's last line, with no Ctrl-C
+        joy.wait(10.0)
+        assert joy.stderr is not None
+        stderr = joy.stderr.read()
+    finally:
+        _kill(joy, emu)
+    assert joy.returncode == 0, out + stderr
+    assert "Landed and disarmed" in out and "The joystick is gone" in out and "joyfly is done" in out
+    assert "distance flown" in out and "time in OFFBOARD" in out and "Traceback" not in stderr
+
+
+def test_an_emulator_restarted_mid_flight_is_reported_as_a_restart(tmp_path: Path) -> None:
+    ports = free_udp_ports(3)
+    emu, joy, out = _start_pair(tmp_path, ports=ports)
+    try:
+        time.sleep(1.0)
+        emu.kill()
+        emu.wait()
+        out += _read_until(joy, "Link lost", 10.0)
+        time.sleep(1.0)  # 4 s of simulated time with no vehicle
+        emu = _serve(*ports, "4")
+        out += _read_until(joy, "The vehicle restarted", 20.0)
+        time.sleep(0.5)
+        joy.send_signal(signal.SIGINT)
+        out += _read_until(joy, "highest", 20.0)  # the summary's last line (communicate() would skip the
+        joy.wait(10.0)  # lines readline() buffered already)
+    finally:
+        _kill(joy, emu)
+    assert joy.returncode == 0, out
+    assert "landed; AUTO.LOITER disarmed; link ok" in out  # what the view shows after the restart
+    assert "Link back" not in out and "will not arm it again on its own" in out
+    offboard_s = float(out.split("time in OFFBOARD")[1].split()[0])
+    flown_s = float(out.split("OFFBOARD: you have control")[0].rsplit("[", 1)[1].split("]")[0])
+    lost_s = float(out.split("Link lost")[0].rsplit("[", 1)[1].split("]")[0])
+    assert offboard_s < lost_s - flown_s  # the outage and the time after the restart are not in it
 
 
 def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str:
-    assert proc.stdout is not None
-    seen = ""
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        line = proc.stdout.readline()
-        if not line and proc.poll() is not None:
-            break
-        seen += line
-        if text in line:
-            return seen
-    raise AssertionError(f"never saw {text!r}:\n{seen}")
+    """proc's output up to the line holding `text`; fails after timeout_s even if proc prints nothing more (a
+    reader thread does the blocking reads, and ends at EOF once the caller killed proc)."""
+    stdout = proc.stdout
+    assert stdout is not None
+    seen: list[str] = []
+
+    def read() -> None:
+        for line in iter(stdout.readline, ""):
+            seen.append(line)
+            if text in line:
+                return
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    reader.join(timeout_s)
+    if not seen or text not in seen[-1]:
+        raise AssertionError(f"never saw {text!r}:\n{''.join(seen)}")
+    return "".join(seen)
 
 
 def test_another_gcs_taking_over_is_reported_and_not_fought(flight: Flight) -> None:

@@ -11,9 +11,9 @@ from joyfly_fakes import FakeVehicle, WallStepper
 from pymavlink.dialects.v20 import common as mavlink2
 
 from joyfly.clock import SimClock, WallClock
-from joyfly.link import VehicleLink, is_offboard, mode_name
-from joyfly.setpoints import Setpoint
-from joyfly.transport import TransportError, UdpTransport, memory_pair, open_transport, parse_udp_url
+from joyfly.link.transport import TransportError, UdpTransport, memory_pair, open_transport, parse_udp_url
+from joyfly.link.vehicle_link import VehicleLink, is_offboard, mode_name
+from joyfly.sticks.setpoints import Setpoint
 
 
 def test_mavros_style_url_gives_bind_and_remote() -> None:

@@ -9,8 +9,8 @@ import tty
 
 import pytest
 
-from joyfly import joystick
-from joyfly.joystick import (
+from joyfly.sticks import joystick
+from joyfly.sticks.joystick import (
     EVENT_SIZE,
     JS_EVENT_AXIS,
     JS_EVENT_BUTTON,
@@ -99,11 +99,12 @@ def test_fifo_split_record_is_joined(tmp_path):
     src.close()
 
 
-def test_regular_file_is_read_and_followed(tmp_path):
+def test_raw_file_is_read_and_followed(tmp_path):
     path = tmp_path / "events.bin"
     path.write_bytes(init_burst([0, 0], [0, 0]) + pack_event(JS_EVENT_AXIS, 1, -20000))
     clock = FakeClock()
-    src = open_joystick(str(path), clock)
+    src = open_joystick(f"raw:{path}", clock)
+    assert src.name == str(path) and src.path == str(path)
     state = src.poll(0.1)
     assert state.axes == (0, -20000) and state.connected
     with path.open("ab") as fh:
@@ -218,5 +219,96 @@ def test_init_burst_after_a_queue_overflow_replaces_the_state(tmp_path):
         + pack_event(JS_EVENT_AXIS, 1, -32767)
         + init_burst([0, 0], [0])
     )
-    state = open_joystick(str(path), FakeClock()).poll(0.0)
+    state = open_joystick(f"raw:{path}", FakeClock()).poll(0.0)
     assert state.axes == (0, 0) and state.buttons == (0,)
+
+
+# ------------------------------------------------------------------------------- what may be a joystick (issue 10)
+
+
+def _one_sentence(exc: JoystickError) -> str:
+    text = str(exc)
+    assert "\n" not in text and text.endswith(".") and ". " not in text, text
+    return text
+
+
+@pytest.mark.parametrize("content", [b"Flight notes: take off at the field.\n", bytes(range(256)) * 8,
+                                     pack_event(JS_EVENT_AXIS, 0, 32767) * 8, b""],
+                         ids=["text", "binary", "js-records", "empty"])
+def test_a_regular_file_not_named_raw_is_refused_at_open(tmp_path, content):
+    """A text file, a binary file, even well-formed js_event records: joyfly cannot tell a joystick stream from a
+    file that happens to parse, so only a --record recording or `raw:FILE` is read."""
+    path = tmp_path / "notes.txt"
+    path.write_bytes(content)
+    with pytest.raises(JoystickError) as info:
+        open_joystick(str(path), FakeClock())
+    text = _one_sentence(info.value)
+    assert f"{path} is a regular file" in text and f"raw:{path}" in text and "--record" in text
+
+
+def test_a_directory_is_refused_at_once_even_as_raw(tmp_path):
+    for spec in (str(tmp_path), f"raw:{tmp_path}"):
+        with pytest.raises(JoystickError) as info:
+            open_joystick(spec, FakeClock())
+        assert _one_sentence(info.value).startswith(f"{tmp_path} is a directory, not a joystick")
+
+
+def test_dev_null_is_a_character_device_but_not_a_joystick():
+    with pytest.raises(JoystickError) as info:
+        open_joystick("/dev/null", FakeClock())
+    text = _one_sentence(info.value)
+    assert text.startswith("/dev/null is a character device but not a joystick") and "raw:/dev/null" in text
+
+
+def test_raw_vouches_for_a_character_device_without_js_ioctls():
+    src = open_joystick("raw:/dev/null", FakeClock())
+    assert src.name == "/dev/null" and src.kind == "device"
+    src.close()
+
+
+def test_a_device_answering_the_js_ioctls_is_a_joystick(monkeypatch):
+    real_ioctl = joystick.fcntl.ioctl
+
+    def js_driver(fd, request, arg):
+        if request == joystick.JSIOCGVERSION:
+            return b"\x00\x01\x02\x00"  # joydev answers JS_VERSION 0x020100
+        return real_ioctl(fd, request, arg)
+
+    monkeypatch.setattr(joystick.fcntl, "ioctl", js_driver)
+    src = open_joystick("/dev/null", FakeClock())
+    assert src.kind == "device"
+    src.close()
+
+
+def test_a_pty_carrying_records_stays_accepted(pty_device):
+    """A pseudo-terminal (socat forwarding a remote joystick's records) is a stream someone set up on purpose."""
+    _master, path = pty_device
+    src = open_joystick(path, FakeClock())
+    assert src.kind == "device"
+    src.close()
+
+
+def test_a_fifo_opens_at_once_and_waits_for_its_writer(tmp_path):
+    path = tmp_path / "js-fifo"
+    os.mkfifo(path)
+    src = open_joystick(str(path), FakeClock())
+    assert src.poll(0.0).connected is False  # no writer yet: not connected, and no error
+    src.close()
+
+
+def test_a_device_replaced_by_something_else_is_not_reopened(pty_device, tmp_path, monkeypatch):
+    _master, path = pty_device
+    clock = FakeClock()
+    src = JsDevice(path, clock)
+    src.path = str(tmp_path)  # the node now names a directory
+
+    def unplugged(fd, n):
+        raise OSError(errno.ENODEV, "No such device")
+
+    monkeypatch.setattr(joystick.os, "read", unplugged)
+    assert src.poll(0.1).connected is False
+    monkeypatch.undo()
+    clock.sleep(1.0)
+    assert src.poll(0.1).connected is False
+    assert "is a directory" in str(src.last_error)
+    src.close()

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import pytest
 
-from joyfly.joystick import JoystickError
-from joyfly.mapping import StickMapper, apply_deadzone, apply_expo, fired, map_state, open_sticks, shape_axis
-from joyfly.profiles import AxisMap, get_profile, load_profile
+from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.mapping import StickMapper, apply_deadzone, apply_expo, fired, map_state, open_sticks, shape_axis
+from joyfly.sticks.profiles import AxisMap, get_profile, load_profile
 from joyfly.types import Action, JoyState, StickCommand
 
 FULL = 32767

@@ -96,3 +96,16 @@ def test_item_request_without_transfer_is_ignored(setup):
     proto, ctx, client = setup
     proto.handle(client.msg("MISSION_REQUEST_INT", 1, 1, 0, 0), ctx)
     assert ctx.take() == []
+
+
+def test_readme_says_what_the_mission_protocol_does(setup):
+    """The README promised "the mission protocol" while uploads were refused (issue 10.5): it must say what happens."""
+    from pathlib import Path
+
+    proto, ctx, client = setup
+    proto.handle(client.msg("MISSION_COUNT", 1, 1, 3, 0), ctx)
+    (ack,) = [m for m in ctx.take() if m.get_type() == "MISSION_ACK"]
+    readme = " ".join((Path(__file__).parent.parent / "README.md").read_text().split())
+    assert "mission protocols" not in readme
+    if ack.type == MAV_MISSION_UNSUPPORTED:
+        assert "a mission upload is refused at once with MISSION_ACK `MAV_MISSION_UNSUPPORTED`" in readme

@@ -6,6 +6,7 @@ import math
 import pytest
 
 from sitl_emu.params import default_registry
+from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import GRAVITY_M_S2, RigidBodyState, SihConfig, hover_state, step
 
 DT = 0.004
@@ -20,7 +21,7 @@ def run(state, cmd, seconds, cfg):
 def test_config_comes_from_the_sih_parameters():
     reg = default_registry()
     reg.set("SIH_MASS", 1.5)
-    cfg = SihConfig.from_params(reg)
+    cfg = sih_config(reg)
     assert cfg.mass_kg == 1.5
     assert cfg.t_max_n == 5.0 and cfg.t_tau_s == 0.05
 

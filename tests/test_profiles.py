@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from joyfly.profiles import (
+from joyfly.sticks.profiles import (
     ProfileError,
     get_profile,
     load_profile,

@@ -56,7 +56,7 @@ def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigter
     assert proc.returncode == 0
     assert "Traceback" not in err
     lines = out.strip().splitlines()
-    assert len(lines) == 1
+    assert len(lines) == 3 and lines[1:] == ["", "PX4 Exiting..."]  # PX4's shutdown line (main.cpp), after "\n"
     assert f"{api_port}" in lines[0] and f"{api_remote}" in lines[0] and f"{gcs_port}" in lines[0]
 
 
@@ -69,9 +69,10 @@ def test_ctrl_c_exits_without_traceback():
         time.sleep(0.2)
     finally:
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=10)
+        out, err = proc.communicate(timeout=10)
     assert proc.returncode == 0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert out.endswith("\nPX4 Exiting...\n")  # as PX4 SITL on Ctrl-C (main.cpp sig_int_handler)
 
 
 def test_instance_gives_sysid_and_offset_ports():

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from joyfly.setpoints import (
+from joyfly.sticks.setpoints import (
     MASK_POSITION_VELOCITY_YAW,
     MASK_POSITION_YAW,
     Fence,

@@ -135,3 +135,25 @@ def test_endless_line_is_cut_and_memory_stays_bounded(setup):
     _type(bridge, ctx, client, b"\n")
     out = _read(bridge, ctx)
     assert out.endswith(b"\nInvalid command: " + b"x" * 1024 + b"\ntype 'help' for a list of commands\npxh> ")
+
+
+def test_listener_works_over_the_mavlink_shell(setup):
+    bridge, ctx, client = setup
+    _type(bridge, ctx, client, b"listener vehicle_status\n")
+    out = _read(bridge, ctx).decode()
+    assert out.startswith("listener vehicle_status\n\nTOPIC: vehicle_status\n vehicle_status\n    timestamp: ")
+    assert "    arming_state: 1\n" in out and out.endswith("pxh> ")
+
+
+def test_listener_n_prints_as_the_topic_is_published_then_the_prompt_then_waiting_input(setup):
+    bridge, ctx, client = setup
+    vehicle = ctx.vehicle
+    _type(bridge, ctx, client, b"listener vehicle_status -n 2\n")
+    first = _read(bridge, ctx).decode()
+    assert "TOPIC: vehicle_status instance 0 #1" in first and "pxh> " not in first
+    _type(bridge, ctx, client, b"ver\n")  # waits until the listener has ended, as in PX4's shell pipe
+    assert _read(bridge, ctx) == b""
+    vehicle.time_us = 500_000  # vehicle_status: 2 Hz
+    rest = _read(bridge, ctx).decode()
+    assert rest.index("TOPIC: vehicle_status instance 0 #2") < rest.index("pxh> ver\nHW arch: PX4_SITL")
+    assert rest.endswith("pxh> ")

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from joyfly.joystick import JoystickError, open_joystick
-from joyfly.mapping import StickMapper
-from joyfly.profiles import load_profile
+from joyfly.sticks.joystick import JoystickError, open_joystick
+from joyfly.sticks.mapping import StickMapper
+from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.virtual import JoyRecorder, ReplaySource, ScriptSource, parse_script, record_to
 from joyfly.types import Action
-from joyfly.virtual import JoyRecorder, ReplaySource, ScriptSource, parse_script, record_to
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "joystick_script.txt"
 
@@ -94,21 +94,27 @@ def test_script_mistakes_name_the_line(text, fragment):
     assert fragment in str(info.value) and str(info.value).startswith("my.txt line")
 
 
-def test_example_script_takes_off_flies_a_square_pushes_the_fence_and_lands():
+def test_example_script_leaves_the_take_off_to_joyfly_flies_a_square_pushes_the_fence_and_lands():
+    """`joyfly fly` arms, takes off and enters OFFBOARD itself (joyfly/session/flight_session.py): the example
+    presses only LAND, and keeps the sticks centred for the take-off's first 8 s."""
     clock = FakeClock(0.0)
     src = open_joystick(f"script:{EXAMPLE}", clock)
     mapper = StickMapper(load_profile("auto", src.name, {}))
     fired: list[Action] = []
     north_demand_s = 0.0
+    first_stick_s: float | None = None
     while True:
         state = src.poll(0.0)
         cmd, actions = mapper.update(state)
         fired.extend(sorted(actions, key=lambda a: a.value))
         north_demand_s += 0.05 * cmd.forward if cmd.forward > 0.9 else 0.0
+        if first_stick_s is None and any((cmd.forward, cmd.right, cmd.up, cmd.yaw)):
+            first_stick_s = clock.now()
         if not state.connected:
             break
         clock.sleep(0.05)
-    assert fired == [Action.ARM, Action.TAKEOFF, Action.OFFBOARD, Action.LAND]
+    assert fired == [Action.LAND]
+    assert first_stick_s == pytest.approx(8.0)
     assert north_demand_s > 3.5  # a long full-stick push north: 20 m of demand against a 5 m fence
     assert 40.0 < clock.now() < 60.0
 
@@ -167,3 +173,80 @@ def test_replay_of_a_non_recording_is_refused(tmp_path):
     with pytest.raises(JoystickError) as info:
         ReplaySource.from_file(str(bad), FakeClock())
     assert "not a joyfly recording" in str(info.value)
+
+
+def _recorded_session(tmp_path: Path) -> tuple[Path, list[tuple[float, tuple[int, ...], tuple[int, ...], bool]]]:
+    clock = FakeClock(10.0)
+    out = tmp_path / "session.jsonl"
+    src = record_to(ScriptSource.from_text(SCRIPT, clock), str(out))
+    seen = []
+    while src.source.state().connected:
+        state = src.poll(0.1)
+        seen.append((round(clock.now() - 10.0, 3), state.axes, state.buttons, state.connected))
+    src.close()
+    return out, seen
+
+
+def test_a_recording_header_says_what_the_file_is(tmp_path):
+    out, _ = _recorded_session(tmp_path)
+    header = json.loads(out.read_text().splitlines()[0])
+    assert header["joyfly_recording"] == 1 and header["name"] == "joyfly script"
+    assert "joyfly fly --joy" in header["about"]  # a reader of the file learns how to use it
+
+
+def test_a_recording_given_as_a_plain_path_replays_like_replay(tmp_path):
+    out, seen = _recorded_session(tmp_path)
+    for spec in (str(out), f"replay:{out}"):
+        clock = FakeClock(500.0)
+        replay = open_joystick(spec, clock)
+        assert isinstance(replay, ReplaySource) and replay.name == "joyfly script" and replay.path == str(out)
+        replayed = []
+        while replay.state().connected:
+            state = replay.poll(0.1)
+            replayed.append((round(clock.now() - 500.0, 3), state.axes, state.buttons, state.connected))
+        assert replayed == seen
+
+
+def test_record_to_an_unwritable_place_is_one_sentence(tmp_path):
+    for bad in (tmp_path, tmp_path / "no-such-dir" / "rec.jsonl"):
+        with pytest.raises(JoystickError) as info:
+            record_to(ScriptSource.from_text(SCRIPT, FakeClock()), str(bad))
+        text = str(info.value)
+        assert text.startswith(f"Cannot write the recording {bad} (") and text.endswith(".") and "\n" not in text
+
+
+def test_record_over_the_joystick_file_itself_is_refused(tmp_path):
+    script = tmp_path / "s.txt"
+    script.write_text(SCRIPT)
+    source = open_joystick(f"script:{script}", FakeClock())
+    with pytest.raises(JoystickError) as info:
+        record_to(source, str(script))
+    assert str(info.value) == (f"--record {script} would overwrite the joystick file it reads: "
+                               "record to another file.")
+    assert script.read_text() == SCRIPT
+
+
+@pytest.mark.parametrize(("body", "fragment"), [
+    ('{"t": "soon", "axes": [0], "buttons": []}', "line 2 is not a joystick record"),
+    ('{"t": 0, "axes": ["up"], "buttons": []}', "line 2 is not a joystick record"),
+    ('{"t": NaN, "axes": [0], "buttons": []}', "line 2 is not a joystick record"),
+    ('[1, 2]', "line 2 is not a joystick record"),
+    ('\n{"t": 0, "axes": [0]', "line 3 is not JSON"),
+    ("[" * 5000, "line 2 is not JSON"),
+])
+def test_a_damaged_recording_names_its_line(tmp_path, body, fragment):
+    rec = tmp_path / "rec.jsonl"
+    rec.write_text('{"joyfly_recording": 1, "name": "pad"}\n' + body + "\n")
+    for spec in (str(rec), f"replay:{rec}"):
+        with pytest.raises(JoystickError) as info:
+            open_joystick(spec, FakeClock())
+        text = str(info.value)
+        assert text.startswith(f"{rec} {fragment}") and text.endswith(": replay a file written by --record."), text
+
+
+def test_a_script_that_is_not_text_is_one_sentence(tmp_path):
+    script = tmp_path / "s.txt"
+    script.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(JoystickError) as info:
+        open_joystick(f"script:{script}", FakeClock())
+    assert str(info.value) == f"The script file {script} is not UTF-8 text: check the path after 'script:'."

@@ -35,6 +35,8 @@ CORE_MODULES = (
     "sitl_emu/physics.py",
     "sitl_emu/control/attitude.py",
     "sitl_emu/control/cascade.py",
+    "sitl_emu/control/control_math.py",
+    "sitl_emu/control/filters.py",
     "sitl_emu/control/hover.py",
     "sitl_emu/control/mixer.py",
     "sitl_emu/control/position.py",
@@ -58,7 +60,6 @@ DEFAULT_MODULES = (
     "sitl_emu/vehicle.py",
     "sitl_emu/vehicle_parts.py",
     "sitl_emu/geo.py",
-    "sitl_emu/floats.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.qmath import tilt_from_q
 from sitl_emu.params import ParamRegistry, default_registry
-from sitl_emu.physics import RigidBodyState, SihConfig, step
+from sitl_emu.params.settings import cascade_settings, sih_config
+from sitl_emu.physics import RigidBodyState, step
 from sitl_emu.types import AttitudeSetpoint, TrajectorySetpoint, Vec4
 
 SetpointFn = Callable[[float], TrajectorySetpoint | None]
@@ -37,8 +38,9 @@ class ClosedLoop:
     def __init__(self, registry: ParamRegistry | None = None, state: RigidBodyState | None = None,
                  flying: bool = False, dt_s: float = 0.004) -> None:
         self.registry = registry or default_registry()
-        self.cfg = SihConfig.from_params(self.registry)
-        self.control = MulticopterControl(self.registry)
+        self.cfg = sih_config(self.registry)
+        self.control = MulticopterControl(cascade_settings(self.registry))
+        self._settings_version = self.registry.version
         self.control.reset(flying=flying)
         self.state = state or RigidBodyState()
         self.dt_s = dt_s
@@ -52,6 +54,9 @@ class ClosedLoop:
         for k in range(round(duration_s / self.dt_s)):
             t = t0_s + k * self.dt_s
             att = attitude(t) if attitude else None
+            if self.registry.version != self._settings_version:  # a parameter changed: new controller settings
+                self._settings_version = self.registry.version
+                self.control.settings = cascade_settings(self.registry)
             motors = self.control.update(self.state, setpoint(t), att, armed, self.state.on_ground,
                                          self.now_us, self.dt_s)
             self.state = step(self.state, motors, self.dt_s, self.cfg)

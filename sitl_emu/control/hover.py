@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
-from sitl_emu.params import ParamRegistry
+from sitl_emu.control.qmath import constrain, isfinite
 
 G: Final = 9.80665
 NOISE_LEARNING_TAU_S: Final = 2.0
@@ -32,12 +32,6 @@ class HoverThrustSettings:
     vxy_thr: float = 10.0  # HTE_VXY_THR
     thr_range: float = 0.2  # HTE_THR_RANGE
 
-    @classmethod
-    def from_params(cls, reg: ParamRegistry) -> HoverThrustSettings:
-        g = reg.get
-        return cls(g("MPC_THR_HOVER"), g("HTE_HT_NOISE"), g("HTE_ACC_GATE"), g("HTE_HT_ERR_INIT"), g("HTE_VZ_THR"),
-                   g("HTE_VXY_THR"), g("HTE_THR_RANGE"))
-
 
 class HoverThrustEstimator:
     def __init__(self, settings: HoverThrustSettings | None = None) -> None:
@@ -55,7 +49,7 @@ class HoverThrustEstimator:
         self._gate_sq = s.gate ** 2
 
     def reset(self) -> None:
-        s = self.settings
+        s = self._settings
         self.estimate = min(0.9, max(0.1, s.initial))
         self.var = s.err_init * s.err_init
         self.valid = False
@@ -72,16 +66,15 @@ class HoverThrustEstimator:
     def update(self, thrust_up: float, acc_up_m_s2: float, vel_ned_m_s: tuple[float, float, float], dt_s: float,
                now_us: int) -> bool:
         """One in-air cycle; returns whether the estimate is valid (then the controller should use it)."""
-        if not (0.001 < dt_s < 1.0) or not math.isfinite(thrust_up):
+        if not (0.001 < dt_s < 1.0) or not isfinite(thrust_up):
             return self.valid
         s = self._settings
         self.var += s.process_noise * s.process_noise * dt_s * dt_s  # predict (as PX4: var += q dt^2)
-        # max(x, 1.0) and max(vz_coeff, vxy_coeff) as the exactly equivalent conditionals (runs at 125 Hz)
+        # trust the measurement less at speed: noise x (1 + the larger excess over HTE_VZ_THR / HTE_VXY_THR)^2
         vz_coeff = abs(vel_ned_m_s[2]) - s.vz_thr + 1.0
-        vz_coeff = 1.0 if vz_coeff < 1.0 else vz_coeff
         vxy_coeff = math.hypot(vel_ned_m_s[0], vel_ned_m_s[1]) - s.vxy_thr + 1.0
-        vxy_coeff = 1.0 if vxy_coeff < 1.0 else vxy_coeff
-        scale = (vxy_coeff if vxy_coeff > vz_coeff else vz_coeff) ** 2
+        coeff = vxy_coeff if vxy_coeff > vz_coeff else vz_coeff
+        scale = (coeff if coeff > 1.0 else 1.0) ** 2
         self._fuse(acc_up_m_s2, thrust_up, scale, dt_s)
         ok = self.var < VALID_VAR
         if ok and self._valid_since_us is None:
@@ -92,31 +85,27 @@ class HoverThrustEstimator:
         return self.valid
 
     def _fuse(self, acc_z: float, thrust: float, scale: float, dt_s: float) -> None:
+        """ZeroOrderHoverThrustEkf::fuseAccZ with the innovation gate, noise learning and large-offset recovery."""
         h = self.estimate
         jac = -G * thrust / (h * h)
         r = self._acc_var * scale
         innov_var = jac * self.var * jac + r
-        innov_var = r if r > innov_var else innov_var  # max(innov_var, r)
+        innov_var = r if r > innov_var else innov_var
         innov = acc_z - (G * thrust / h - G)
         ratio = innov * innov / (self._gate_sq * innov_var)
         residual = innov
-        if ratio < 1.0:  # min(hi, max(lo, x)) below is `m if m < hi else hi` with m = `x if x > lo else lo`
+        if ratio < 1.0:
             k = self.var * jac / innov_var
             lo, hi = self._bounds
-            est = h + k * innov
-            est = est if est > lo else lo
-            self.estimate = est = est if est < hi else hi
-            var = (1.0 - k * jac) * self.var
-            var = var if var > 1e-10 else 1e-10
-            self.var = var if var < 1.0 else 1.0
-            residual = acc_z - (G * thrust / est - G)
+            self.estimate = constrain(h + k * innov, lo, hi)
+            self.var = constrain((1.0 - k * jac) * self.var, 1e-10, 1.0)
+            residual = acc_z - (G * thrust / self.estimate - G)
         elif abs(self._ratio_lpf) > 0.2:  # large offset: bump the variance to recover
-            self.var += 1e3 * self.settings.process_noise ** 2 * dt_s
+            self.var += 1e3 * self._settings.process_noise ** 2 * dt_s
         alpha = dt_s / (LPF_TAU_S + dt_s)
         self._residual_lpf += alpha * (residual - self._residual_lpf)
-        self._ratio_lpf += alpha * (math.copysign(1.0 if ratio > 1.0 else ratio, innov) - self._ratio_lpf)
+        self._ratio_lpf += alpha * (math.copysign(ratio if ratio < 1.0 else 1.0, innov) - self._ratio_lpf)
         alpha_n = dt_s / (NOISE_LEARNING_TAU_S + dt_s)
         res = residual - self._residual_lpf
         acc_var = (1.0 - alpha_n) * self._acc_var + alpha_n * (res * res + jac * self.var * jac)
-        acc_var = acc_var if acc_var > 1.0 else 1.0
-        self._acc_var = acc_var if acc_var < 400.0 else 400.0
+        self._acc_var = constrain(acc_var, 1.0, 400.0)

@@ -1,4 +1,5 @@
-"""Quad-X control allocation after PX4's ControlAllocationSequentialDesaturation (MC_AIRMODE 0).
+"""Quad-X control allocation after PX4's ControlAllocationSequentialDesaturation (src/modules/control_allocator/
+ControlAllocation/ControlAllocationSequentialDesaturation.cpp, MC_AIRMODE 0: mixAirmodeDisabled).
 
 The effectiveness matrix of the 10040_sihsim_quadx airframe, pseudo-inverted and normalised as PX4 does
 (ControlAllocationPseudoInverse::updateControlAllocationMatrixScale), gives for rotors r0 front-right, r1 rear-left,
@@ -15,82 +16,89 @@ from __future__ import annotations
 import math
 from typing import Final
 
+from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3, Vec4
 
 _K: Final = 1.0 / math.sqrt(2.0)
-ROLL: Final = (-_K, _K, _K, -_K)
-PITCH: Final = (_K, -_K, _K, -_K)
-YAW: Final = (1.0, 1.0, -1.0, -1.0)
-THRUST: Final = (1.0, 1.0, 1.0, 1.0)
+# The effectiveness columns. Not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183).
+ROLL: Vec4 = (-_K, _K, _K, -_K)
+PITCH: Vec4 = (_K, -_K, _K, -_K)
+YAW: Vec4 = (1.0, 1.0, -1.0, -1.0)
+THRUST: Vec4 = (1.0, 1.0, 1.0, 1.0)
+YAW_HEADROOM: Final = 1.15  # mixYaw: some yaw authority above full thrust
+SATURATION_TOLERANCE: Final = 1e-4
+Flags3 = tuple[bool, bool, bool]
 _NO_SAT: Final = (False, False, False)
-# isfinite(x) is written `x - x == 0.0` (exact for floats: finite gives 0.0, inf and NaN give NaN): no call when
-# compiled by `make speedups` (mypyc has no isfinite primitive).
 
 
-def _desat_gain(vec: Vec4, u: list[float], lo: float, hi: float) -> float:
-    """ControlAllocationSequentialDesaturation::computeDesaturationGain."""
-    k_min = k_max = 0.0
-    for i in range(4):
-        d = vec[i]
-        if abs(d) < 1.2e-7:
-            continue
-        if u[i] < lo:
-            k = (lo - u[i]) / d
-            k_min, k_max = min(k_min, k), max(k_max, k)
-        if u[i] > hi:
-            k = (hi - u[i]) / d
-            k_min, k_max = min(k_min, k), max(k_max, k)
-    return k_min + k_max
-
-
-def _desaturate(u: list[float], vec: Vec4, lo: float, hi: float, reduce_only: bool = False) -> None:
-    gain = _desat_gain(vec, u, lo, hi)
-    if reduce_only and gain > 0.0:
-        return
-    for i in range(4):
-        u[i] += gain * vec[i]
-    gain = 0.5 * _desat_gain(vec, u, lo, hi)
-    for i in range(4):
-        u[i] += gain * vec[i]
-
-
-def mix(torque: Vec3, thrust: float) -> tuple[Vec4, tuple[bool, bool, bool], tuple[bool, bool, bool]]:
-    """Motor commands 0..1 for normalised torque (roll, pitch, yaw) and collective thrust 0..1.
+def mix(torque: Vec3, thrust: float) -> tuple[Vec4, Flags3, Flags3]:
+    """Motor commands 0..1 for normalised torque (roll, pitch, yaw) and collective thrust 0..1 (NaN counts as 0).
 
     Also returns per-axis positive/negative saturation flags (the torque achieved fell short of the demand), which
     the rate controller uses to stop integrating into the saturation.
     """
-    roll, pitch, yaw = torque  # every tick: no generators, no min()/max() on the fast path
-    roll = roll if roll - roll == 0.0 else 0.0
-    pitch = pitch if pitch - pitch == 0.0 else 0.0
-    yaw = yaw if yaw - yaw == 0.0 else 0.0
-    thrust = thrust if thrust - thrust == 0.0 else 0.0
-    r, p = _K * roll, _K * pitch
-    f0, f1, f2, f3 = thrust - r + p + yaw, thrust + r - p + yaw, thrust + r + p - yaw, thrust - r - p - yaw
-    # min(fast) >= 0 and max(fast) <= 1, with min()/max()'s own rule (a later item replaces only if < / >)
-    lo = f1 if f1 < f0 else f0
-    lo = f2 if f2 < lo else lo
-    lo = f3 if f3 < lo else lo
-    if lo >= 0.0:
-        hi = f1 if f1 > f0 else f0
-        hi = f2 if f2 > hi else hi
-        hi = f3 if f3 > hi else hi
-        if hi <= 1.0:  # nothing saturates: the plain mix
-            return (f0, f1, f2, f3), _NO_SAT, _NO_SAT
-    u = [thrust + ROLL[i] * roll + PITCH[i] * pitch for i in range(4)]
-    _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
-    _desaturate(u, ROLL, 0.0, 1.0)
-    _desaturate(u, PITCH, 0.0, 1.0)
+    roll, pitch, yaw = torque
+    roll, pitch, yaw = (roll if isfinite(roll) else 0.0, pitch if isfinite(pitch) else 0.0,
+                        yaw if isfinite(yaw) else 0.0)
+    thrust = thrust if isfinite(thrust) else 0.0
+    r, p = _K * roll, _K * pitch  # the ROLL and PITCH columns above, row by row
+    u = (thrust - r + p, thrust + r - p, thrust + r + p, thrust - r - p)
+    saturated = not _within(u, 1.0)
+    if saturated:  # unsaturate with thrust (reducing it only), then roll, then pitch
+        u = _desaturate(u, THRUST, 1.0, reduce_only=True)
+        u = _desaturate(u, ROLL, 1.0)
+        u = _desaturate(u, PITCH, 1.0)
+    u = (u[0] + yaw, u[1] + yaw, u[2] - yaw, u[3] - yaw)  # mixYaw: the YAW column
+    if not _within(u, 1.0):  # unsaturate with yaw (with headroom), then by reducing thrust
+        saturated = True
+        u = _desaturate(u, YAW, YAW_HEADROOM)
+        u = _desaturate(u, THRUST, 1.0, reduce_only=True)
+    if not saturated:  # every desaturation gain would be zero: the demand is met exactly
+        return u, _NO_SAT, _NO_SAT
+    out = (constrain(u[0], 0.0, 1.0), constrain(u[1], 0.0, 1.0), constrain(u[2], 0.0, 1.0), constrain(u[3], 0.0, 1.0))
+    positive, negative = _saturation_flags(allocated_torque(out), (roll, pitch, yaw))
+    return out, positive, negative
+
+
+def _within(u: Vec4, hi: float) -> bool:
+    """Every actuator within 0..hi (else computeDesaturationGain would be non-zero)."""
+    return 0.0 <= u[0] <= hi and 0.0 <= u[1] <= hi and 0.0 <= u[2] <= hi and 0.0 <= u[3] <= hi
+
+
+def _desaturation_gain(vec: Vec4, u: Vec4, hi: float) -> float:
+    """computeDesaturationGain: the gain along vec that brings the most saturated actuator back into 0..hi."""
+    k_min = k_max = 0.0
     for i in range(4):
-        u[i] += YAW[i] * yaw
-    _desaturate(u, YAW, 0.0, 1.15)
-    _desaturate(u, THRUST, 0.0, 1.0, reduce_only=True)
-    out = tuple(0.0 if v < 0.0 else (1.0 if v > 1.0 else v) for v in u)
-    achieved = allocated_torque(out)  # type: ignore[arg-type]
-    demand = (roll, pitch, yaw)
-    pos = tuple(achieved[i] < demand[i] - 1e-4 for i in range(3))
-    neg = tuple(achieved[i] > demand[i] + 1e-4 for i in range(3))
-    return out, pos, neg  # type: ignore[return-value]
+        if abs(vec[i]) < 1.2e-7:  # FLT_EPSILON: this axis cannot move this actuator
+            continue
+        if u[i] < 0.0:
+            k = -u[i] / vec[i]
+            k_min, k_max = min(k_min, k), max(k_max, k)
+        if u[i] > hi:
+            k = (hi - u[i]) / vec[i]
+            k_min, k_max = min(k_min, k), max(k_max, k)
+    return k_min + k_max
+
+
+def _desaturate(u: Vec4, vec: Vec4, hi: float, reduce_only: bool = False) -> Vec4:
+    """desaturateActuators: move u along vec to unsaturate, then by half of what is still saturated."""
+    gain = _desaturation_gain(vec, u, hi)
+    if reduce_only and gain > 0.0:
+        return u
+    u = _plus_scaled(u, vec, gain)
+    return _plus_scaled(u, vec, 0.5 * _desaturation_gain(vec, u, hi))
+
+
+def _plus_scaled(u: Vec4, vec: Vec4, gain: float) -> Vec4:
+    return u[0] + gain * vec[0], u[1] + gain * vec[1], u[2] + gain * vec[2], u[3] + gain * vec[3]
+
+
+def _saturation_flags(achieved: Vec3, demand: Vec3) -> tuple[Flags3, Flags3]:
+    """Per axis: the torque achieved fell short of a positive (negative) demand."""
+    tol = SATURATION_TOLERANCE
+    positive = (achieved[0] < demand[0] - tol, achieved[1] < demand[1] - tol, achieved[2] < demand[2] - tol)
+    negative = (achieved[0] > demand[0] + tol, achieved[1] > demand[1] + tol, achieved[2] > demand[2] + tol)
+    return positive, negative
 
 
 def allocated_torque(u: Vec4) -> Vec3:

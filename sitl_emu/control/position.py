@@ -1,4 +1,5 @@
-"""Multicopter position controller after PX4's PositionControl (src/modules/mc_pos_control/PositionControl/).
+"""Multicopter position controller after PX4's PositionControl (src/modules/mc_pos_control/PositionControl/
+PositionControl.cpp).
 
 Position P -> velocity PID -> acceleration -> thrust vector -> attitude setpoint, with PX4's rules:
 - validity (PositionControl.cpp _inputValid): every axis needs a position, velocity or acceleration setpoint, and x/y
@@ -14,18 +15,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from math import acos, cos, hypot, sin, sqrt
+from math import hypot, sqrt
 from typing import Final
 
-from sitl_emu.control.qmath import constrain, q_from_dcm_columns
-from sitl_emu.params import ParamRegistry
-from sitl_emu.types import NAN, NAN3, TrajectorySetpoint, Vec3, Vec4
+from sitl_emu.control.control_math import add_if_not_nan3, bodyz_to_attitude, constrain_xy, limit_tilt
+from sitl_emu.control.filters import LowPassDerivative
+from sitl_emu.control.qmath import constrain, emult, isfinite, norm, normalized, scale, sub
+from sitl_emu.types import TrajectorySetpoint, Vec3, Vec4
 
 G: Final = 9.80665  # CONSTANTS_ONE_G
 INVALID_HOLD_US: Final = 200_000  # MulticopterPositionControl LOITER_TIME_BEFORE_DESCEND hysteresis
-_TWO_PI: Final = 2.0 * math.pi  # (2 pi) fc dt, multiplied left to right as before
-# isfinite(x) is written `x - x == 0.0` on the per-tick path: the same for every float (finite: exactly 0.0; inf and
-# NaN: NaN) and, unlike a call, plain float arithmetic when compiled by `make speedups` (mypyc has no isfinite).
+THR_MIN_FLOOR: Final = 10e-4  # PositionControl::setThrustLimits: enough thrust to infer an attitude from
 
 
 @dataclass(frozen=True, slots=True)
@@ -45,34 +45,6 @@ class PositionControlSettings:
     tilt_max_lnd_rad: float = math.radians(12.0)
     veld_lp_hz: float = 5.0
     use_hte: bool = True
-
-    @classmethod
-    def from_params(cls, reg: ParamRegistry) -> PositionControlSettings:
-        g = reg.get
-        xy_p, xy_vp, xy_vi, xy_vd = g("MPC_XY_P"), g("MPC_XY_VEL_P_ACC"), g("MPC_XY_VEL_I_ACC"), g("MPC_XY_VEL_D_ACC")
-        tilt_air = min(g("MPC_TILTMAX_AIR"), 89.0)
-        return cls(
-            pos_p=(xy_p, xy_p, g("MPC_Z_P")), vel_p=(xy_vp, xy_vp, g("MPC_Z_VEL_P_ACC")),
-            vel_i=(xy_vi, xy_vi, g("MPC_Z_VEL_I_ACC")), vel_d=(xy_vd, xy_vd, g("MPC_Z_VEL_D_ACC")),
-            thr_hover=constrain(g("MPC_THR_HOVER"), g("MPC_THR_MIN"), g("MPC_THR_MAX")),
-            thr_min=g("MPC_THR_MIN"), thr_max=g("MPC_THR_MAX"), thr_xy_margin=g("MPC_THR_XY_MARG"),
-            vel_max_xy=g("MPC_XY_VEL_MAX"), vel_max_up=g("MPC_Z_VEL_MAX_UP"), vel_max_dn=g("MPC_Z_VEL_MAX_DN"),
-            tilt_max_air_rad=math.radians(tilt_air),
-            tilt_max_lnd_rad=math.radians(min(g("MPC_TILTMAX_LND"), tilt_air)),
-            veld_lp_hz=g("MPC_VELD_LP"), use_hte=bool(g("MPC_USE_HTE")),
-        )
-
-
-@dataclass(frozen=True, slots=True)
-class PositionLimits:
-    """Limits for one update (MulticopterPositionControl sets them every cycle)."""
-
-    vel_xy: float = 12.0
-    vel_up: float = 3.0  # may be negative at the start of the takeoff ramp
-    vel_dn: float = 1.5
-    tilt_rad: float = math.radians(45.0)
-    thr_min: float = 0.12
-    thr_max: float = 1.0
 
 
 @dataclass(slots=True)
@@ -111,16 +83,12 @@ class PositionOutput:
 
 
 def input_valid(sp: TrajectorySetpoint) -> bool:
-    """PX4 PositionControl::_inputValid (the estimate is always valid here)."""
-    p0, p1, p2 = sp.position_ned_m
-    v0, v1, v2 = sp.velocity_ned_m_s
-    a0, a1, a2 = sp.acceleration_ned_m_s2
-    fp0, fv0, fa0 = p0 - p0 == 0.0, v0 - v0 == 0.0, a0 - a0 == 0.0
-    fp1, fv1, fa1 = p1 - p1 == 0.0, v1 - v1 == 0.0, a1 - a1 == 0.0
-    if not (fp0 or fv0 or fa0) or not (fp1 or fv1 or fa1) or not (p2 - p2 == 0.0 or v2 - v2 == 0.0
-                                                                   or a2 - a2 == 0.0):
-        return False
-    return fp0 == fp1 and fv0 == fv1 and fa0 == fa1
+    """PositionControl::_inputValid (the estimate is always valid here)."""
+    pos, vel, acc = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
+    pos_x, vel_x, acc_x = isfinite(pos[0]), isfinite(vel[0]), isfinite(acc[0])
+    in_pairs = pos_x == isfinite(pos[1]) and vel_x == isfinite(vel[1]) and acc_x == isfinite(acc[1])
+    # every axis needs some setpoint (with x and y in pairs, x stands for both)
+    return in_pairs and (pos_x or vel_x or acc_x) and (isfinite(pos[2]) or isfinite(vel[2]) or isfinite(acc[2]))
 
 
 def failsafe_setpoint() -> TrajectorySetpoint:
@@ -128,113 +96,42 @@ def failsafe_setpoint() -> TrajectorySetpoint:
     return TrajectorySetpoint(velocity_ned_m_s=(0.0, 0.0, 0.0))
 
 
-def constrain_xy(v0x: float, v0y: float, v1x: float, v1y: float, vmax: float) -> tuple[float, float]:
-    """ControlMath::constrainXY: limit |v0 + v1| to vmax, keeping as much of v0 as possible."""
-    sx, sy = v0x + v1x, v0y + v1y
-    if hypot(sx, sy) <= vmax:
-        return sx, sy
-    n0 = hypot(v0x, v0y)
-    if n0 >= vmax:
-        return (v0x / n0 * vmax, v0y / n0 * vmax) if n0 > 0.0 else (0.0, 0.0)
-    if hypot(v1x - v0x, v1y - v0y) < 0.001:
-        return v0x / n0 * vmax, v0y / n0 * vmax
-    n1 = hypot(v1x, v1y)
-    if n0 < 0.001:
-        return v1x / n1 * vmax, v1y / n1 * vmax
-    ux, uy = v1x / n1, v1y / n1
-    m = ux * v0x + uy * v0y
-    c = v0x * v0x + v0y * v0y - vmax * vmax
-    s = -m + sqrt(m * m - c)
-    return v0x + ux * s, v0y + uy * s
-
-
-def limit_tilt(bz: Vec3, max_angle_rad: float) -> Vec3:
-    """ControlMath::limitTilt against the world z axis (0, 0, 1)."""
-    d = constrain(bz[2], -1.0, 1.0)
-    angle = acos(d)
-    angle = max_angle_rad if max_angle_rad < angle else angle  # min(acos(d), max_angle_rad)
-    rx, ry = bz[0], bz[1]
-    rn = hypot(rx, ry)
-    if rn * rn < 1.2e-7:  # FLT_EPSILON
-        rx, ry, rn = 1.0, 0.0, 1.0
-    s = sin(angle)
-    return s * rx / rn, s * ry / rn, cos(angle)
-
-
-def bodyz_to_attitude(bz: Vec3, yaw_rad: float) -> Vec4:
-    """ControlMath::bodyzToAttitude: attitude with body z along bz (world frame) and the given heading.
-
-    Written on scalars, it runs every position cycle: qmath's normalized, cross and (for a positive trace, the
-    usual case) q_from_dcm_columns with q_normalized are inlined in their operation order, zero components kept."""
-    z0, z1, z2 = bz
-    if z0 * z0 + z1 * z1 + z2 * z2 < 1.2e-7:
-        z0, z1, z2 = 0.0, 0.0, 1.0
-    n = sqrt(z0 * z0 + z1 * z1 + z2 * z2)
-    if n > 0.0:
-        z0, z1, z2 = z0 / n, z1 / n, z2 / n
-    else:
-        z0 = z1 = z2 = 0.0
-    y0, y1, y2 = -sin(yaw_rad), cos(yaw_rad), 0.0
-    x0, x1, x2 = y1 * z2 - y2 * z1, y2 * z0 - y0 * z2, y0 * z1 - y1 * z0  # cross(y_c, bz)
-    if z2 < 0.0:
-        x0, x1, x2 = -x0, -x1, -x2
-    if abs(z2) < 1e-6:
-        x0, x1, x2 = 0.0, 0.0, 1.0
-    n = sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-    if n > 0.0:
-        x0, x1, x2 = x0 / n, x1 / n, x2 / n
-    else:
-        x0 = x1 = x2 = 0.0
-    b0, b1, b2 = z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0  # by = cross(bz, bx)
-    tr = x0 + b1 + z2
-    if not tr > 0.0:
-        return q_from_dcm_columns((x0, x1, x2), (b0, b1, b2), (z0, z1, z2))
-    s = sqrt(tr + 1.0)
-    w = 0.5 * s
-    s = 0.5 / s
-    qx, qy, qz = (b2 - z1) * s, (z0 - x2) * s, (x1 - b0) * s
-    n = sqrt(w * w + qx * qx + qy * qy + qz * qz)
-    if not n > 0.0:
-        return 1.0, 0.0, 0.0, 0.0
-    return w / n, qx / n, qy / n, qz / n
-
-
-class VelocityDerivative:
-    """controllib BlockDerivative: finite difference through a first-order low-pass (MPC_VELD_LP)."""
-
-    def __init__(self) -> None:
-        self._prev: Vec3 | None = None
-        self._out: Vec3 = (0.0, 0.0, 0.0)
-
-    def reset(self) -> None:
-        self._prev = None
-        self._out = (0.0, 0.0, 0.0)
-
-    def update(self, vel: Vec3, dt_s: float, cutoff_hz: float) -> Vec3:
-        if self._prev is None or dt_s <= 0.0:
-            self._prev = vel
-            return self._out
-        b = _TWO_PI * cutoff_hz * dt_s
-        a = b / (1.0 + b) if cutoff_hz > 0.0 else 1.0
-        o0, o1, o2 = self._out
-        p0, p1, p2 = self._prev
-        v0, v1, v2 = vel
-        self._out = (o0 + a * ((v0 - p0) / dt_s - o0), o1 + a * ((v1 - p1) / dt_s - o1),
-                     o2 + a * ((v2 - p2) / dt_s - o2))
-        self._prev = vel
-        return self._out
-
-
 class PositionControl:
-    """One instance per vehicle; `update` is pure apart from the integrator, filter and failsafe memory."""
+    """One instance per vehicle; `update` is pure apart from the integrator, filter and failsafe memory.
+
+    As in PX4, the wrapper (cascade.py, MulticopterPositionControl's role) sets the limits before every update."""
 
     def __init__(self, settings: PositionControlSettings | None = None) -> None:
+        self._deriv = LowPassDerivative(0.0)
         self.settings = settings or PositionControlSettings()
-        self.hover_thrust = self.settings.thr_hover
-        self._vel_int: list[float] = [0.0, 0.0, 0.0]
-        self._deriv = VelocityDerivative()
+        s = self.settings
+        self.hover_thrust = s.thr_hover
+        self.set_velocity_limits(s.vel_max_xy, s.vel_max_up, s.vel_max_dn)
+        self.set_thrust_limits(s.thr_min, s.thr_max)
+        self.set_tilt_limit(s.tilt_max_air_rad)
+        self._vel_int: Vec3 = (0.0, 0.0, 0.0)
         self._last_valid: TrajectorySetpoint | None = None
         self._invalid_since_us: int | None = None
+
+    @property
+    def settings(self) -> PositionControlSettings:
+        return self._settings
+
+    @settings.setter
+    def settings(self, s: PositionControlSettings) -> None:
+        self._settings = s
+        self._deriv.cutoff_hz = s.veld_lp_hz
+
+    def set_velocity_limits(self, horizontal: float, up: float, down: float) -> None:
+        """m/s; `up` may be negative at the start of the takeoff ramp (it then still pushes down)."""
+        self._lim_vel_xy, self._lim_vel_up, self._lim_vel_dn = horizontal, up, down
+
+    def set_thrust_limits(self, minimum: float, maximum: float) -> None:
+        self._lim_thr_min = minimum if minimum > THR_MIN_FLOOR else THR_MIN_FLOOR
+        self._lim_thr_max = maximum
+
+    def set_tilt_limit(self, tilt_rad: float) -> None:
+        self._lim_tilt = tilt_rad
 
     def reset(self) -> None:
         self.reset_integral()
@@ -243,7 +140,7 @@ class PositionControl:
         self._invalid_since_us = None
 
     def reset_integral(self) -> None:
-        self._vel_int = [0.0, 0.0, 0.0]
+        self._vel_int = (0.0, 0.0, 0.0)
 
     def set_hover_thrust(self, hover: float) -> None:
         self.hover_thrust = hover
@@ -251,7 +148,8 @@ class PositionControl:
     def update_hover_thrust(self, hover_new: float, acc_sp_z: float) -> None:
         """PositionControl::updateHoverThrust: change the hover thrust without a thrust step (integrator absorbs)."""
         if hover_new > 1.2e-7:
-            self._vel_int[2] += (acc_sp_z - G) * self.hover_thrust / hover_new + G - acc_sp_z
+            i0, i1, i2 = self._vel_int
+            self._vel_int = (i0, i1, i2 + ((acc_sp_z - G) * self.hover_thrust / hover_new + G - acc_sp_z))
             self.hover_thrust = hover_new
 
     def select_setpoint(self, sp: TrajectorySetpoint, now_us: int) -> tuple[TrajectorySetpoint, bool]:
@@ -265,114 +163,88 @@ class PositionControl:
             return self._last_valid, False
         return failsafe_setpoint(), True
 
-    def update(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, limits: PositionLimits,
-               dt_s: float, now_us: int) -> PositionOutput:
-        return self.update_with(pos, vel, yaw_rad, sp, dt_s, now_us, limits.vel_xy, limits.vel_up, limits.vel_dn,
-                                limits.tilt_rad, limits.thr_min, limits.thr_max)
+    def update(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, dt_s: float,
+               now_us: int) -> PositionOutput:
+        """One cycle (PositionControl::update and getAttitudeSetpoint)."""
+        vel_dot = self._deriv.update(vel, dt_s)
+        sp, in_failsafe = self.select_setpoint(sp, now_us)
+        vel_sp = self._position_control(pos, sp)
+        acc_sp, thrust_sp = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, dt_s)
+        yaw_sp = sp.yaw_rad if isfinite(sp.yaw_rad) else yaw_rad  # no yaw setpoint: keep the heading
+        yawspeed_sp = sp.yawspeed_rad_s if isfinite(sp.yawspeed_rad_s) else 0.0
+        q_sp = bodyz_to_attitude(scale(thrust_sp, -1.0), yaw_sp)  # ControlMath::thrustToAttitude
+        return PositionOutput(thrust_sp, q_sp, norm(thrust_sp), yaw_sp, yawspeed_sp, in_failsafe, sp.position_ned_m,
+                              vel_sp, acc_sp)
 
-    def update_with(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, dt_s: float, now_us: int,
-                    vel_xy: float, vel_up: float, vel_dn: float, tilt_rad: float, thr_min: float,
-                    thr_max: float) -> PositionOutput:
-        """`update` with the PositionLimits fields passed as floats (the cascade's path: no limits object)."""
-        vel_dot = self._deriv.update(vel, dt_s, self.settings.veld_lp_hz)
-        if sp is self._last_valid:  # select_setpoint's answer for the same (immutable, valid) setpoint object
-            self._invalid_since_us, in_failsafe = None, False
-        else:
-            sp, in_failsafe = self.select_setpoint(sp, now_us)
-        vel_sp = self._position_control(pos, sp, vel_xy, vel_up, vel_dn)
-        acc_sp, thr = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, tilt_rad, thr_min,
-                                             thr_max, dt_s)
-        yaw_sp, yawspeed = sp.yaw_rad, sp.yawspeed_rad_s
-        yaw_sp = yaw_sp if yaw_sp - yaw_sp == 0.0 else yaw_rad
-        yawspeed = yawspeed if yawspeed - yawspeed == 0.0 else 0.0
-        t0, t1, t2 = thr
-        collective = sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        q_sp = bodyz_to_attitude((-t0, -t1, -t2), yaw_sp)
-        return PositionOutput(thr, q_sp, collective, yaw_sp, yawspeed, in_failsafe, sp.position_ned_m, vel_sp, acc_sp)
+    def _position_control(self, pos: Vec3, sp: TrajectorySetpoint) -> Vec3:
+        """PositionControl::_positionControl: P on the position error plus the velocity feed-forward, limited."""
+        vel_sp_position = emult(sub(sp.position_ned_m, pos), self._settings.pos_p)  # NaN where not controlled
+        vel_sp = add_if_not_nan3(sp.velocity_ned_m_s, vel_sp_position)
+        p_x, p_y = vel_sp_position[0], vel_sp_position[1]
+        p_xy = (p_x if isfinite(p_x) else 0.0, p_y if isfinite(p_y) else 0.0)  # setZeroIfNan
+        ff_xy = (vel_sp[0] - p_xy[0], vel_sp[1] - p_xy[1])
+        vel_sp_x, vel_sp_y = constrain_xy(p_xy, ff_xy, self._lim_vel_xy)  # the position term first
+        return vel_sp_x, vel_sp_y, constrain(vel_sp[2], -self._lim_vel_up, self._lim_vel_dn)
 
-    def _position_control(self, pos: Vec3, sp: TrajectorySetpoint, vel_xy: float, vel_up: float,
-                          vel_dn: float) -> Vec3:
-        k0, k1, k2 = self.settings.pos_p
-        p0, p1, p2 = sp.position_ned_m
-        f0, f1, f2 = sp.velocity_ned_m_s
-        x0, x1, x2 = pos
-        v0, v1, v2 = (p0 - x0) * k0, (p1 - x1) * k1, (p2 - x2) * k2  # NaN where not controlled
-        # ControlMath::addIfNotNan(feed-forward, P term)
-        s0 = (f0 + v0 if v0 - v0 == 0.0 else f0) if f0 - f0 == 0.0 else v0
-        s1 = (f1 + v1 if v1 - v1 == 0.0 else f1) if f1 - f1 == 0.0 else v1
-        s2 = (f2 + v2 if v2 - v2 == 0.0 else f2) if f2 - f2 == 0.0 else v2
-        v0 = v0 if v0 - v0 == 0.0 else 0.0
-        v1 = v1 if v1 - v1 == 0.0 else 0.0
-        vx, vy = constrain_xy(v0, v1, s0 - v0, s1 - v1, vel_xy)
-        lo = -vel_up
-        return vx, vy, lo if s2 < lo else (vel_dn if s2 > vel_dn else s2)
+    def _velocity_control(self, vel: Vec3, vel_dot: Vec3, vel_sp: Vec3, acc_ff: Vec3,
+                          dt_s: float) -> tuple[Vec3, Vec3]:
+        """PositionControl::_velocityControl: velocity PID -> acceleration -> thrust, with the anti-windups.
 
-    def _velocity_control(self, vel: Vec3, vel_dot: Vec3, vel_sp: Vec3, acc_ff: Vec3, tilt_rad: float,
-                          thr_min: float, thr_max: float, dt_s: float) -> tuple[Vec3, Vec3]:
-        """Velocity PID -> acceleration -> thrust, with the anti-windups; flat on scalars (the hot path)."""
-        s = self.settings
-        kp0, kp1, kp2 = s.vel_p
-        kd0, kd1, kd2 = s.vel_d
-        integ = self._vel_int
-        e0, e1, e2 = vel_sp[0] - vel[0], vel_sp[1] - vel[1], vel_sp[2] - vel[2]
-        f0, f1, f2 = acc_ff
-        a0 = e0 * kp0 + integ[0] - vel_dot[0] * kd0
-        a1 = e1 * kp1 + integ[1] - vel_dot[1] * kd1
-        a2 = e2 * kp2 + integ[2] - vel_dot[2] * kd2
-        a0 = (f0 + a0 if a0 - a0 == 0.0 else f0) if f0 - f0 == 0.0 else a0  # addIfNotNan(feed-forward, PID)
-        a1 = (f1 + a1 if a1 - a1 == 0.0 else f1) if f1 - f1 == 0.0 else a1
-        a2 = (f2 + a2 if a2 - a2 == 0.0 else f2) if f2 - f2 == 0.0 else a2
-        # acceleration -> thrust: body z = limit_tilt(normalized((-a0, -a1, G)), tilt_rad), inlined
-        z0, z1 = -a0, -a1
-        n = sqrt(z0 * z0 + z1 * z1 + G * G)
-        if n > 0.0:
-            z0, z1, z2 = z0 / n, z1 / n, G / n
-        else:
-            z0 = z1 = z2 = 0.0
-        z2 = -1.0 if z2 < -1.0 else (1.0 if z2 > 1.0 else z2)
-        angle = acos(z2)
-        angle = tilt_rad if tilt_rad < angle else angle  # min(acos(z), tilt_rad)
-        rn = hypot(z0, z1)
-        if rn * rn < 1.2e-7:  # FLT_EPSILON
-            z0, z1, rn = 1.0, 0.0, 1.0
-        sn = sin(angle)
-        z0, z1, z2 = sn * z0 / rn, sn * z1 / rn, cos(angle)
-        h = self.hover_thrust
-        c = (a2 * (h / G) - h) / z2
-        tmin = 10e-4 if thr_min < 10e-4 else thr_min  # max(thr_min, 10e-4)
-        c = -tmin if -tmin < c else c  # min(c, -tmin)
-        t0, t1, t2 = z0 * c, z1 * c, z2 * c
-        if (t2 >= -tmin and e2 >= 0.0) or (t2 <= -thr_max and e2 <= 0.0):
-            e2 = 0.0  # vertical anti-windup
-        # saturation: prioritise vertical thrust but keep MPC_THR_XY_MARG for horizontal control
-        xy = hypot(t0, t1)
-        tmax2 = thr_max * thr_max
-        margin = s.thr_xy_margin
-        allocated_xy = margin if margin < xy else xy  # min(xy, margin)
-        rem = tmax2 - allocated_xy * allocated_xy
-        lo = -sqrt(0.0 if rem < 0.0 else rem)  # -sqrt(max(rem, 0))
-        t2 = lo if lo > t2 else t2  # max(t2, lo)
-        rem = tmax2 - t2 * t2
-        xy_max = sqrt(0.0 if rem < 0.0 else rem)
+        Returns the acceleration setpoint and the thrust setpoint."""
+        s = self._settings
+        e = sub(vel_sp, vel)  # the velocity error
+        kp, i, kd = s.vel_p, self._vel_int, s.vel_d
+        acc_sp_velocity = (e[0] * kp[0] + i[0] - vel_dot[0] * kd[0], e[1] * kp[1] + i[1] - vel_dot[1] * kd[1],
+                           e[2] * kp[2] + i[2] - vel_dot[2] * kd[2])  # PID: P e + I - D d(vel)/dt
+        acc_sp = add_if_not_nan3(acc_ff, acc_sp_velocity)
+        thrust_sp = self._acceleration_control(acc_sp)
+        err_x, err_y, err_z = e
+        # vertical anti-windup: no integration into a saturated vertical thrust
+        if ((thrust_sp[2] >= -self._lim_thr_min and err_z >= 0.0)
+                or (thrust_sp[2] <= -self._lim_thr_max and err_z <= 0.0)):
+            err_z = 0.0
+        thrust_sp = self._saturate_thrust(thrust_sp)
+        # horizontal tracking anti-windup (Rundqwist): feed back the acceleration the thrust could not produce
+        k = G / self.hover_thrust
+        produced_x, produced_y = thrust_sp[0] * k, thrust_sp[1] * k
+        if acc_sp[0] * acc_sp[0] + acc_sp[1] * acc_sp[1] > produced_x * produced_x + produced_y * produced_y:
+            arw_gain = 2.0 / s.vel_p[0]
+            err_x -= arw_gain * (acc_sp[0] - produced_x)
+            err_y -= arw_gain * (acc_sp[1] - produced_y)
+        i_x, i_y, i_z = self._vel_int
+        self._vel_int = (_integrate(i_x, err_x, s.vel_i[0], dt_s), _integrate(i_y, err_y, s.vel_i[1], dt_s),
+                         constrain(_integrate(i_z, err_z, s.vel_i[2], dt_s), -G, G))
+        return acc_sp, thrust_sp
+
+    def _acceleration_control(self, acc_sp: Vec3) -> Vec3:
+        """PositionControl::_accelerationControl: the thrust vector for acc_sp, hover thrust balancing gravity."""
+        body_z = limit_tilt(normalized((-acc_sp[0], -acc_sp[1], G)), self._lim_tilt)
+        hover = self.hover_thrust
+        thrust_ned_z = acc_sp[2] * (hover / G) - hover
+        collective = thrust_ned_z / body_z[2]  # projected onto the body z axis
+        collective = -self._lim_thr_min if -self._lim_thr_min < collective else collective  # at least the minimum
+        return scale(body_z, collective)
+
+    def _saturate_thrust(self, thrust_sp: Vec3) -> Vec3:
+        """Prioritise vertical thrust, keeping MPC_THR_XY_MARG of it for horizontal control."""
+        t_x, t_y, t_z = thrust_sp
+        xy = hypot(t_x, t_y)
+        thr_max_sq = self._lim_thr_max * self._lim_thr_max
+        margin = self._settings.thr_xy_margin
+        allocated_xy = margin if margin < xy else xy  # the horizontal thrust kept, at most the margin
+        t_z_max_sq = thr_max_sq - allocated_xy * allocated_xy
+        t_z_lim = -sqrt(t_z_max_sq if t_z_max_sq > 0.0 else 0.0)
+        t_z = t_z_lim if t_z_lim > t_z else t_z  # the vertical thrust left beside it
+        xy_max_sq = thr_max_sq - t_z * t_z
+        xy_max = sqrt(xy_max_sq if xy_max_sq > 0.0 else 0.0)  # the horizontal thrust left
         if xy > xy_max:
-            t0, t1 = t0 / xy * xy_max, t1 / xy * xy_max
-        # horizontal tracking anti-windup: feed back the part of the demand the thrust could not produce
-        k = G / h
-        prod_x, prod_y = t0 * k, t1 * k
-        if a0 * a0 + a1 * a1 > prod_x * prod_x + prod_y * prod_y:
-            arw = 2.0 / kp0
-            e0 -= arw * (a0 - prod_x)
-            e1 -= arw * (a1 - prod_y)
-        ki0, ki1, ki2 = s.vel_i
-        if e0 - e0 == 0.0:
-            integ[0] += e0 * ki0 * dt_s
-        if e1 - e1 == 0.0:
-            integ[1] += e1 * ki1 * dt_s
-        if e2 - e2 == 0.0:
-            integ[2] += e2 * ki2 * dt_s
-        i2 = integ[2]
-        integ[2] = -G if i2 < -G else (G if i2 > G else i2)
-        return (a0, a1, a2), (t0, t1, t2)
+            t_x, t_y = t_x / xy * xy_max, t_y / xy * xy_max
+        return t_x, t_y, t_z
 
 
-__all__ = ["NAN", "NAN3", "PositionControl", "PositionControlSettings", "PositionLimits", "PositionOutput"]
+def _integrate(integral: float, error: float, gain: float, dt_s: float) -> float:
+    """One integrator step; a NaN error (an axis not controlled) leaves the integral as it is."""
+    return integral + error * gain * dt_s if isfinite(error) else integral
+
+
+__all__ = ["PositionControl", "PositionControlSettings", "PositionOutput"]

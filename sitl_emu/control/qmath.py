@@ -26,10 +26,11 @@ def q_inv(q: Vec4) -> Vec4:
 
 
 def q_normalized(q: Vec4) -> Vec4:
-    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    w, x, y, z = q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
     if not n > 0.0:
         return 1.0, 0.0, 0.0, 0.0
-    return q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    return w / n, x / n, y / n, z / n
 
 
 def q_canonical(q: Vec4) -> Vec4:
@@ -46,7 +47,9 @@ def dcm_z(q: Vec4) -> Vec3:
 def q_from_two_vectors(src: Vec3, dst: Vec3) -> Vec4:
     """Shortest rotation taking src onto dst (PX4 Quaternion(src, dst) constructor)."""
     cx, cy, cz = cross(src, dst)
-    d = dot(src, dst)
+    sx, sy, sz = src
+    dx, dy, dz = dst
+    d = sx * dx + sy * dy + sz * dz  # src . dst
     if math.sqrt(cx * cx + cy * cy + cz * cz) < 1e-5 and d < 0.0:
         # 180 degrees: rotate about any axis orthogonal to src
         ax, ay, az = abs(src[0]), abs(src[1]), abs(src[2])
@@ -56,7 +59,7 @@ def q_from_two_vectors(src: Vec3, dst: Vec3) -> Vec4:
             axis = (0.0, 1.0, 0.0) if ay < az else (0.0, 0.0, 1.0)
         cx, cy, cz = cross(src, axis)
         return q_normalized((0.0, cx, cy, cz))
-    return q_normalized((d + math.sqrt(dot(src, src) * dot(dst, dst)), cx, cy, cz))
+    return q_normalized((d + math.sqrt((sx * sx + sy * sy + sz * sz) * (dx * dx + dy * dy + dz * dz)), cx, cy, cz))
 
 
 def q_from_dcm_columns(bx: Vec3, by: Vec3, bz: Vec3) -> Vec4:
@@ -85,6 +88,7 @@ def q_from_dcm_columns(bx: Vec3, by: Vec3, bz: Vec3) -> Vec4:
 
 
 def q_from_yaw(yaw_rad: float) -> Vec4:
+    """A level attitude with the given heading."""
     return math.cos(yaw_rad / 2.0), 0.0, 0.0, math.sin(yaw_rad / 2.0)
 
 
@@ -101,11 +105,11 @@ def euler_from_q(q: Vec4) -> Vec3:
     w, x, y, z = q
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    yaw = math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-    return roll, pitch, yaw
+    return roll, pitch, yaw_from_q(q)
 
 
 def yaw_from_q(q: Vec4) -> float:
+    """Heading in radians (the yaw of the ZYX Euler angles)."""
     w, x, y, z = q
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
@@ -116,16 +120,36 @@ def tilt_from_q(q: Vec4) -> float:
 
 
 def rotate_world_to_body(q: Vec4, v: Vec3) -> Vec3:
-    """R^T v."""
-    return q_mul(q_mul(q_inv(q), (0.0, *v)), q)[1:]  # type: ignore[return-value]
+    """R^T v: a world-frame (NED) vector in the body frame (FRD), R being the rotation matrix of q."""
+    w, x, y, z = q
+    v0, v1, v2 = v
+    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
+    r10, r11, r12 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)
+    r20, r21, r22 = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)
+    return r00 * v0 + r10 * v1 + r20 * v2, r01 * v0 + r11 * v1 + r21 * v2, r02 * v0 + r12 * v1 + r22 * v2
 
 
-def dot(a: Vec3, b: Vec3) -> float:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+def add(a: Vec3, b: Vec3) -> Vec3:
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2]
+
+
+def sub(a: Vec3, b: Vec3) -> Vec3:
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
+
+
+def scale(a: Vec3, k: float) -> Vec3:
+    return a[0] * k, a[1] * k, a[2] * k
+
+
+def emult(a: Vec3, b: Vec3) -> Vec3:
+    """Element-wise product (PX4 Vector3f::emult)."""
+    return a[0] * b[0], a[1] * b[1], a[2] * b[2]
 
 
 def cross(a: Vec3, b: Vec3) -> Vec3:
-    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+    a0, a1, a2 = a
+    b0, b1, b2 = b
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
 def norm(a: Vec3) -> float:
@@ -133,10 +157,27 @@ def norm(a: Vec3) -> float:
 
 
 def normalized(a: Vec3) -> Vec3:
-    n = norm(a)
-    return (a[0] / n, a[1] / n, a[2] / n) if n > 0.0 else (0.0, 0.0, 0.0)
+    a0, a1, a2 = a
+    n = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+    return (a0 / n, a1 / n, a2 / n) if n > 0.0 else (0.0, 0.0, 0.0)
+
+
+def isfinite(x: float) -> bool:
+    """math.isfinite for a float. Written as arithmetic because `make speedups` (mypyc) has no primitive for
+    math.isfinite: a call would box the float into a Python object on every use. x - x is 0.0 for every finite x and
+    NaN for inf and NaN."""
+    return x - x == 0.0
 
 
 def constrain(v: float, lo: float, hi: float) -> float:
     """Like PX4's math::constrain: NaN passes through."""
     return lo if v < lo else (hi if v > hi else v)
+
+
+def constrain3(v: Vec3, lo: Vec3, hi: Vec3) -> Vec3:
+    """Element-wise constrain (PX4 matrix::constrain)."""
+    v0, v1, v2 = v
+    l0, l1, l2 = lo
+    h0, h1, h2 = hi
+    return (l0 if v0 < l0 else (h0 if v0 > h0 else v0), l1 if v1 < l1 else (h1 if v1 > h1 else v1),
+            l2 if v2 < l2 else (h2 if v2 > h2 else v2))

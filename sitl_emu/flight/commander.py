@@ -13,10 +13,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import Enum
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.mode_intention import ModeIntention
-from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
 from sitl_emu.types import NAN, HomePosition, OffboardControlMode, Vec3

@@ -9,8 +9,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
-from sitl_emu.floats import isfinite
 from sitl_emu.px4 import (
     MODE_FLAG_AUTO_ENABLED,
     MODE_FLAG_CUSTOM_MODE_ENABLED,

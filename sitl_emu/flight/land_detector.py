@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
-from sitl_emu.floats import isfinite
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 

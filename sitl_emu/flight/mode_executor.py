@@ -17,10 +17,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Final
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.tasks import SetpointType
-from sitl_emu.floats import isfinite
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity

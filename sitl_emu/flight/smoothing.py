@@ -13,8 +13,7 @@ import math
 from collections.abc import Sequence
 from typing import Final
 
-from sitl_emu.control.qmath import constrain
-from sitl_emu.floats import isfinite
+from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3
 
 _EPS: Final = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it

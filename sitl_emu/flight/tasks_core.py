@@ -16,10 +16,9 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any, Final
 
-from sitl_emu.control.qmath import constrain
+from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.smoothing import PositionSmoother
-from sitl_emu.floats import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3

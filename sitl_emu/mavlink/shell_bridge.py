@@ -6,6 +6,8 @@ bytes are written to it and the sender becomes the reply target. Without the RES
 the write (a message with flags 0 ends the session).
 Shell (pxh.cpp run_remote_pxh): no prompt on start; every input byte > 3 is echoed; on '\\n' it prints "\\n", runs
 the line, then prints the prompt "pxh> ". Log output (vehicle events) shows up in the session while it is open.
+A command that keeps printing (`listener -n N`) runs to its end before the prompt, as process_line() blocks in PX4;
+bytes that arrive meanwhile wait and are handled after it, as they wait in the shell's input pipe in PX4.
 Output (mavlink_main.cpp handleMavlinkShellOutput): SERIAL_CONTROL {device 10, flags REPLY, timeout 0, baudrate 0,
 count <= 70}. PX4 sends one chunk per 1.5 ms main-loop pass; we send up to CHUNKS_PER_TICK per tick so long outputs
 (`param show`) arrive as quickly.
@@ -41,6 +43,7 @@ class ShellBridge:
         self._shell: Shell | None = None
         self._line = bytearray()
         self._out = bytearray()
+        self._waiting_input = bytearray()  # arrived while a command still runs
         self._last_seq = -1
 
     @property
@@ -68,9 +71,13 @@ class ShellBridge:
         self._shell = None
         self._line.clear()
         self._out.clear()
+        self._waiting_input.clear()
 
     def _write(self, data: bytes, ctx: Any) -> None:
-        for byte in data:
+        for i, byte in enumerate(data):
+            if self._shell is not None and self._shell.busy:
+                self._waiting_input += data[i:][: max(0, MAX_LINE - len(self._waiting_input))]
+                return
             if byte == 0x0A:
                 self._run_line(ctx)
             elif byte > 3 and len(self._line) < MAX_LINE:
@@ -85,13 +92,16 @@ class ShellBridge:
         self._collect_events(ctx)
         self._out += self._shell.execute(line).encode("utf-8", errors="replace")
         self._collect_events(ctx)
-        self._out += PROMPT
+        if not self._shell.busy:
+            self._out += PROMPT
 
     # --- transmit ----------------------------------------------------------------------------------------------
     def tick(self, ctx: Any) -> None:
         if self._shell is None:
             return
         self._collect_events(ctx)
+        if self._shell.busy:
+            self._continue_command(ctx)
         for _ in range(CHUNKS_PER_TICK):
             if not self._out:
                 break
@@ -100,6 +110,16 @@ class ShellBridge:
             data = list(chunk) + [0] * (MAX_CHUNK - len(chunk))
             ctx.send(ENCODER.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
                                                    len(chunk), data))
+
+    def _continue_command(self, ctx: Any) -> None:
+        """Output of the running command; when it has ended, the prompt and then the input that waited for it."""
+        assert self._shell is not None
+        self._out += self._shell.poll().encode("utf-8", errors="replace")
+        if not self._shell.busy:
+            self._out += PROMPT
+            waiting = bytes(self._waiting_input)
+            self._waiting_input.clear()
+            self._write(waiting, ctx)
 
     def _collect_events(self, ctx: Any) -> None:
         events = ctx.vehicle.events_after(self._last_seq)

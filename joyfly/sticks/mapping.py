@@ -18,10 +18,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from joyfly.joystick import AXIS_MAX, JoystickError, open_joystick
-from joyfly.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.sticks.joystick import AXIS_MAX, JoystickError, open_joystick
+from joyfly.sticks.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.sticks.virtual import record_to
 from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
-from joyfly.virtual import record_to
 
 HOLD_EPS_S = 1e-6  # held times are float sums of poll intervals: 10 x 0.1 s must count as 1 s
 
@@ -204,14 +204,13 @@ class MappedSource:
 def open_sticks(spec: str, clock: Clock | None = None, profile: str = "auto",
                 overrides: Mapping[str, Any] | None = None, record: str | None = None,
                 dev_dir: str = "/dev/input") -> MappedSource:
-    """One call for `joyfly fly`: open `--joy` (path, script:, replay:), pick the profile (`--profile`, the config's
-    `[profile]` table), optionally `--record`, and map. Raises JoystickError (one sentence) on any problem."""
+    """One call for `joyfly fly`: open `--joy` (path, raw:, script:, replay:), pick the profile (`--profile`, the
+    config's `[profile]` table), optionally `--record`, and map. Raises JoystickError (one sentence) on any problem."""
     source = open_joystick(spec, clock, dev_dir=dev_dir)
     try:
         chosen = load_profile(profile, source.name, overrides)
+        source = record_to(source, record) if record else source
     except JoystickError:
         source.close()
         raise
-    if record:
-        source = record_to(source, record)
     return MappedSource(source, chosen)

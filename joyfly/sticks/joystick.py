@@ -1,17 +1,18 @@
-"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS.
+"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS (the record format: joyfly/sticks/js_events.py).
 
-A js device (`/dev/input/jsN`) delivers 8-byte `struct js_event {u32 time_ms; s16 value; u8 type; u8 number}`
-records (include/uapi/linux/joystick.h). Axes run -32767..32767 (up on a stick is negative), buttons 1/0.
-On open, and again after the kernel's 64-event queue overflows, the driver re-sends the whole state as events
-flagged JS_EVENT_INIT (buttons first, then axes).
-
-`open_joystick(spec, clock)` returns a `JoystickSource` for:
+`open_joystick(spec, clock)` returns a `JoystickSource` for what `--joy` names:
   - a js device: name and axis/button counts come from the JSIOCGNAME/JSIOCGAXES/JSIOCGBUTTONS ioctls; a read error
     (ENODEV: unplugged) gives `connected=False`, and the device is reopened automatically when it comes back;
   - a FIFO of js_event records (`mkfifo`): opened without blocking even when no writer exists yet; until the first
     writer connects and after it closes, `connected=False`; a new writer is picked up again;
-  - a regular file of js_event records: read like `tail -f` (events appended later are picked up);
-  - `script:FILE` and `replay:FILE`: virtual joysticks, see joyfly/virtual.py.
+  - a pseudo-terminal carrying js_event records (e.g. `socat` forwarding a remote joystick), read like a device;
+  - a recording written by `--record` (its first line says so): replayed, as `replay:FILE` does;
+  - `raw:FILE`: a file of js_event records the user vouches for (e.g. `cat /dev/input/js0 > FILE`), read like
+    `tail -f` (events appended later are picked up); raw: also takes a character device that is no joystick;
+  - `script:FILE` and `replay:FILE`: virtual joysticks, see joyfly/sticks/virtual.py.
+Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (a text file, a
+binary: joyfly cannot tell records from bytes that merely parse), a directory, a character device that answers
+neither the js ioctls nor is a pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer.
 For a FIFO or a file the counts grow as events arrive and the name is the path.
 """
 
@@ -24,20 +25,38 @@ import logging
 import os
 import select
 import stat
-import struct
-import time
 from dataclasses import dataclass
 
+from joyfly.clock import WallClock
+from joyfly.sticks.js_events import (
+    AXIS_MAX,
+    EVENT_FORMAT,
+    EVENT_SIZE,
+    JS_EVENT_AXIS,
+    JS_EVENT_BUTTON,
+    JS_EVENT_INIT,
+    DeviceVanishedError,
+    JoystickError,
+    JsEvent,
+    JsStateTracker,
+    NoDeviceError,
+    PermissionDeniedError,
+    pack_event,
+    parse_events,
+    permission_error,
+    vanished_error,
+)
+from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
 
-log = logging.getLogger(__name__)
+__all__ = [  # the record format is re-exported: callers import the joystick side from here
+    "AXIS_MAX", "EVENT_FORMAT", "EVENT_SIZE", "JS_EVENT_AXIS", "JS_EVENT_BUTTON", "JS_EVENT_INIT", "DeviceInfo",
+    "DeviceVanishedError", "JoystickError", "JsDevice", "JsEvent", "JsStateTracker",
+    "NoDeviceError", "PermissionDeniedError", "default_device", "find_device_paths", "list_devices", "open_joystick",
+    "pack_event", "parse_events", "probe_fd",
+]
 
-JS_EVENT_BUTTON = 0x01
-JS_EVENT_AXIS = 0x02
-JS_EVENT_INIT = 0x80
-EVENT_FORMAT = "IhBB"
-EVENT_SIZE = struct.calcsize(EVENT_FORMAT)  # 8
-AXIS_MAX = 32767
+log = logging.getLogger(__name__)
 
 # ioctl numbers (asm-generic/ioctl.h): _IOC(dir, type, nr, size) = dir << 30 | size << 16 | type << 8 | nr
 _IOC_READ = 2
@@ -56,22 +75,6 @@ JSIOCGBUTTONS = _ior(0x12, 1)
 JSIOCGNAME = _ior(0x13, NAME_LEN)
 
 
-class JoystickError(Exception):
-    """A joystick problem a user can fix; str() is one sentence saying what happened and what to do."""
-
-
-class NoDeviceError(JoystickError):
-    """Nothing at the path (lists the js devices that do exist, or says there are none)."""
-
-
-class PermissionDeniedError(JoystickError):
-    """The device exists but we may not read it."""
-
-
-class DeviceVanishedError(JoystickError):
-    """The device went away while in use (unplugged, out of radio range)."""
-
-
 def no_such_device_error(path: str, dev_dir: str = "/dev/input") -> JoystickError:
     others = [p for p in find_device_paths(dev_dir) if p != path]
     if others:
@@ -80,86 +83,6 @@ def no_such_device_error(path: str, dev_dir: str = "/dev/input") -> JoystickErro
         f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a virtual one with "
         "--joy script:examples/joystick_script.txt."
     )
-
-
-def permission_error(path: str) -> JoystickError:
-    return PermissionDeniedError(
-        f"Permission denied opening {path}: run `sudo chmod a+rw {path}` for now, or add yourself to the input group "
-        "(`sudo usermod -aG input $USER`, then log in again) or write a udev rule."
-    )
-
-
-def vanished_error(path: str) -> JoystickError:
-    return DeviceVanishedError(f"The joystick {path} vanished (unplugged?): plug it back in and joyfly reopens it.")
-
-
-# ---------------------------------------------------------------------------------------------------------- events
-
-
-@dataclass(frozen=True, slots=True)
-class JsEvent:
-    time_ms: int
-    value: int
-    type: int
-    number: int
-
-    @property
-    def is_init(self) -> bool:
-        return bool(self.type & JS_EVENT_INIT)
-
-
-def pack_event(kind: int, number: int, value: int, time_ms: int = 0) -> bytes:
-    """One js_event record; kind is JS_EVENT_AXIS or JS_EVENT_BUTTON (or'ed with JS_EVENT_INIT if wanted)."""
-    return struct.pack(EVENT_FORMAT, time_ms & 0xFFFFFFFF, value, kind, number)
-
-
-def parse_events(data: bytes) -> tuple[list[JsEvent], bytes]:
-    """Split bytes into whole js_event records; returns (events, leftover bytes of a partial record)."""
-    whole = len(data) - len(data) % EVENT_SIZE
-    events = [JsEvent(*rec) for rec in struct.iter_unpack(EVENT_FORMAT, data[:whole])]
-    return events, data[whole:]
-
-
-class JsStateTracker:
-    """Axes and buttons state built from js_events; lists grow when an index beyond the known count arrives."""
-
-    def __init__(self, n_axes: int = 0, n_buttons: int = 0) -> None:
-        self.axes = [0] * n_axes
-        self.buttons = [0] * n_buttons
-        self.events_seen = 0
-
-    def apply(self, ev: JsEvent) -> None:
-        kind = ev.type & ~JS_EVENT_INIT
-        if kind == JS_EVENT_AXIS:
-            _set_grow(self.axes, ev.number, max(-AXIS_MAX, min(AXIS_MAX, ev.value)))
-        elif kind == JS_EVENT_BUTTON:
-            _set_grow(self.buttons, ev.number, 1 if ev.value else 0)
-        else:
-            return
-        self.events_seen += 1
-
-    def state(self, time_s: float, connected: bool) -> JoyState:
-        return JoyState(time_s=time_s, axes=tuple(self.axes), buttons=tuple(self.buttons), connected=connected)
-
-
-def _set_grow(values: list[int], index: int, value: int) -> None:
-    if index >= len(values):
-        values.extend([0] * (index + 1 - len(values)))
-    values[index] = value
-
-
-# ---------------------------------------------------------------------------------------------------------- clocks
-
-
-class MonotonicClock:
-    """The wall clock (monotonic seconds): the default when no clock is injected (joyfly.clock has the others)."""
-
-    def now(self) -> float:
-        return time.monotonic()
-
-    def sleep(self, seconds: float) -> None:
-        if seconds > 0:
-            time.sleep(seconds)
 
 
 # ---------------------------------------------------------------------------------------------------------- device
@@ -171,7 +94,7 @@ class DeviceInfo:
     name: str
     axes: int
     buttons: int
-    kind: str  # "device", "fifo" or "file"
+    kind: str  # "device", "fifo" or "file" (what open_source_fd accepts)
 
 
 def _open_fd(path: str, dev_dir: str = "/dev/input") -> int:
@@ -193,7 +116,51 @@ def _kind_of(fd: int) -> str:
         return "device"
     if stat.S_ISFIFO(mode):
         return "fifo"
-    return "file"
+    if stat.S_ISREG(mode):
+        return "file"
+    return "directory" if stat.S_ISDIR(mode) else "other"
+
+
+# Linux's Unix98 pty slaves (/dev/pts/N): UNIX98_PTY_SLAVE_MAJOR 136 and the 7 majors after it
+# (include/uapi/linux/major.h, UNIX98_PTY_MAJOR_COUNT 8).
+PTY_SLAVE_MAJORS = range(136, 144)
+JOYSTICKS = "a /dev/input/js* device, a FIFO of js_event records, or script:FILE"
+
+
+def _is_joystick_or_pty(fd: int) -> bool:
+    """A joystick driver answers JSIOCGVERSION (drivers/input/joydev.c); a pty is a stream someone set up."""
+    try:
+        fcntl.ioctl(fd, JSIOCGVERSION, b"\0" * 4)
+        return True
+    except OSError:
+        return os.major(os.fstat(fd).st_rdev) in PTY_SLAVE_MAJORS
+
+
+def refusal(fd: int, path: str, raw: bool = False) -> str | None:
+    """Why the open file `fd` cannot be a joystick (one sentence), or None when it can; `raw` (the `raw:` spec) takes
+    the user's word for a regular file or a character device."""
+    kind = _kind_of(fd)
+    if kind == "directory":
+        return f"{path} is a directory, not a joystick: pass {JOYSTICKS}."
+    if kind == "other":
+        return f"{path} is neither a joystick device nor a FIFO: pass {JOYSTICKS}."
+    if raw or kind == "fifo" or (kind == "device" and _is_joystick_or_pty(fd)):
+        return None
+    if kind == "file":
+        return (f"{path} is a regular file but not a joyfly recording (--record), so it is not read as a joystick: "
+                f"pass raw:{path} if it holds js_event records, else {JOYSTICKS}.")
+    return (f"{path} is a character device but not a joystick (it does not answer the joystick ioctls): pass a "
+            f"/dev/input/js* device, or raw:{path} if it really carries js_event records.")
+
+
+def open_source_fd(path: str, dev_dir: str = "/dev/input", raw: bool = False) -> int:
+    """Open path without blocking and check it can be a joystick; JoystickError (one sentence) when not."""
+    fd = _open_fd(path, dev_dir)
+    why = refusal(fd, path, raw)
+    if why is not None:
+        os.close(fd)
+        raise JoystickError(why)
+    return fd
 
 
 def _ioctl_u8(fd: int, request: int) -> int | None:
@@ -243,13 +210,15 @@ def list_devices(dev_dir: str = "/dev/input") -> list[DeviceInfo | JoystickError
 
 
 class JsDevice:
-    """A js device, a FIFO or a regular file of js_event records, read without ever blocking longer than asked."""
+    """A js device, a FIFO, a pty or (raw) a regular file of js_event records, read without ever blocking longer than
+    asked. Refuses at open what cannot be a joystick (see `refusal`), and again on every reopen."""
 
-    def __init__(self, path: str, clock: Clock, dev_dir: str = "/dev/input") -> None:
+    def __init__(self, path: str, clock: Clock, dev_dir: str = "/dev/input", raw: bool = False) -> None:
         self.path = path
         self.clock = clock
         self.dev_dir = dev_dir
-        self._fd: int | None = _open_fd(path, dev_dir)
+        self.raw = raw
+        self._fd: int | None = open_source_fd(path, dev_dir, raw)
         self.info = probe_fd(self._fd, path)
         self.name = self.info.name
         self.kind = self.info.kind
@@ -283,7 +252,7 @@ class JsDevice:
         """Try to open the path again (after the device vanished); True when it is back."""
         self._close_fd()
         try:
-            self._fd = _open_fd(self.path, self.dev_dir)
+            self._fd = open_source_fd(self.path, self.dev_dir, self.raw)
         except JoystickError as exc:
             if not (isinstance(exc, NoDeviceError) and isinstance(self.last_error, DeviceVanishedError)):
                 self.last_error = exc  # "vanished" stays the news until something else goes wrong
@@ -379,20 +348,24 @@ class JsDevice:
                 self._fd = None
 
 
+RAW_PREFIX = "raw:"
+
+
 def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/input") -> JoystickSource:
-    """A joystick source from `--joy`: a device/FIFO/file path, `script:FILE` or `replay:FILE`.
+    """A joystick source from `--joy`: a device/FIFO/pty path, a --record recording, `raw:FILE`, `script:FILE` or
+    `replay:FILE` (see the module docstring).
 
-    Raises JoystickError (one sentence with the fix) when it cannot be opened.
+    Raises JoystickError (one sentence with the fix) when it cannot be opened or cannot be a joystick.
     """
-    clock = clock or MonotonicClock()
+    clock = clock or WallClock()
     if spec.startswith("script:"):
-        from joyfly.virtual import ScriptSource
-
         return ScriptSource.from_file(spec[len("script:") :], clock)
     if spec.startswith("replay:"):
-        from joyfly.virtual import ReplaySource
-
         return ReplaySource.from_file(spec[len("replay:") :], clock)
+    if spec.startswith(RAW_PREFIX):
+        return JsDevice(spec[len(RAW_PREFIX) :], clock, dev_dir, raw=True)
+    if is_recording(spec):
+        return ReplaySource.from_file(spec, clock)
     return JsDevice(spec, clock, dev_dir)
 
 

@@ -14,23 +14,22 @@ import logging
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.failsafes import ExitPlan, Retry
-from joyfly.flight_session import (
+from joyfly.link.vehicle_link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER
+from joyfly.session.core import (
     MIN_SEND_GAP_S,
-    STREAMING_PHASES,
     FlightStats,
     Note,
     Phase,
-    SessionCore,
     SessionSettings,
     SessionView,
     StickSource,
     left_offboard_message,
     no_vehicle_message,
 )
-from joyfly.link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER
-from joyfly.mapping import fired
-from joyfly.setpoints import initial_setpoint, next_setpoint
+from joyfly.session.retry import ExitPlan, Retry
+from joyfly.session.watch import SessionWatch
+from joyfly.sticks.mapping import fired
+from joyfly.sticks.setpoints import initial_setpoint, next_setpoint
 from joyfly.types import Action
 
 __all__ = ["FlightSession", "FlightStats", "Note", "Phase", "SessionSettings", "SessionView", "StickSource"]
@@ -44,7 +43,7 @@ ARMABLE_MODES = ("AUTO.LOITER", "OFFBOARD")
 log = logging.getLogger(__name__)
 
 
-class FlightSession(SessionCore):
+class FlightSession(SessionWatch):
     """Run with `run()`; `request_exit()` (e.g. from SIGINT) performs the --on-exit action and finishes."""
 
     # --- the loop ----------------------------------------------------------------------------------------------
@@ -101,9 +100,11 @@ class FlightSession(SessionCore):
         self._last_tick_s = now
         if self.exit_requested and self.phase not in (Phase.EXITING, Phase.DONE, Phase.FAILED):
             self._begin_exit()
-        if self.phase is not Phase.CONNECTING and not self._watch_link(now):
-            self._tick_exit_timeout(now)
-            return
+        if self.phase is not Phase.CONNECTING:
+            self._watch_vehicle(now)
+            if not self._watch_link(now):
+                self._tick_exit_timeout(now)
+                return
         self._watch_joystick(now)
         if self.phase not in (Phase.EXITING, Phase.CONNECTING):
             self._handle_buttons()
@@ -114,51 +115,13 @@ class FlightSession(SessionCore):
     def _send_flight_setpoint(self) -> None:
         now = self.clock.now()
         assert self.sp is not None
-        if self._joy.holding or self.cmd.deadman_ok is False:
+        if self._joy.lost or self.cmd.deadman_ok is False:
             sp = replace(self.sp, vel_ned_m_s=(0.0, 0.0, 0.0) if self.sp.vel_ned_m_s is not None else None)
         else:
             dt = min(max(now - self._last_sp_s, 0.0), 0.2)
             sp = next_setpoint(self.sp, self.cmd, self._vehicle_pos(), dt, self.s.limits, self.fence,
                                self.link.state.vel_ned_m_s)
         self._send(sp)
-
-    # --- watchdogs -------------------------------------------------------------------------------------------
-
-    def _watch_link(self, now: float) -> bool:
-        change = self._linkw.update(self.link.state.link_ok(now))
-        if change == "lost":
-            self._note("warn", f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
-                               f"{self.link.transport.description}.")
-        elif change == "back":
-            self._note("info", "Link back: the vehicle answers again.")
-            self._on_link_back()
-        return self._linkw.ok
-
-    def _on_link_back(self) -> None:
-        st = self.link.state
-        if self.phase in STREAMING_PHASES:
-            if not st.armed:
-                self._set_phase(Phase.GROUNDED)
-            elif st.offboard:
-                self.sp = self._hold_here()
-            else:
-                self.sp = self._hold_here()
-                self._set_phase(Phase.RESUMING)
-
-    def _watch_joystick(self, now: float) -> None:
-        change = self._joy.update(self.cmd.connected, now)
-        if change == "lost" and self.phase is Phase.FLYING:
-            self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
-                               "unless it comes back.")
-            self.sp = self._hold_here()
-        elif change == "lost":
-            self._note("warn", "Joystick lost.")
-        elif change == "back":
-            self._note("info", "Joystick back: you have control again.")
-        if self._joy.expired(now) and self.phase is Phase.FLYING:
-            self._note("warn", f"Joystick still lost after {self.s.joy_timeout_s:g} s: landing.")
-            self.link.land()
-            self._set_phase(Phase.LANDING)
 
     # --- buttons -----------------------------------------------------------------------------------------------
 
@@ -197,16 +160,17 @@ class FlightSession(SessionCore):
             self.sp = self._hold_here()
         else:
             self._note("info", f"{why}: taking off to {self.s.alt_m:g} m.")
-            self._reset_home()
+            self._home_here()
             self.sp = initial_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, self.s.alt_m)
         self._prestreamed = 0
         self._hold_requests = 0
         self._set_phase(Phase.PRESTREAM)
 
-    def _reset_home(self) -> None:
-        st = self.link.state
-        home = st.home_ned_m if st.home_ned_m is not None and not st.armed else self._vehicle_pos()
-        self.fence = replace(self.fence, home_ned_m=home)
+    def _home_here(self) -> None:
+        """Centre the fence (and measure altitudes from) where joyfly arms the vehicle: PX4 sets its home there when
+        it arms (COM_HOME_EN, Commander::arm), so a HOME_POSITION read before arming is the last flight's home."""
+        self._home_from_vehicle = False
+        self.fence = replace(self.fence, home_ned_m=self._vehicle_pos())
 
     # --- phases --------------------------------------------------------------------------------------------------
 
@@ -233,6 +197,10 @@ class FlightSession(SessionCore):
         self._note("info", f"Connected to vehicle {st.sysid} on {self.link.transport.description} ({st.mode}, "
                            f"{'armed' if st.armed else 'disarmed'}).")
         self.link.request_home()
+        self._restarts_seen = st.restarts  # a restart before we flew is nothing to report
+        if st.armed:  # taking over a flight: PX4 set its home when it armed (until HOME_POSITION comes: here)
+            self._home_from_vehicle = True
+            self.fence = replace(self.fence, home_ned_m=st.home_ned_m or self._vehicle_pos())
         if self.exit_requested:
             self._set_phase(Phase.DONE)
         elif st.armed and st.offboard:
@@ -355,16 +323,25 @@ class FlightSession(SessionCore):
     def _grounded(self, now: float) -> None:
         if self.s.exit_when_landed:
             self._set_phase(Phase.DONE)
+        elif self._joy.lost:  # a script that ended, a joystick unplugged after the flight: nothing more to fly
+            self._note("info", "The joystick is gone and the vehicle is on the ground, disarmed: joyfly is done.")
+            self._set_phase(Phase.DONE)
 
     # --- exit ----------------------------------------------------------------------------------------------------
 
     def _begin_exit(self) -> None:
-        st = self.link.state
-        if self.phase is Phase.CONNECTING or not st.armed:
+        if self.phase is Phase.CONNECTING or not self._maybe_armed():
             self._set_phase(Phase.DONE)
             return
         self._note("info", f"Exiting: {self.s.on_exit} (press Ctrl-C again to quit at once).")
         self._set_phase(Phase.EXITING)
+
+    def _maybe_armed(self) -> bool:
+        """Armed, or an ARM was sent and not refused (PX4 ACKs it at once, the 1 Hz HEARTBEAT shows it later):
+        leaving then would leave an armed vehicle behind."""
+        handle = self._retry.handle if self.phase is Phase.ARMING and self._retry is not None else None
+        arming = handle is not None and (handle.accepted or not handle.done)
+        return self.link.state.armed or arming or self.phase is Phase.ENTERING
 
     def _exiting(self, now: float) -> None:
         if self._exit is None:

@@ -1,59 +1,17 @@
-"""Small state machines the flight session runs on its clock: the joystick and link watchdogs, and bounded
-command retries that explain a refusal with the vehicle's own words (COMMAND_ACK result + STATUSTEXT)."""
+"""Bounded command retries that explain a refusal with the vehicle's own words (COMMAND_ACK result + STATUSTEXT),
+and the plan joyfly carries out when it exits (--on-exit)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
 
-from joyfly.link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink
+from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink
 
 # PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
 REASON_GRACE_S = 0.25
 WARNING = 4  # MAV_SEVERITY_WARNING: CRITICAL "Arming denied: ..." and friends are below it
-
-
-class LinkWatch:
-    """Reports "lost" once the heartbeat watchdog fails and "back" when it recovers."""
-
-    def __init__(self) -> None:
-        self.ok = False
-
-    def update(self, ok: bool) -> str | None:
-        if ok == self.ok:
-            return None
-        self.ok = ok
-        return "back" if ok else "lost"
-
-
-class JoystickWatch:
-    """Tracks a lost joystick: "lost"/"back" on changes, `expired()` once after `timeout_s` lost."""
-
-    def __init__(self, timeout_s: float) -> None:
-        self.timeout_s = timeout_s
-        self.lost_since: float | None = None
-        self._fired = False
-
-    @property
-    def holding(self) -> bool:
-        return self.lost_since is not None
-
-    def update(self, connected: bool, now_s: float) -> str | None:
-        if connected and self.lost_since is not None:
-            self.lost_since = None
-            self._fired = False
-            return "back"
-        if not connected and self.lost_since is None:
-            self.lost_since = now_s
-            return "lost"
-        return None
-
-    def expired(self, now_s: float) -> bool:
-        if self.lost_since is None or self._fired or now_s - self.lost_since < self.timeout_s:
-            return False
-        self._fired = True
-        return True
 
 
 class Retry:
@@ -130,6 +88,9 @@ class Retry:
         return f"{self.what} failed after {self.attempt} attempt(s). {self.last_refusal}"
 
 
+EXIT_MODES = {"land": "AUTO.LAND", "rtl": "AUTO.RTL", "hold": "AUTO.LOITER"}  # where each --on-exit puts PX4
+
+
 class ExitPlan:
     """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
     until the vehicle is disarmed (land, rtl) or out of OFFBOARD (hold). The caller enforces the overall timeout."""
@@ -137,8 +98,15 @@ class ExitPlan:
     def __init__(self, on_exit: str, link: VehicleLink, now_s: float) -> None:
         self.on_exit = on_exit
         self.link = link
+        self.started_s = now_s
         self.retry = Retry(f"Exit action {on_exit}", 3, now_s, settle_s=math.inf)
         self._gave_up = False
+
+    @property
+    def commanded_mode(self) -> str | None:
+        """The mode the vehicle is in once it ACCEPTED the exit command (PX4 ACKs after switching), else None."""
+        handle = self.retry.handle
+        return EXIT_MODES.get(self.on_exit) if handle is not None and handle.accepted else None
 
     def _send(self) -> CommandHandle:
         if self.on_exit == "land":
@@ -148,8 +116,12 @@ class ExitPlan:
         return self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
 
     def done(self) -> bool:
+        """Out of OFFBOARD (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not
+        show in the 1 Hz HEARTBEAT yet)."""
         st = self.link.state
-        return not st.offboard if self.on_exit == "hold" else not st.armed
+        if self.on_exit == "hold":
+            return not st.offboard
+        return not st.armed and st.last_heartbeat_s is not None and st.last_heartbeat_s > self.started_s
 
     def update(self, now_s: float) -> str | None:
         """"done", a refusal to report, or None while in progress."""

@@ -1,6 +1,6 @@
 """The flight session's vocabulary and state: phases, settings, notes to the user, flight statistics, the view
 snapshot the live view draws, and `SessionCore`, the session's state with its small helpers. The behaviour (loop,
-watchdogs, buttons, phases) is `FlightSession` in joyfly/flight.py."""
+watchdogs, buttons, phases) is `FlightSession` in joyfly/session/flight_session.py."""
 
 from __future__ import annotations
 
@@ -11,14 +11,16 @@ from dataclasses import dataclass, field
 from enum import Enum
 from typing import Protocol
 
-from joyfly.failsafes import ExitPlan, JoystickWatch, LinkWatch, Retry
-from joyfly.link import VehicleLink, VehicleState
-from joyfly.setpoints import Fence, Limits, Setpoint, hold_setpoint
+from joyfly.link.vehicle_link import VehicleLink, VehicleState
+from joyfly.session.retry import ExitPlan, Retry
+from joyfly.session.watchdogs import JoystickWatch, LinkWatch
+from joyfly.sticks.setpoints import Fence, Limits, Setpoint, hold_setpoint
 from joyfly.types import Action, Clock, StickCommand
 
-log = logging.getLogger("joyfly.flight")
+log = logging.getLogger("joyfly.session.flight_session")
 
 MIN_SEND_GAP_S = 0.01  # stick changes are sent at once, at most 100 times a second (plus the stream's ticks)
+STALE_S = 0.5  # the vehicle's state is news while it keeps sending (PX4's ATTITUDE: 15-100 Hz); older is a guess
 
 
 class Phase(Enum):
@@ -99,13 +101,15 @@ class SessionView:
     statustexts: tuple[str, ...]
     notes: tuple[Note, ...]
     link_description: str
+    heard: bool = True  # a vehicle has answered
 
 
 def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None, st: VehicleState, fence: Fence,
-                 dt_s: float) -> FlightStats:
-    """Accumulate distance flown, closest approach to the fence (in the air) and time in OFFBOARD, while armed."""
+                 dt_s: float, now_s: float) -> FlightStats:
+    """Accumulate distance flown, closest approach to the fence (in the air) and time in OFFBOARD, while armed and
+    while the vehicle is heard (a link outage is not time in OFFBOARD: we do not know what it did)."""
     pos = st.pos_ned_m
-    if pos is None or not st.armed:
+    if pos is None or not st.armed or st.stamped_s is None or now_s - st.stamped_s > STALE_S:
         return stats
     dist = stats.distance_m + (math.dist(pos, prev_pos) if prev_pos is not None else 0.0)
     in_air = st.landed_state != 1
@@ -121,6 +125,16 @@ def no_vehicle_message(where: str, heard: bool, timeout_s: float) -> str:
                 "no position estimate yet; wait for it, then retry.")
     return (f"No HEARTBEAT from a vehicle on {where} after {timeout_s:g} s: start `sitl-emu serve` or PX4 SITL "
             "first (PX4 sends to UDP port 14540), or fix --url.")
+
+
+def restarted_message(st: VehicleState, quitting: bool) -> str:
+    """What a restart of the vehicle means for the user (its boot time went back)."""
+    before = f"{st.uptime_before_restart_s:.1f} s" if st.uptime_before_restart_s is not None else "?"
+    now = f"{st.boot_s:.1f} s" if st.boot_s is not None else "?"
+    then = "joyfly quits." if quitting else "press ARM or TAKEOFF to fly again, or Ctrl-C to quit."
+    return (f"The vehicle restarted (its time since boot went back from {before} to {now}): this flight is over. "
+            f"A restarted PX4 is disarmed; joyfly stopped sending setpoints and will not arm it again on its own: "
+            f"{then}")
 
 
 def left_offboard_message(mode: str, recent_texts: list[str]) -> str:
@@ -164,10 +178,19 @@ class SessionCore:
         self._last_immediate_s = -MIN_SEND_GAP_S
         self._hold_requests = 0
         self._hold_sent_s = -math.inf
+        self.armed_seen = False  # the vehicle was armed at some point of this session: there is a flight to sum up
+        self._restarts_seen = 0
+        self._restart_s = -math.inf  # when joyfly last reported a restart of the vehicle
+        self._home_from_vehicle = False  # True when joyfly took over a flying vehicle: its HOME_POSITION is home
 
     @property
     def finished(self) -> bool:
         return self.phase in (Phase.DONE, Phase.FAILED)
+
+    @property
+    def exit_mode(self) -> str | None:
+        """The mode the vehicle accepted for --on-exit (AUTO.LAND...), None before it did."""
+        return self._exit.commanded_mode if self._exit is not None else None
 
     def request_exit(self) -> None:
         """Perform --on-exit, then finish (the first Ctrl-C)."""
@@ -219,7 +242,7 @@ class SessionCore:
 
     def _update_stats(self, now: float) -> None:
         st = self.link.state
-        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s)
+        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s, now)
         self._last_pos = st.pos_ned_m
 
     def _note_once(self, text: str) -> None:
@@ -232,6 +255,7 @@ class SessionCore:
         return SessionView(
             time_s=now - self._start_s, phase=self.phase, link_ok=st.link_ok(now), mode=st.mode, armed=st.armed,
             landed_state=st.landed_state, pos_ned_m=st.pos_ned_m, setpoint=self.sp,
-            streaming=self._streaming_allowed(), stick=self.cmd, joystick_ok=not self._joy.holding,
+            streaming=self._streaming_allowed(), stick=self.cmd, joystick_ok=not self._joy.lost,
             fence=self.fence, stats=self.stats, statustexts=tuple(t.text for t in list(self.link.statustexts)[-5:]),
-            notes=tuple(self.notes[-5:]), link_description=self.link.transport.description)
+            notes=tuple(self.notes[-5:]), link_description=self.link.transport.description,
+            heard=st.last_heartbeat_s is not None)

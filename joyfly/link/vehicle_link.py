@@ -1,7 +1,7 @@
 """joyfly's MAVLink client: heartbeats as a GCS, commands with retries, setpoints out, the vehicle's state in.
 
 It speaks plain MAVLink 2 as any PX4 client does, so the same code flies real PX4 SITL and sitl-emu. The bytes go
-through a `Transport` (joyfly/transport.py: UDP in MAVROS fcu_url style, pymavlink connection strings, or an
+through a `Transport` (joyfly/link/transport.py: UDP in MAVROS fcu_url style, pymavlink connection strings, or an
 in-memory pair for tests).
 """
 
@@ -15,8 +15,8 @@ from typing import Any
 
 from pymavlink.dialects.v20 import common as mavlink2
 
-from joyfly.setpoints import FRAME_LOCAL_NED, Setpoint
-from joyfly.transport import Transport
+from joyfly.link.transport import Transport
+from joyfly.sticks.setpoints import FRAME_LOCAL_NED, Setpoint
 from joyfly.types import Clock
 
 log = logging.getLogger(__name__)
@@ -31,6 +31,9 @@ MAV_TYPE_ONBOARD_CONTROLLER = 18
 MAV_AUTOPILOT_INVALID = 8
 HEARTBEAT_PERIOD_S = 1.0
 LINK_TIMEOUT_S = 3.0  # as MAVSDK's DEFAULT_HEARTBEAT_TIMEOUT_S (core/mavsdk_impl.hpp)
+# A vehicle's time since boot (time_boot_ms of LOCAL_POSITION_NED, ATTITUDE, SYSTEM_TIME...) that goes back by more
+# than this means it restarted: UDP reorders by milliseconds, and PX4's streams stamp samples at most ~0.1 s old.
+RESTART_STEP_S = 1.0
 
 # MAV_CMD numbers (MAVLink common.xml)
 CMD_NAV_RETURN_TO_LAUNCH = 20
@@ -62,10 +65,6 @@ _AUTO_NAMES = {1: "AUTO.READY", 2: "AUTO.TAKEOFF", 3: "AUTO.LOITER", 4: "AUTO.MI
                6: "AUTO.LAND", 8: "AUTO.FOLLOW_TARGET", 9: "AUTO.PRECLAND", 20: "AUTO.DESCEND"}
 
 
-def custom_mode_of(main: int, sub: int = 0) -> int:
-    return (sub << 24) | (main << 16)
-
-
 def mode_name(custom_mode: int) -> str:
     """MAVROS-style name of a PX4 custom_mode ("OFFBOARD", "AUTO.LOITER"), "CMODE(n)" if unknown."""
     main, sub = (custom_mode >> 16) & 0xFF, (custom_mode >> 24) & 0xFF
@@ -92,6 +91,10 @@ class VehicleState:
     yaw_rad: float = 0.0
     landed_state: int = 0  # MAV_LANDED_STATE: 0 unknown, 1 on ground, 2 in air, 3 takeoff, 4 landing
     home_ned_m: tuple[float, float, float] | None = None
+    boot_s: float | None = None  # the vehicle's time since boot, from the latest time_boot_ms
+    stamped_s: float | None = None  # our time when that message arrived
+    restarts: int = 0  # times its boot time went back (it restarted) since we first heard it
+    uptime_before_restart_s: float | None = None  # its time since boot just before the last restart
 
     @property
     def mode(self) -> str:
@@ -187,6 +190,9 @@ class VehicleLink:
             return
         if self.state.sysid is None or msg.get_srcSystem() != self.state.sysid:
             return
+        boot_ms = getattr(msg, "time_boot_ms", None)
+        if boot_ms is not None and msg.get_srcComponent() == self.state.compid:
+            self._on_boot_time(boot_ms / 1000)
         handler = _HANDLERS.get(kind)
         if handler is not None:
             handler(self, msg)
@@ -203,6 +209,18 @@ class VehicleLink:
             return
         self.state = replace(self.state, last_heartbeat_s=self._clock.now(), armed=bool(msg.base_mode & 128),
                              custom_mode=msg.custom_mode, system_status=msg.system_status)
+
+    def _on_boot_time(self, boot_s: float) -> None:
+        """Track the vehicle's time since boot; when it goes back, the vehicle restarted: forget what we knew of the
+        flight before (a restarted PX4 is disarmed, its position and home are new) and count the restart."""
+        st = self.state
+        if st.boot_s is not None and boot_s < st.boot_s - RESTART_STEP_S:
+            log.info("vehicle restarted: time since boot went from %.3f s to %.3f s", st.boot_s, boot_s)
+            st = replace(VehicleState(), sysid=st.sysid, compid=st.compid, last_heartbeat_s=st.last_heartbeat_s,
+                         custom_mode=st.custom_mode, system_status=st.system_status, restarts=st.restarts + 1,
+                         uptime_before_restart_s=st.boot_s)
+        latest = boot_s if st.boot_s is None else max(st.boot_s, boot_s)
+        self.state = replace(st, boot_s=latest, stamped_s=self._clock.now())
 
     def _on_local_position(self, msg: Any) -> None:
         self.state = replace(self.state, pos_ned_m=(msg.x, msg.y, msg.z), vel_ned_m_s=(msg.vx, msg.vy, msg.vz))

@@ -35,8 +35,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from joyfly.joystick import AXIS_MAX, JoystickError
-from joyfly.types import Action, JoyState, StickCommand
+from joyfly.sticks.joystick import AXIS_MAX, JoystickError
+from joyfly.types import Action, JoyState
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -84,12 +84,6 @@ class Profile:
     def matches(self, device_name: str) -> bool:
         name = device_name.lower().strip()
         return any(fnmatch.fnmatchcase(name, pattern) for pattern in self.match)
-
-    def map(self, state: JoyState, prev: StickCommand | None = None) -> StickCommand:
-        """Raw state -> StickCommand (pure; hold times carried over from prev)."""
-        from joyfly.mapping import map_state
-
-        return map_state(self, state, prev)
 
 
 # ---------------------------------------------------------------------------------------------------------- built-in

@@ -8,39 +8,41 @@ Script format (one step a line; `#` starts a comment; blank lines are ignored)::
   previous line's time.
 - sticks, already in the flying convention (no profile signs, deadzone or expo apply): `forward` (+1 = fly north),
   `right` (+1 = fly east), `up` (+1 = climb, a centred throttle stick), `yaw` (+1 = turn clockwise), each -1..1.
-- buttons, 1 (down) or 0 (up): `arm` (hold it 1 s to arm, or to disarm once landed), `takeoff`, `land`, `rtl`
-  (alias `return`), `hold`, `offboard`, `deadman` (only acts when the profile configures a deadman button).
+- buttons, 1 (down) or 0 (up): `land`, `rtl` (alias `return`), `hold`, `offboard`, `takeoff`, `arm` (held 1 s),
+  `deadman` (only acts when the profile configures a deadman button). `joyfly fly` arms, takes off and enters
+  OFFBOARD by itself; `offboard`, `takeoff` and `arm` fly again after a hold, a return or a landing (`arm` held on
+  the ground while armed disarms).
 - `end`: the virtual joystick goes away (JoyState.connected False from then on, as if unplugged).
 Values hold until changed. A button press must last longer than the caller's poll period to be seen (0.2 s is safe).
 
-    # take off, fly 2 m/s forward for 3 s, land
-    0     arm=1
-    1.5   arm=0 takeoff=1
-    +0.3  takeoff=0
-    8     forward=1
+    # joyfly fly takes off by itself meanwhile; then 2 m/s north for 3 s (5 m/s at full stick), land
+    8     forward=0.4
     +3    forward=0
     +2    land=1
     +0.3  land=0
-    +8    end
+    +12   end
 
 A script source reports the name "joyfly script", which selects the built-in `script` profile: axes 0..3 = forward,
 right, up, yaw (scaled to +-32767 with the flying signs) and buttons 0..6 = arm, takeoff, land, rtl, hold, offboard,
 deadman.
 
-Recordings (`JoyRecorder`, `--record FILE`) are JSON lines: a header `{"joyfly_recording": 1, "name", "path"}`, then
-one `{"t", "axes", "buttons", "connected"}` line per change of the raw JoyState (t in seconds since the first
-record), and `{"t", "end": true}` on close. `replay:FILE` plays them back with their timing on the injected clock,
-under the recorded device name (so the same profile matches), and reports connected False after the end.
+Recordings (`JoyRecorder`, `--record FILE`) are JSON lines: a header `{"joyfly_recording": 1, "about", "name",
+"path"}` that says what the file is, then one `{"t", "axes", "buttons", "connected"}` line per change of the raw
+JoyState (t in seconds since the first record), and `{"t", "end": true}` on close. `replay:FILE`, or the file's
+path alone (`is_recording` knows it by its header), plays them back with their timing on the injected clock, under
+the recorded device name (so the same profile matches), and reports connected False after the end.
 """
 
 from __future__ import annotations
 
 import json
+import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
-from joyfly.joystick import AXIS_MAX, JoystickError
+from joyfly.sticks.js_events import AXIS_MAX, JoystickError
 from joyfly.types import Clock, JoyState, JoystickSource
 
 SCRIPT_NAME = "joyfly script"
@@ -194,9 +196,36 @@ def _read_text(path: str, what: str) -> str:
         raise JoystickError(f"No {what} file at {path}: check the path after '{what}:'.") from None
     except OSError as exc:
         raise JoystickError(f"Cannot read the {what} file {path} ({exc.strerror}): check the path.") from None
+    except UnicodeDecodeError:
+        raise JoystickError(f"The {what} file {path} is not UTF-8 text: check the path after '{what}:'.") from None
 
 
 # ---------------------------------------------------------------------------------------------------------- record
+
+RECORDING_KEY = "joyfly_recording"  # the header's first key, version 1
+RECORDING_ABOUT = "a joystick session recorded by joyfly --record: replay it with joyfly fly --joy FILE"
+HEADER_PEEK_BYTES = 4096
+
+
+def is_recording(path: str) -> bool:
+    """True when path is a regular file whose first line is a joyfly recording header (never reads a FIFO)."""
+    if not os.path.isfile(path):
+        return False
+    try:
+        with open(path, "rb") as fh:
+            first = fh.read(HEADER_PEEK_BYTES).split(b"\n", 1)[0]
+        header = json.loads(first)
+    except (OSError, ValueError, RecursionError):  # unreadable, not JSON: the caller's own checks say what it is
+        return False
+    return isinstance(header, dict) and header.get(RECORDING_KEY) == 1
+
+
+def _open_for_writing(path: str) -> IO[str]:
+    try:
+        return open(path, "w", encoding="utf-8")  # JoyRecorder.close() closes it
+    except OSError as exc:
+        raise JoystickError(f"Cannot write the recording {path} ({exc.strerror}): pass --record a file path in a "
+                            "directory you can write to.") from None
 
 
 class JoyRecorder:
@@ -204,11 +233,11 @@ class JoyRecorder:
 
     def __init__(self, out: str | IO[str], name: str, path: str) -> None:
         self._own = isinstance(out, str)
-        self._out: IO[str] = open(out, "w", encoding="utf-8") if isinstance(out, str) else out  # noqa: SIM115
+        self._out: IO[str] = _open_for_writing(out) if isinstance(out, str) else out
         self._t0: float | None = None
         self._last: tuple[tuple[int, ...], tuple[int, ...], bool] | None = None
         self._last_t = 0.0
-        self._write({"joyfly_recording": 1, "name": name, "path": path})
+        self._write({RECORDING_KEY: 1, "about": RECORDING_ABOUT, "name": name, "path": path})
 
     def record(self, state: JoyState) -> None:
         if self._t0 is None:
@@ -254,32 +283,70 @@ class RecordingSource:
 
 
 def record_to(source: JoystickSource, out: str | IO[str]) -> RecordingSource:
-    """`--record FILE`: the same source, also writing every change to out."""
+    """`--record FILE`: the same source, also writing every change to out (never over the file the source reads)."""
+    if isinstance(out, str) and _same_file(out, source.path):
+        raise JoystickError(f"--record {out} would overwrite the joystick file it reads: record to another file.")
     return RecordingSource(source, JoyRecorder(out, source.name, source.path))
+
+
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # either does not exist (yet)
+        return False
 
 
 # ---------------------------------------------------------------------------------------------------------- replay
 
 
 def parse_recording(text: str, source: str = "recording") -> tuple[str, list[Step]]:
-    """Recording text -> (recorded device name, Steps); the last step is connected False (the end)."""
-    lines = [ln for ln in text.splitlines() if ln.strip()]
-    try:
-        header = json.loads(lines[0]) if lines else {}
-        records = [json.loads(ln) for ln in lines[1:]]
-    except json.JSONDecodeError as exc:
-        raise JoystickError(f"{source} line {exc.lineno} is not JSON: replay a file written by --record.") from None
-    if header.get("joyfly_recording") != 1:
+    """Recording text -> (recorded device name, Steps); the last step is connected False (the end).
+    Raises JoystickError naming the file and line of the first thing that is not a recording."""
+    lines = _json_lines(text, source)
+    header = lines[0][1] if lines else None
+    if not isinstance(header, dict) or header.get(RECORDING_KEY) != 1:
         raise JoystickError(f"{source} is not a joyfly recording: replay a file written by --record.")
-    steps, last = [], Step(0.0, (), ())
-    for rec in records:
-        if rec.get("end"):
+    steps, last, end_t = [], Step(0.0, (), ()), None
+    for lineno, rec in lines[1:]:
+        last_or_end = _record_step(rec, f"{source} line {lineno}")
+        if isinstance(last_or_end, float):
+            end_t = last_or_end
             break
-        last = Step(float(rec["t"]), tuple(rec["axes"]), tuple(rec["buttons"]), bool(rec.get("connected", True)))
+        last = last_or_end
         steps.append(last)
-    end_t = max((float(r["t"]) for r in records if r.get("end")), default=last.t_s)
-    steps.append(Step(end_t, last.axes, last.buttons, connected=False))
+    steps.append(Step(last.t_s if end_t is None else end_t, last.axes, last.buttons, connected=False))
     return str(header.get("name", source)), steps
+
+
+def _json_lines(text: str, source: str) -> list[tuple[int, object]]:
+    out: list[tuple[int, object]] = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            out.append((lineno, json.loads(line)))
+        except (ValueError, RecursionError):  # JSONDecodeError, or nested too deep
+            raise JoystickError(f"{source} line {lineno} is not JSON: replay a file written by --record.") from None
+    return out
+
+
+def _record_step(rec: object, where: str) -> Step | float:
+    """One recorded line -> its Step, or the end's time (a float) for the `end` line."""
+    bad = JoystickError(f"{where} is not a joystick record of t, axes and buttons: replay a file written by --record.")
+    if not isinstance(rec, dict):
+        raise bad
+    try:
+        t = float(rec["t"])
+        if rec.get("end"):
+            out: Step | float = t
+        else:
+            axes, buttons = tuple(int(v) for v in rec["axes"]), tuple(int(v) for v in rec["buttons"])
+            out = Step(t, axes, buttons, bool(rec.get("connected", True)))
+    except (KeyError, TypeError, ValueError, OverflowError):
+        raise bad from None
+    if not math.isfinite(t):
+        raise bad
+    return out
 
 
 class ReplaySource(TimedSource):

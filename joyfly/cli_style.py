@@ -1,0 +1,74 @@
+"""The one style of joyfly's user errors: one line `joyfly: <what is wrong and what to do>` on stderr, a non-zero
+exit status, no traceback; click's own usage errors too (`OneLineGroup` turns them into `UserError`).
+
+sitl_emu/cli_options.py does the same for `sitl-emu` (the two packages do not import each other: DESIGN.md);
+change both.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import IO, Any
+
+import click
+
+TOOL = "joyfly"
+CONTEXT = {"help_option_names": ["-h", "--help"]}
+
+
+class UserError(click.ClickException):
+    """A mistake the user can fix, shown as one line `joyfly: sentence` on stderr; exit status 2."""
+
+    exit_code = 2
+
+    def show(self, file: IO[Any] | None = None) -> None:
+        click.echo(f"{TOOL}: {self.message}", err=True)
+
+
+class UserFailure(UserError):
+    """The same with exit status 1 (click.ClickException's status: a command that could not do its work)."""
+
+    exit_code = 1
+
+
+def one_line(err: click.ClickException) -> UserError:
+    """click's error as a UserError with its exit status; a usage error says where the help is."""
+    text = " ".join(err.format_message().split())
+    ctx = getattr(err, "ctx", None)
+    if isinstance(err, click.UsageError) and ctx is not None:
+        hint = f"see '{ctx.command_path} --help'"
+        text = f"{text} ({hint})" if text.endswith("?") else f"{text.rstrip('.')} ({hint})."
+    return UserFailure(text) if err.exit_code == 1 else UserError(text)
+
+
+class OneLineGroup(click.Group):
+    """A click group whose errors, click's usage errors included, are one line (`UserError`)."""
+
+    def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
+                     **extra: Any) -> click.Context:
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except UserError:
+            raise
+        except click.ClickException as err:
+            raise one_line(err) from None
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except UserError:
+            raise
+        except click.ClickException as err:
+            raise one_line(err) from None
+
+
+class FiniteRange(click.FloatRange):
+    """click.FloatRange that also refuses nan (nan compares false with both bounds, so FloatRange lets it through)."""
+
+    name = "float"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a number from {self.min:g} to {self.max:g}.", param, ctx)
+        return number

@@ -1,0 +1,93 @@
+"""Running a flight session for `joyfly fly` and `joyfly demo`: Ctrl-C/SIGTERM handling, then the closing words
+(what happened, the summary, or in what state the vehicle was left).
+
+The first Ctrl-C or SIGTERM asks the session to perform --on-exit; a second one quits at once (exit status 130).
+"""
+
+from __future__ import annotations
+
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import FrameType
+from typing import Any
+
+import click
+
+from joyfly.dashboard import summary_lines
+from joyfly.session.flight_session import FlightSession, Phase
+
+
+def fly_session(session: FlightSession, view: Any, out: Any) -> int:
+    """Run the session with Ctrl-C/SIGTERM handling, close everything, then say how it ended; returns the exit
+    status (0 done, 1 failed, 130 quit at once by a second Ctrl-C)."""
+    interrupted = False
+    try:
+        with exit_signals(session):
+            session.run(on_view=view.show)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        view.close(keep=session.link.state.last_heartbeat_s is not None)  # an empty view says nothing
+        session.link.close()
+        session.sticks.close()
+    if interrupted:
+        out.write(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}\n")
+        return 130
+    if session.armed_seen:
+        out.writelines(line + "\n" for line in summary_lines(session.stats))
+    elif session.phase is not Phase.FAILED:
+        out.write(f"joyfly: {nothing_flown(session)}\n")
+    if session.phase is Phase.FAILED:
+        click.echo(f"joyfly: {session.error}", err=True)
+        return 1
+    return 0
+
+
+def nothing_flown(session: FlightSession) -> str:
+    """The closing sentence of a session that ended before the vehicle was ever armed."""
+    st = session.link.state
+    if st.last_heartbeat_s is None:
+        return f"Stopped before a vehicle answered on {session.link.transport.description}; nothing was flown."
+    return f"Stopped before arming; nothing was flown (the vehicle is disarmed in {st.mode})."
+
+
+# What PX4 does next in the mode joyfly leaves it in (px4-behaviour.md 4.3 for OFFBOARD without setpoints)
+_NEXT = {
+    "AUTO.LAND": "it lands and disarms by itself.",
+    "AUTO.RTL": "it returns to its home, lands and disarms by itself.",
+    "AUTO.LOITER": "it holds position until a ground station takes over.",
+    "OFFBOARD": "with no more setpoints, PX4's offboard-loss failsafe takes over within COM_OF_LOSS_T (1 s; "
+                "Return in SITL without RC).",
+}
+
+
+def left_behind(session: FlightSession) -> str:
+    """In what state joyfly leaves the vehicle when it quits at once, and what the vehicle does next."""
+    st = session.link.state
+    if st.last_heartbeat_s is None:
+        return "no vehicle had answered; nothing was flown."
+    heard = "" if st.link_ok(session.clock.now()) else " (as last heard)"
+    if not st.armed:
+        return f"the vehicle was left disarmed in {st.mode}{heard}."
+    mode = session.exit_mode if st.offboard and session.exit_mode else st.mode  # the HEARTBEAT trails the ACK
+    return f"the vehicle was left armed in {mode}{heard}: {_NEXT.get(mode, 'take over with a ground station.')}"
+
+
+@contextmanager
+def exit_signals(session: FlightSession) -> Iterator[None]:
+    """First SIGINT/SIGTERM: ask the session to perform --on-exit; the second: KeyboardInterrupt, at once."""
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        if session.exit_requested:
+            raise KeyboardInterrupt
+        session.request_exit()
+
+    previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+

@@ -1,0 +1,1 @@
+"""The flight session: one FlightSession (connect, pre-stream, arm, OFFBOARD, stream, watchdogs, clean exit)."""

@@ -1,0 +1,1 @@
+"""The stick side: joystick sources (js API, FIFO, raw file, script, replay), profiles, mapping, setpoints."""
