@@ -7,7 +7,8 @@ Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (400
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
  4. control cascade: setpoint -> motor commands (zero when disarmed or terminated);
  5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
- 6. land detector on the new estimate -> commander ("Takeoff detected" / "Landing detected");
+ 6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
+    "Landing detected");
  7. events: the task's messages join the event stream.
 Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
 on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
@@ -112,10 +113,11 @@ class Vehicle:
         motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
         motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
-        self._estimate = self._estimate_from(self._state)
+        self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
         climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
         detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
-        c.on_land_detector(detected.landed, detected.maybe_landed)
+        if detected is not None:
+            c.on_land_detector(detected.landed, detected.maybe_landed)
         for severity, text in out.messages:
             self._emit(severity, "navigator", text, True, True)
 
@@ -137,9 +139,8 @@ class Vehicle:
             self._sih, self._sih_version = sih_config(self.params), self.params.version
         return self._sih
 
-    def _estimate_from(self, truth: RigidBodyState) -> RigidBodyState:
-        if self._noise_m <= 0.0:
-            return truth
+    def _with_noise(self, truth: RigidBodyState) -> RigidBodyState:
+        """The estimate: the truth with seeded Gaussian noise on the position."""
         n = self._rng.normal(0.0, self._noise_m, 3)
         p = truth.pos_ned_m
         est = RigidBodyState(**{f: getattr(truth, f) for f in RIGID_BODY_FIELDS})

@@ -39,7 +39,6 @@ class ControlChain:
         # the land detector runs when now_us >= _land_next_us (every LAND_DETECTOR_PERIOD_US) or when arming changed
         self._land_next_us = -(1 << 62)
         self._land_armed = False
-        self._land_state = self._detector.state
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
         """What the navigator task sees (tasks_core.NavInput)."""
@@ -57,17 +56,18 @@ class ControlChain:
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)
 
-    def land(self, est: RigidBodyState, armed: bool, climb_rate_controlled: bool, now_us: int) -> LandDetectorState:
-        """The land detector's state after this tick: it runs on the new state at 50 Hz, and at once when arming
-        changes.
+    def land(self, est: RigidBodyState, armed: bool, climb_rate_controlled: bool,
+             now_us: int) -> LandDetectorState | None:
+        """Run the land detector on the new state when it is due: at 50 Hz, and at once when arming changes. Its new
+        state (PX4's vehicle_land_detected), or None when it did not run this tick.
 
         `climb_rate_controlled` is PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard
         position/velocity/acceleration (not offboard attitude/rates, not manual modes)."""
         if now_us < self._land_next_us and armed == self._land_armed:
-            return self._land_state
+            return None
         self._land_next_us, self._land_armed = now_us + LAND_DETECTOR_PERIOD_US, armed
         ctrl = self.control
-        state = self._land_state = self._detector.update(LandDetectorInput(
+        state = self._detector.update(LandDetectorInput(
             time_us=now_us, armed=armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
             specific_force_norm_m_s2=norm(est.specific_force_frd), thrust_setpoint=ctrl.thrust_setpoint,
             hover_thrust=ctrl.hover_thrust, setpoint_vz_m_s=descent_vz(ctrl.local_setpoint),
