@@ -87,6 +87,7 @@ class Vehicle:
         self._setpoint_type = SetpointType.NONE
         self._task_finished = False
         self._commander_last_us = -COMMANDER_PERIOD_US
+        self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -108,7 +109,7 @@ class Vehicle:
             c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             c.update(now)
         chain = self.chain
-        out = chain.executor.update(c.nav_state, c.armed, now, self._nav_input, c.nav_commands, self.ref, dt_s)
+        out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
         motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
@@ -118,8 +119,9 @@ class Vehicle:
         detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
         if detected is not None:
             c.on_land_detector(detected.landed, detected.maybe_landed)
-        for severity, text in out.messages:
-            self._emit(severity, "navigator", text, True, True)
+        if out.messages:  # the task said something this tick
+            for severity, text in out.messages:
+                self._emit(severity, "navigator", text, True, True)
 
     def run_until(self, time_us: int) -> None:
         """Step until time_us is reached (no-op if already there)."""
