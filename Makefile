@@ -27,7 +27,7 @@ CHECK_DIR := build/compiled-check
 CORE_TESTS := tests/test_speedups_exact.py tests/test_determinism.py tests/test_vehicle_scenarios.py \
 	tests/test_fidelity_takeoff_land.py tests/test_fidelity_xy.py tests/test_control.py \
 	tests/test_tasks.py tests/test_commander.py tests/test_land_detector.py \
-	tests/test_physics.py tests/test_api.py tests/test_vehicle_snapshot.py tests/test_arming_shortcuts.py \
+	tests/test_physics.py tests/test_api.py tests/test_vehicle_snapshot.py \
 	tests/test_arming_table.py
 test-compiled: $(STAMP)
 	@if ! command -v "$$($(BIN)/python -c 'import sysconfig; print((sysconfig.get_config_var("CC") or "cc").split()[0])')" \

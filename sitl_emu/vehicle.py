@@ -7,7 +7,8 @@ Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (400
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
  4. control cascade: setpoint -> motor commands (zero when disarmed or terminated);
  5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
- 6. land detector on the new estimate -> commander ("Takeoff detected" / "Landing detected");
+ 6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
+    "Landing detected");
  7. events: the task's messages join the event stream.
 Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
 on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
@@ -15,21 +16,22 @@ on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the 
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
-import math
 from collections import deque
+from typing import Final
 
 import numpy as np
 
+from sitl_emu.control.qmath import euler_from_q, yaw_from_q
 from sitl_emu.flight.commander import Commander
-from sitl_emu.flight.tasks_core import NavInput
+from sitl_emu.flight.commands import handle_command
+from sitl_emu.flight.tasks_core import NavInput, SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
-from sitl_emu.px4 import AUTO_MODES, LandedState, MavState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
@@ -37,17 +39,15 @@ from sitl_emu.types import (
     OffboardControlMode,
     TrajectorySetpoint,
     Vec3,
-    Vec4,
     VehicleCommand,
     VehicleEvent,
     VehicleSnapshot,
 )
-from sitl_emu.vehicle_parts import Parts, yaw_of
+from sitl_emu.vehicle_parts import ControlChain
 
-EVENT_HISTORY = 1000
-COMMANDER_PERIOD_US = 8000  # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
-_TERMINATION = NavState.TERMINATION  # a module constant: enum member lookups cost on the per-tick path
-_STATUS_VALUES = {status: float(status) for status in MavState}  # snapshot extras["system_status"]
+EVENT_HISTORY: Final = 1000
+# PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
+COMMANDER_PERIOD_US: Final = 8000
 
 
 class Vehicle:
@@ -75,12 +75,6 @@ class Vehicle:
 
     def _boot(self) -> None:
         self._snap: VehicleSnapshot | None = None
-        # lat/lon of the last snapshot and the north/east float objects they were computed from (at rest physics
-        # passes the same objects on); the altitude is recomputed (it is one subtraction)
-        self._geo_of: tuple[object, object] = (None, None)
-        self._lat_lon: tuple[float, float] = (0.0, 0.0)
-        self._euler_of: Vec4 | None = None  # the quaternion (tuple object) self._euler was computed for
-        self._euler: Vec3 = (0.0, 0.0, 0.0)
         self._time_us = 0
         self.ref = GeoRef(*self._home_tuple)
         self._rng = np.random.default_rng(self._seed)
@@ -88,13 +82,12 @@ class Vehicle:
         self._estimate = self._state
         self._sih_version = -1
         self._sih = sih_config(self.params)
-        self.commander = Commander(self.params, self._emit, self._ned_of)
-        self.parts = Parts(self.params)
-        self._setpoint_type = "none"
+        self.commander = Commander(self.params, self._emit, self._ned_of, self._here)
+        self.chain = ControlChain(self.params)
+        self._setpoint_type = SetpointType.NONE
         self._task_finished = False
         self._commander_last_us = -COMMANDER_PERIOD_US
-        self._here_fn = self._here  # bound once: handed to the commander every cycle
-        self._nav_fn = self._nav_input
+        self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -103,35 +96,30 @@ class Vehicle:
         return self._time_us
 
     def step(self) -> None:
-        """Advance exactly one physics tick (dt_us), in the fixed order of the module docstring.
-
-        This runs 250 times per simulated second, so work is skipped where its inputs did not change (each
-        shortcut says why it is exact)."""
+        """Advance exactly one physics tick (dt_us), in the fixed order of the module docstring."""
         c = self.commander
         if c.reboot_requested:
             self._boot()
             return
-        now = self._time_us + self.dt_us
-        self._time_us = now
+        now = self._time_us = self._time_us + self.dt_us
         self._snap = None
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now
-            c.observe_state(now, now >= self._ready_delay_us, self._here_fn, self._task_finished)
+            c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             c.update(now)
-        parts = self.parts
-        out = parts.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
+        chain = self.chain
+        out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
-        armed = c.armed and c.nav_state != _TERMINATION
-        motors = parts.control_update(self._estimate, out, armed, c.landed, now, dt_s)
-        sih = self._sih if self.params.version == self._sih_version else self._sih_config()
-        state = self._state = physics_step(self._state, motors, dt_s, sih)
-        self._estimate = state if self._noise_m <= 0.0 else self._estimate_from(state)
-        climb_rate_controlled = out.attitude is None and out.setpoint_type != "none"
-        landed, maybe_landed = parts.land(self._estimate, c, climb_rate_controlled, now)
-        if landed != c.landed or maybe_landed != c.maybe_landed:  # else on_land_detector changes nothing
-            c.on_land_detector(landed, maybe_landed)
-        if out.messages:
+        motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
+        motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
+        self._state = physics_step(self._state, motors, dt_s, self._sih_config())
+        self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
+        climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
+        detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
+        if detected is not None:
+            c.on_land_detector(detected.landed, detected.maybe_landed)
+        if out.messages:  # the task said something this tick
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)
 
@@ -146,16 +134,15 @@ class Vehicle:
 
     def _nav_input(self) -> NavInput:
         """The navigator task's input, built only when a task runs (before physics: the estimate of this tick)."""
-        return self.parts.nav_input(self._time_us, self._estimate, self.commander, self.ref)
+        return self.chain.nav_input(self._time_us, self._estimate, self.commander, self.ref)
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:
             self._sih, self._sih_version = sih_config(self.params), self.params.version
         return self._sih
 
-    def _estimate_from(self, truth: RigidBodyState) -> RigidBodyState:
-        if self._noise_m <= 0.0:
-            return truth
+    def _with_noise(self, truth: RigidBodyState) -> RigidBodyState:
+        """The estimate: the truth with seeded Gaussian noise on the position."""
         n = self._rng.normal(0.0, self._noise_m, 3)
         p = truth.pos_ned_m
         est = RigidBodyState(**{f: getattr(truth, f) for f in RIGID_BODY_FIELDS})
@@ -166,14 +153,14 @@ class Vehicle:
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
         self._snap = None
-        return self.commander.handle_command(cmd, self._time_us)
+        return handle_command(self.commander, cmd, self._time_us)
 
     def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
                        attitude: AttitudeSetpoint | None = None) -> None:
         """An offboard message: refreshes the COM_OF_LOSS_T watchdog in any mode; setpoints are used in OFFBOARD."""
         self._snap = None
         self.commander.offboard_signal(self._time_us, mode)
-        self.parts.executor.offboard(mode, trajectory, attitude)
+        self.chain.executor.offboard(mode, trajectory, attitude)
 
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""
@@ -207,16 +194,16 @@ class Vehicle:
             return None
         pos = self._estimate.pos_ned_m
         lat, lon, alt = ned_to_global(self.ref, pos)
-        return HomePosition(lat, lon, alt, pos, yaw_of(self._estimate.q_wxyz))
+        return HomePosition(lat, lon, alt, pos, yaw_from_q(self._estimate.q_wxyz))
 
     def landed_state(self) -> LandedState:
         """EXTENDED_SYS_STATE.landed_state (reference 5.5)."""
         c = self.commander
         if c.landed:
             return LandedState.ON_GROUND
-        if c.nav_state in AUTO_MODES and self._setpoint_type == "takeoff":
+        if c.nav_state in AUTO_MODES and self._setpoint_type is SetpointType.TAKEOFF:
             return LandedState.TAKEOFF
-        if c.nav_state in AUTO_MODES and self._setpoint_type == "land":
+        if c.nav_state in AUTO_MODES and self._setpoint_type is SetpointType.LAND:
             return LandedState.LANDING
         return LandedState.IN_AIR
 
@@ -227,64 +214,17 @@ class Vehicle:
         return self._snap
 
     def _make_snapshot(self) -> VehicleSnapshot:
-        """Built about every second tick when telemetry runs: what did not change since the last one (the same
-        position or attitude tuple, e.g. at rest) is reused, not recomputed."""
-        c, s = self.commander, self._estimate
-        pos, q = s.pos_ned_m, s.q_wxyz
-        north, east = pos[0], pos[1]
-        geo_of = self._geo_of
-        if north is not geo_of[0] or east is not geo_of[1]:
-            lat, lon, alt = ned_to_global(self.ref, pos)
-            self._geo_of, self._lat_lon = (north, east), (lat, lon)
-        else:
-            lat, lon = self._lat_lon
-            alt = self.ref.alt_amsl_m - pos[2]  # as ned_to_global computes it
-        if q is not self._euler_of:
-            self._euler_of, self._euler = q, _euler(q)
-        ctrl = self.parts.control
-        pre_flight_ok, offboard, status = c.telemetry_status()
-        ref = self.ref
-        return _new_snapshot((  # the fields in _SNAPSHOT_FIELDS order
-            self._time_us, c.armed, c.nav_state, c.intention.user_intended, c.failsafe, self.landed_state(),
-            pre_flight_ok, c.estimator_ready, c.have_taken_off, offboard, pos, s.vel_ned_m_s,
-            s.acc_ned_m_s2, q, s.rates_frd_rad_s, self._euler, lat, lon, alt, ref.lat_deg, ref.lon_deg,
-            ref.alt_amsl_m, c.home, ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s,
-            ctrl.thrust_setpoint, self._state.motors, {"system_status": _STATUS_VALUES[status]},
-        ))
-
-
-# VehicleSnapshot's generated __init__ (frozen dataclass) sets each of its ~30 fields through object.__setattr__;
-# storing into the slots directly builds the same object in about half the time. _new_snapshot takes the values of
-# _SNAPSHOT_FIELDS in this order; any other field (e.g. one added later with a default) gets its default.
-_SNAPSHOT_FIELDS = (
-    "time_us", "armed", "nav_state", "user_intended_nav_state", "failsafe", "landed_state", "pre_flight_checks_pass",
-    "position_valid", "takeoff_detected", "offboard_control", "pos_ned_m", "vel_ned_m_s", "acc_ned_m_s2", "q_wxyz",
-    "rates_frd_rad_s", "euler_rad", "lat_deg", "lon_deg", "alt_amsl_m", "ref_lat_deg", "ref_lon_deg",
-    "ref_alt_amsl_m", "home", "local_setpoint", "attitude_setpoint_q_wxyz", "rates_setpoint_rad_s",
-    "thrust_setpoint", "motors", "extras",
-)
-_SNAPSHOT_OTHERS = [f for f in dataclasses.fields(VehicleSnapshot) if f.name not in _SNAPSHOT_FIELDS]
-_SNAPSHOT_SETTERS = tuple(getattr(VehicleSnapshot, name).__set__
-                          for name in _SNAPSHOT_FIELDS + tuple(f.name for f in _SNAPSHOT_OTHERS))
-_SNAPSHOT_DEFAULTS = tuple(f.default for f in _SNAPSHOT_OTHERS)
-# only where that is the same as calling the constructor: no __post_init__, the other fields have plain defaults
-_SNAPSHOT_DIRECT = not hasattr(VehicleSnapshot, "__post_init__") and dataclasses.MISSING not in _SNAPSHOT_DEFAULTS
-
-
-def _new_snapshot(values: tuple[object, ...]) -> VehicleSnapshot:
-    if not _SNAPSHOT_DIRECT:
-        return VehicleSnapshot(**dict(zip(_SNAPSHOT_FIELDS, values, strict=True)))  # type: ignore[arg-type]
-    snap = object.__new__(VehicleSnapshot)
-    for setter, value in zip(_SNAPSHOT_SETTERS, values + _SNAPSHOT_DEFAULTS, strict=True):
-        setter(snap, value)
-    return snap
-
-
-def _euler(q: Vec4) -> Vec3:
-    """(roll, pitch, yaw) of a w-first quaternion, ZYX (PX4 matrix::Eulerf)."""
-    w, x, y, z = q
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    sin_pitch = 2.0 * (w * y - z * x)
-    sin_pitch = sin_pitch if sin_pitch < 1.0 else 1.0  # max(-1.0, min(1.0, sin_pitch)), NaN kept
-    pitch = math.asin(sin_pitch if sin_pitch > -1.0 else -1.0)
-    return roll, pitch, math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))  # yaw_of(q)
+        c, s, ctrl, ref = self.commander, self._estimate, self.chain.control, self.ref
+        lat, lon, alt = ned_to_global(ref, s.pos_ned_m)
+        return VehicleSnapshot(
+            time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
+            user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe, landed_state=self.landed_state(),
+            pre_flight_checks_pass=c.pre_flight_checks_pass(), position_valid=c.estimator_ready,
+            takeoff_detected=c.have_taken_off, offboard_control=c.offboard_mode,
+            pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s, acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz,
+            rates_frd_rad_s=s.rates_frd_rad_s, euler_rad=euler_from_q(s.q_wxyz), lat_deg=lat, lon_deg=lon,
+            alt_amsl_m=alt, ref_lat_deg=ref.lat_deg, ref_lon_deg=ref.lon_deg, ref_alt_amsl_m=ref.alt_amsl_m,
+            home=c.home, local_setpoint=ctrl.local_setpoint, attitude_setpoint_q_wxyz=ctrl.attitude_setpoint_q_wxyz,
+            rates_setpoint_rad_s=ctrl.rates_setpoint_rad_s, thrust_setpoint=ctrl.thrust_setpoint,
+            motors=self._state.motors, extras={"system_status": float(c.system_status())},
+        )

@@ -7,7 +7,8 @@ from dataclasses import dataclass
 
 import pytest
 
-from sitl_emu.flight.commander import Commander, Observation
+from sitl_emu.flight.commander import Commander
+from sitl_emu.flight.commands import handle_command
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavResult, NavState
 from sitl_emu.types import HomePosition, OffboardControlMode, VehicleCommand
@@ -20,18 +21,20 @@ HERE = HomePosition(47.397742, 8.545594, 488.0, (0.0, 0.0, 0.0), 0.0)
 class Harness:
     def __init__(self, *, ready: bool = True) -> None:
         self.texts: list[str] = []
-        self.c = Commander(default_registry(), lambda sev, mod, text, ev, st: self.texts.append(text))
         self.ready = ready
+        self.here = HERE
+        self.c = Commander(default_registry(), lambda sev, mod, text, ev, st: self.texts.append(text),
+                           here=lambda: self.here if self.ready else None)
         self.tick(T0)
 
     def tick(self, now_us: int) -> None:
-        self.c.observe(Observation(now_us, self.ready, HERE if self.ready else None))
+        self.c.observe(now_us, estimator_ready=self.ready)
         self.c.update(now_us)
 
     def cmd(self, command: int, *params: float, external: bool = True, compid: int = 190):
         p = tuple(params) + (NAN,) * (7 - len(params))
-        return self.c.handle_command(VehicleCommand(command, p, source_component=compid, from_external=external),
-                                     self.c.now_us)
+        return handle_command(self.c, VehicleCommand(command, p, source_component=compid, from_external=external),
+                              self.c.now_us)
 
 
 @dataclass(frozen=True)
@@ -142,7 +145,7 @@ def test_arm_disarm_table(case: Case) -> None:
 def test_home_is_set_at_arming() -> None:
     h = Harness()
     moved = HomePosition(47.4, 8.55, 490.0, (10.0, 5.0, -2.0), 1.0)
-    h.c.observe(Observation(h.c.now_us, True, moved))
+    h.here = moved
     assert h.cmd(400, 1.0).result == MavResult.ACCEPTED
     assert h.c.home == moved
 

@@ -7,7 +7,8 @@ import math
 
 import pytest
 
-from sitl_emu.flight.commander import Commander, Observation
+from sitl_emu.flight.commander import Commander, NavCommandKind
+from sitl_emu.flight.commands import handle_command
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavResult, MavState, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import HomePosition, OffboardControlMode, VehicleCommand
@@ -22,13 +23,14 @@ class Harness:
     def __init__(self, *, ready: bool = True, t0_us: int = 5 * S) -> None:
         self.texts: list[str] = []
         self.params = default_registry()
-        self.c = Commander(self.params, lambda sev, mod, text, ev, st: self.texts.append(text))
+        self.c = Commander(self.params, lambda sev, mod, text, ev, st: self.texts.append(text),
+                           here=lambda: HERE if self.ready else None)
         self.ready = ready
         self.finished = False
         self.tick(t0_us)
 
     def tick(self, now_us: int) -> None:
-        self.c.observe(Observation(now_us, self.ready, HERE if self.ready else None, self.finished))
+        self.c.observe(now_us, estimator_ready=self.ready, task_finished=self.finished)
         self.c.update(now_us)
 
     def run(self, seconds: float, dt_us: int = 4000, stream: OffboardControlMode | None = None) -> None:
@@ -40,8 +42,8 @@ class Harness:
 
     def cmd(self, command: int, *params: float, compid: int = 190, external: bool = True):
         p = tuple(params) + (NAN,) * (7 - len(params))
-        return self.c.handle_command(VehicleCommand(command, p, source_component=compid, from_external=external),
-                                     self.c.now_us)
+        return handle_command(self.c, VehicleCommand(command, p, source_component=compid, from_external=external),
+                              self.c.now_us)
 
     def set_mode(self, nav: NavState, compid: int = 190):
         main, sub = decode_custom_mode(custom_mode(nav))
@@ -129,7 +131,7 @@ def test_takeoff_accepted_while_disarmed_and_queues_altitude() -> None:
     h = Harness()
     assert h.cmd(22, NAN, NAN, NAN, NAN, NAN, NAN, 500.0).result == MavResult.ACCEPTED
     assert h.c.nav_state == NavState.AUTO_TAKEOFF
-    assert h.c.nav_commands[-1].kind == "takeoff" and h.c.nav_commands[-1].alt_amsl_m == 500.0
+    assert h.c.nav_commands[-1].kind is NavCommandKind.TAKEOFF and h.c.nav_commands[-1].alt_amsl_m == 500.0
 
 
 def test_land_and_return_texts() -> None:

@@ -316,7 +316,7 @@ def test_a_parameter_set_in_flight_reaches_the_controllers_at_the_next_tick():
     v.params.set("MC_ROLL_P", 6.5)
     v.params.set("MPC_XY_VEL_MAX", 4.0)
     v.step()
-    control = v.parts.control
+    control = v.chain.control
     assert control.attitude.settings.gain_p[0] == 6.5
     assert control.position.settings.vel_max_xy == 4.0
 

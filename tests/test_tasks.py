@@ -8,8 +8,20 @@ from dataclasses import dataclass, field
 
 import pytest
 
+from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.smoothing import AxisSmoother, braking_distance, max_speed_from_distance
-from sitl_emu.flight.tasks import NavInput, Task, make_land, make_loiter, make_reposition, make_rtl, make_takeoff
+from sitl_emu.flight.tasks import (
+    NavInput,
+    SetpointType,
+    TakeoffTask,
+    Task,
+    make_land,
+    make_loiter,
+    make_reposition,
+    make_rtl,
+    make_takeoff,
+)
+from sitl_emu.flight.tasks_rtl import RtlState
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import TrajectorySetpoint, Vec3
@@ -28,7 +40,7 @@ class PointMass:
     tau_s: float = 0.1
     home: Vec3 = (0.0, 0.0, 0.0)
     armed: bool = True
-    takeoff_state: str = "flight"
+    takeoff_state: TakeoffState = TakeoffState.FLIGHT
     history: list = field(default_factory=list)
 
     @property
@@ -107,7 +119,7 @@ def test_takeoff_default_altitude_message_profile_and_completion(params):
     pm = PointMass()
     task = make_takeoff(pm.nav(), params, None)
     assert task.drain_messages() == [(Severity.INFO, "Using default takeoff altitude: 2.5 m")]
-    assert task.setpoint_type == "takeoff" or task.kind == "takeoff"
+    assert isinstance(task, TakeoffTask)
     finished_at = None
     for _ in range(round(10 / DT)):
         sp = task.update(pm.nav(), DT)
@@ -115,9 +127,9 @@ def test_takeoff_default_altitude_message_profile_and_completion(params):
         assert sp.acceleration_ned_m_s2[2] >= -0.5 - 1e-6  # MPC_TKO_SPEED / MPC_TKO_RAMP_T
         if task.finished and finished_at is None:
             finished_at = -pm.pos[2]
-            assert task.setpoint_type == "position"
+            assert task.setpoint_type is SetpointType.POSITION
         if not task.finished:
-            assert task.setpoint_type == "takeoff"
+            assert task.setpoint_type is SetpointType.TAKEOFF
         pm.follow(sp)
     assert finished_at == pytest.approx(1.7, abs=0.05)  # MIS_TAKEOFF_ALT - NAV_MC_ALT_RAD
     assert task.target_ned_m == (0.0, 0.0, -2.5)
@@ -131,7 +143,7 @@ def test_hold_after_takeoff_keeps_climbing_to_the_full_target(params):
     hold = make_loiter(pm.nav(), params, hold_at_ned_m=task.target_ned_m)
     pm.fly(hold, 12.0)
     assert -pm.pos[2] == pytest.approx(2.5, abs=0.05)
-    assert hold.setpoint_type == "position"
+    assert hold.setpoint_type is SetpointType.POSITION
 
 
 def test_takeoff_explicit_target_below_is_refused_and_finishes_at_once(params):
@@ -153,7 +165,7 @@ def test_takeoff_explicit_target_climbs_there(params):
 
 
 def test_before_the_ramp_the_trajectory_stays_at_the_vehicle_but_wants_takeoff(params):
-    pm = PointMass(takeoff_state="spoolup")
+    pm = PointMass(takeoff_state=TakeoffState.SPOOLUP)
     task = make_takeoff(pm.nav(), params, None)
     task.update(pm.nav(), DT)
     for _ in range(50):
@@ -161,7 +173,7 @@ def test_before_the_ramp_the_trajectory_stays_at_the_vehicle_but_wants_takeoff(p
         assert task.want_takeoff
         assert sp.position_ned_m[2] == pytest.approx(0.0, abs=0.02)
         assert sp.velocity_ned_m_s[2] > 0.6  # PX4 reActivate: the trajectory restarts from 0.7 m/s down
-    pm.takeoff_state = "flight"
+    pm.takeoff_state = TakeoffState.FLIGHT
     pm.fly(task, 8.0)
     assert task.finished
 
@@ -174,7 +186,7 @@ def test_hold_on_the_ground_is_idle(params, armed):
     pm = PointMass(armed=armed)
     task = make_loiter(pm.nav(), params)
     sp = pm.fly(task, 2.0)[-1]
-    assert task.setpoint_type == "idle"
+    assert task.setpoint_type is SetpointType.IDLE
     assert not task.want_takeoff
     assert all(math.isnan(c) for c in sp.position_ned_m + sp.velocity_ned_m_s)
     assert sp.acceleration_ned_m_s2[2] > 50.0
@@ -199,7 +211,7 @@ def test_land_speed_profile_and_push_down_on_the_ground(params):
     pm = hovering(-20.0)
     task = make_land(pm.nav(), params)
     pm.fly(task, 40.0)
-    assert task.setpoint_type == "land"
+    assert task.setpoint_type is SetpointType.LAND
     speeds = {}
     for _t, pos, vel, _kind, _sp in pm.history:
         height = -pos[2]
@@ -241,12 +253,12 @@ def test_rtl_climbs_returns_and_lands_home(params):
     pm.fly(task, 60.0)
     messages = task.drain_messages()
     assert (Severity.INFO, "RTL: land at destination") in messages
-    assert task.setpoint_type == "land"
+    assert task.setpoint_type is SetpointType.LAND
     assert max(math.hypot(v[0], v[1]) for _t, _p, v, _k, _sp in pm.history) <= 5.0 + 0.1  # MPC_XY_CRUISE
     assert math.hypot(pm.pos[0], pm.pos[1]) < 1.0
     assert pm.pos[2] == 0.0
     heading_home = math.atan2(-30.0, -60.0)
-    cruise_yaws = [sp.yaw_rad for t, pos, _v, k, sp in pm.history if k == "position" and -pos[2] > 29.5
+    cruise_yaws = [sp.yaw_rad for t, pos, _v, k, sp in pm.history if k is SetpointType.POSITION and -pos[2] > 29.5
                    and math.hypot(pos[0], pos[1]) > 20.0]
     assert cruise_yaws and all(abs(y - heading_home) < 0.05 for y in cruise_yaws[-10:])
     assert not task.finished
@@ -263,7 +275,7 @@ def test_rtl_above_return_altitude_does_not_climb(params):
     pm = PointMass(pos=(100.0, 0.0, -40.0))
     task = make_rtl(pm.nav(), params)
     assert task.return_alt_up_m == pytest.approx(40.0)
-    assert task.state == "return"
+    assert task.state is RtlState.RETURN
 
 
 def test_rtl_land_delay_descends_waits_then_lands(params):
@@ -272,13 +284,13 @@ def test_rtl_land_delay_descends_waits_then_lands(params):
     task = make_rtl(pm.nav(), params)
     states = []
     for _ in range(round(60 / DT)):
-        states.append((pm.t, task.state if hasattr(task, "state") else "", -pm.pos[2]))
+        states.append((pm.t, task.state, -pm.pos[2]))
         pm.follow(task.update(pm.nav(), DT))
     seen = [s for _t, s, _h in states]
-    assert seen.index("descend") < seen.index("hold") < seen.index("land")
-    hold_times = [t for t, s, _h in states if s == "hold"]
+    assert seen.index(RtlState.DESCEND) < seen.index(RtlState.HOLD) < seen.index(RtlState.LAND)
+    hold_times = [t for t, s, _h in states if s is RtlState.HOLD]
     assert hold_times[-1] - hold_times[0] == pytest.approx(2.0, abs=0.1)
-    assert all(h == pytest.approx(10.0, abs=0.85) for _t, s, h in states if s == "hold")  # RTL_DESCEND_ALT
+    assert all(h == pytest.approx(10.0, abs=0.85) for _t, s, h in states if s is RtlState.HOLD)  # RTL_DESCEND_ALT
     assert pm.pos[2] == 0.0
 
 
@@ -286,7 +298,7 @@ def test_rtl_landed_stays_idle(params):
     pm = PointMass()
     task = make_rtl(pm.nav(), params)
     pm.fly(task, 1.0)
-    assert task.setpoint_type == "idle"
+    assert task.setpoint_type is SetpointType.IDLE
     assert pm.pos == (0.0, 0.0, 0.0)
 
 

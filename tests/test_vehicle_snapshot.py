@@ -27,7 +27,7 @@ def _expected_euler(q: tuple[float, float, float, float]) -> tuple[float, float,
 
 def _check(v: Vehicle) -> VehicleSnapshot:
     s = v.snapshot()
-    for f in dataclasses.fields(VehicleSnapshot):  # every field is set (the snapshot is built slot by slot)
+    for f in dataclasses.fields(VehicleSnapshot):  # every field is set
         getattr(s, f.name)
     assert (s.lat_deg, s.lon_deg, s.alt_amsl_m) == ned_to_global(v.ref, s.pos_ned_m)
     assert s.euler_rad == _expected_euler(s.q_wxyz)
@@ -87,23 +87,3 @@ def test_georef_derived_values_do_not_change_its_identity():
     assert a == b and hash(a) == hash(b)
     assert repr(a) == "GeoRef(lat_deg=47.397742, lon_deg=8.545594, alt_amsl_m=488.0)"
     assert a.lat_rad == math.radians(47.397742) and a.cos_lat == math.cos(math.radians(47.397742))
-
-
-def test_the_slot_by_slot_snapshot_equals_the_constructors(monkeypatch):
-    import sitl_emu.vehicle as vehicle_module
-
-    fast, slow = Vehicle(), Vehicle()
-    monkeypatch.setattr(vehicle_module, "_SNAPSHOT_DIRECT", False)  # slow: VehicleSnapshot(**fields)
-    for v in (fast, slow):
-        v.run_for(2.5)
-        _command(v, 400, 1.0)
-        _command(v, 22)
-    for _ in range(20):
-        fast.run_for(0.2)
-        slow.run_for(0.2)
-        monkeypatch.setattr(vehicle_module, "_SNAPSHOT_DIRECT", True)
-        a = fast.snapshot()
-        monkeypatch.setattr(vehicle_module, "_SNAPSHOT_DIRECT", False)
-        b = slow.snapshot()
-        assert type(a) is type(b) is VehicleSnapshot
-        assert repr(a) == repr(b)

@@ -65,9 +65,12 @@ _REASONS: tuple[tuple[int, str], ...] = (
 )
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class CheckInputs:
-    """What the checks look at, at one instant."""
+    """What the checks look at, at one instant.
+
+    Made every commander cycle, so not frozen and with its __init__ written out (the same as the generated one:
+    `make speedups` compiles only a written-out __init__, as for NavInput). Treat it as read-only."""
 
     estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
     home_valid: bool
@@ -75,25 +78,26 @@ class CheckInputs:
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # sitl_emu has no mission storage
 
+    def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
+                 mission_valid: bool = False) -> None:
+        self.estimator_ready = estimator_ready
+        self.home_valid = home_valid
+        self.offboard_signal = offboard_signal
+        self.manual_control = manual_control
+        self.mission_valid = mission_valid
+
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
-        return available_bits(self.estimator_ready, self.home_valid, self.offboard_signal, self.manual_control,
-                              self.mission_valid)
-
-
-def available_bits(estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
-                   mission_valid: bool = False) -> int:
-    """The requirement bits satisfied by these inputs (CheckInputs.available, without building a CheckInputs)."""
-    have = (Req.ATTITUDE | Req.POSITION) if estimator_ready else 0
-    if home_valid:
-        have |= Req.HOME
-    if mission_valid:
-        have |= Req.MISSION
-    if offboard_signal:
-        have |= Req.OFFBOARD
-    if manual_control:
-        have |= Req.MANUAL
-    return have
+        have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else Req.NONE
+        if self.home_valid:
+            have |= Req.HOME
+        if self.mission_valid:
+            have |= Req.MISSION
+        if self.offboard_signal:
+            have |= Req.OFFBOARD
+        if self.manual_control:
+            have |= Req.MANUAL
+        return have
 
 
 def requirements(nav_state: NavState) -> int:
@@ -133,23 +137,3 @@ def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> 
 
 def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
     return arming_failure(nav_state, c, armed) is None
-
-
-def can_run_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool) -> bool:
-    """can_run(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal)), without the allocation (the
-    commander asks every cycle)."""
-    return not (requirements(nav_state) & ~(available_bits(estimator_ready, home_valid, offboard_signal)
-                                            | Req.PREVENT_ARMING))
-
-
-_CAN_ARM_MEMO: dict[tuple[NavState, bool, bool, bool, bool], bool] = {}
-
-
-def can_arm_now(nav_state: NavState, estimator_ready: bool, home_valid: bool, offboard_signal: bool,
-                armed: bool) -> bool:
-    """can_arm(nav_state, CheckInputs(...), armed), memoised (a pure function of a few booleans and the mode)."""
-    key = (nav_state, estimator_ready, home_valid, offboard_signal, armed)
-    ok = _CAN_ARM_MEMO.get(key)
-    if ok is None:
-        ok = _CAN_ARM_MEMO[key] = can_arm(nav_state, CheckInputs(estimator_ready, home_valid, offboard_signal), armed)
-    return ok

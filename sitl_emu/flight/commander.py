@@ -1,44 +1,33 @@
 """PX4's commander for a SITL multicopter: arming, user mode intention vs mode in force, failsafes, auto-disarm.
 
 A pure state machine: simulated time comes in as `now_us`, texts go out through the `emit` callback, requests for
-the navigator (takeoff altitude, reposition, altitude change) queue in `nav_commands`. Commands are handled in
-`sitl_emu.flight.commands`. Sources: src/modules/commander/Commander.cpp (arm ~l.663, disarm ~l.744,
-handleAutoDisarm ~l.2455, takeoff completion ~l.2208, land detector texts ~l.2310), UserModeIntention.cpp,
-failsafe/failsafe.cpp. See ../shared/reference/px4-behaviour.md sections 2-5.
+the navigator (takeoff altitude, reposition, altitude change) queue in `nav_commands`. Commands are handled by
+`sitl_emu.flight.commands.handle_command(commander, ...)`. Sources: src/modules/commander/Commander.cpp (arm ~l.663,
+disarm ~l.744, handleAutoDisarm ~l.2455, takeoff completion ~l.2208, land detector texts ~l.2310),
+UserModeIntention.cpp, failsafe/failsafe.cpp. See ../shared/reference/px4-behaviour.md sections 2-5.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import Enum
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
-from sitl_emu.types import NAN, CommandAck, HomePosition, OffboardControlMode, Vec3, VehicleCommand
+from sitl_emu.types import NAN, HomePosition, OffboardControlMode, Vec3
 
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
 # geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
 NedOf = Callable[[float, float, float], Vec3]
-# module constants: enum member lookups cost on the per-cycle path
-_TERMINATION = NavState.TERMINATION
-_AUTO_TAKEOFF = NavState.AUTO_TAKEOFF
-
-
-@dataclass(frozen=True, slots=True)
-class Observation:
-    """What the commander sees of the vehicle at the start of a step."""
-
-    now_us: int
-    estimator_ready: bool
-    # the current position as a home candidate (None while the estimator is not ready), or a function giving it
-    # (evaluated only when home is set: at arming, when first ready, on DO_SET_HOME)
-    here: HomePosition | Callable[[], HomePosition | None] | None
-    task_finished: bool = False  # the navigator's current task says it is done (takeoff reached)
+# the current position as a home candidate, None while the estimator is not ready (called only when home is set:
+# at arming, when first ready, on DO_SET_HOME)
+Here = Callable[[], HomePosition | None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,11 +52,17 @@ class CommanderSettings:
         )
 
 
+class NavCommandKind(Enum):
+    TAKEOFF = "takeoff"
+    REPOSITION = "reposition"
+    CHANGE_ALTITUDE = "change_altitude"
+
+
 @dataclass(frozen=True, slots=True)
 class NavCommand:
     """A request for the navigator that comes with a command (global coordinates, NaN = keep current)."""
 
-    kind: str  # "takeoff" | "reposition" | "change_altitude"
+    kind: NavCommandKind
     lat_deg: float = NAN
     lon_deg: float = NAN
     alt_amsl_m: float = NAN
@@ -75,15 +70,20 @@ class NavCommand:
     speed_m_s: float = NAN
 
 
+def _nowhere() -> HomePosition | None:
+    return None
+
+
 class Commander:
     """The vehicle's brain; see the module docstring."""
 
-    def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None) -> None:
+    def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None, here: Here = _nowhere) -> None:
         self.params = params
         self._settings = CommanderSettings.from_params(params)
         self._settings_version = params.version
         self._emit = emit
         self._ned_of = ned_of
+        self._here = here
         self.intention = ModeIntention(NavState.AUTO_LOITER)
         self._failsafe = Failsafe()
         self.armed = False
@@ -96,10 +96,9 @@ class Commander:
         self.maybe_landed = True
         self.nav_commands: list[NavCommand] = []
         self.reboot_requested = False
-        # the latest Observation, kept as plain attributes (Vehicle.step sets them every cycle via observe_state)
-        self._now_us = 0
-        self._ready = False
-        self._here_src: HomePosition | Callable[[], HomePosition | None] | None = None
+        # what the commander saw of the vehicle at the start of the current cycle (observe)
+        self.now_us = 0
+        self.estimator_ready = False
         self._task_finished = False
         self._ready_announced = False
         self._armed_at_us = 0
@@ -116,28 +115,12 @@ class Commander:
         return self._settings
 
     # ---- inputs -------------------------------------------------------------------------------------------------
-    def observe(self, obs: Observation) -> None:
-        self.observe_state(obs.now_us, obs.estimator_ready, obs.here, obs.task_finished)
-
-    def observe_state(self, now_us: int, estimator_ready: bool,
-                      here: HomePosition | Callable[[], HomePosition | None] | None, task_finished: bool) -> None:
-        """observe() without building an Observation (the vehicle calls this every cycle)."""
-        self._now_us = now_us
-        self._ready = estimator_ready
-        self._here_src = here
+    def observe(self, now_us: int, *, estimator_ready: bool, task_finished: bool = False) -> None:
+        """What the commander sees of the vehicle at the start of a cycle: the time, whether the estimator is ready,
+        and whether the navigator's current task says it is done (takeoff reached)."""
+        self.now_us = now_us
+        self.estimator_ready = estimator_ready
         self._task_finished = task_finished
-
-    def _here(self) -> HomePosition | None:
-        here = self._here_src
-        return here() if callable(here) else here
-
-    @property
-    def now_us(self) -> int:
-        return self._now_us
-
-    @property
-    def estimator_ready(self) -> bool:
-        return self._ready
 
     def offboard_signal(self, now_us: int, mode: OffboardControlMode) -> None:
         """An offboard_control_mode arrived (any mode): refresh the COM_OF_LOSS_T watchdog."""
@@ -166,25 +149,15 @@ class Commander:
 
     def pre_flight_checks_pass(self) -> bool:
         """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed)."""
-        return arming.can_arm_now(self.nav_state, self._ready, self.home is not None,
-                                  self.offboard_fresh(self._now_us), self.armed)
+        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed)
 
-    def telemetry_status(self) -> tuple[bool, OffboardControlMode | None, MavState]:
-        """(pre_flight_checks_pass(), offboard_mode, system_status()) together, checking the offboard signal's
-        freshness once (the vehicle's snapshot needs all three whenever telemetry is due)."""
-        fresh = self.offboard_fresh(self._now_us)
-        ok = arming.can_arm_now(self.nav_state, self._ready, self.home is not None, fresh, self.armed)
-        return ok, (self._offboard_mode if fresh else None), self.system_status(ok)
-
-    def system_status(self, pre_flight_checks_pass: bool | None = None) -> MavState:
-        """HEARTBEAT.system_status (HEARTBEAT.hpp); pass pre_flight_checks_pass() if you already have it."""
-        if self.nav_state == NavState.TERMINATION and self.armed:
+    def system_status(self) -> MavState:
+        """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
+        if self.nav_state is NavState.TERMINATION and self.armed:
             return MavState.FLIGHT_TERMINATION
         if self.armed:
             return MavState.CRITICAL if self.failsafe else MavState.ACTIVE
-        if pre_flight_checks_pass is None:
-            pre_flight_checks_pass = self.pre_flight_checks_pass()
-        return MavState.STANDBY if pre_flight_checks_pass else MavState.UNINIT
+        return MavState.STANDBY if self.pre_flight_checks_pass() else MavState.UNINIT
 
     # ---- texts --------------------------------------------------------------------------------------------------
     def say(self, severity: Severity, text: str, is_event: bool = True, statustext: bool = True,
@@ -242,30 +215,19 @@ class Commander:
     def change_mode(self, nav_state: NavState, *, force: bool = False) -> bool:
         """UserModeIntention::change; on success the mode in force follows at once when it can run."""
         ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
-                                   in_termination=self.nav_state == NavState.TERMINATION)
+                                   in_termination=self.nav_state is NavState.TERMINATION)
         if ok:
             self._apply_mode(self.now_us)
         return ok
 
     def _apply_mode(self, now_us: int) -> None:
-        user = self.intention.user_intended
-        armed = self.armed
-        if not armed or (not self.terminated and arming.can_run_now(
-                user, self._ready, self.home is not None, self.offboard_fresh(now_us))):
-            # the common case, decided without allocations: Failsafe.update would return Decision(user, False)
-            self._failsafe.active = False
-            self.nav_state = _TERMINATION if armed and self.nav_state == _TERMINATION else user
-            self.failsafe = False
-            return
-        inputs = self.check_inputs(now_us)
+        """The mode in force: the user's mode, or the failsafe's fallback while it cannot run; an armed vehicle never
+        leaves termination."""
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
-                                         can_run=lambda m: arming.can_run(m, inputs),
-                                         settings=self.settings.fallback, terminated=self.terminated)
-        if self.nav_state == NavState.TERMINATION and self.armed:
-            decision_nav = NavState.TERMINATION  # never leave termination while armed
-        else:
-            decision_nav = decision.nav_state
-        self.nav_state = decision_nav
+                                         inputs=self.check_inputs(now_us), settings=self.settings.fallback,
+                                         terminated=self.terminated)
+        if not (self.armed and self.nav_state is NavState.TERMINATION):
+            self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
         if decision.activated:
             self.say(Severity.CRITICAL, "Failsafe activated")
@@ -307,8 +269,7 @@ class Commander:
 
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
-        if (self.armed and not self.landed and self.nav_state == _AUTO_TAKEOFF
-                and self._task_finished):
+        if self.armed and not self.landed and self._task_finished and self.nav_state is NavState.AUTO_TAKEOFF:
             self.change_mode(NavState.AUTO_LOITER)
 
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:
@@ -323,18 +284,13 @@ class Commander:
             self.say(Severity.INFO, "Takeoff detected")
             self.have_taken_off = True
 
-    # ---- commands -----------------------------------------------------------------------------------------------
-    def handle_command(self, cmd: VehicleCommand, now_us: int) -> CommandAck | None:
-        from sitl_emu.flight.commands import handle_command
-
-        return handle_command(self, cmd, now_us)
-
+    # ---- home ---------------------------------------------------------------------------------------------------
     def home_from_global(self, lat_deg: float, lon_deg: float, alt_amsl_m: float, yaw_rad: float) -> bool:
         """HomePosition::setManually: needs a valid local position to place home in the local frame."""
         if not self.estimator_ready or self._ned_of is None:
             return False
         pos = self._ned_of(lat_deg, lon_deg, alt_amsl_m)
-        yaw = yaw_rad if math.isfinite(yaw_rad) else (self.home.yaw_rad if self.home else 0.0)
+        yaw = yaw_rad if isfinite(yaw_rad) else (self.home.yaw_rad if self.home else 0.0)
         self.home = HomePosition(lat_deg, lon_deg, alt_amsl_m, pos, yaw)
         return True
 

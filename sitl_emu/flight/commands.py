@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from sitl_emu.flight.commander import Commander, NavCommand
+from sitl_emu.control.qmath import isfinite
+from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
 from sitl_emu.px4 import (
     MODE_FLAG_AUTO_ENABLED,
     MODE_FLAG_CUSTOM_MODE_ENABLED,
@@ -50,7 +51,7 @@ def lround(x: float) -> int:
 
 def _uint8(x: float) -> int:
     """(uint8_t)float as the MAVLink receiver casts DO_SET_MODE params; NaN/inf read as 0 here (UB in C)."""
-    return int(x) & 0xFF if math.isfinite(x) else 0
+    return int(x) & 0xFF if isfinite(x) else 0
 
 
 def _ack(cmd: VehicleCommand, result: MavResult) -> CommandAck:
@@ -58,6 +59,7 @@ def _ack(cmd: VehicleCommand, result: MavResult) -> CommandAck:
 
 
 def handle_command(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck | None:
+    """The commander acts on `cmd` now; the ACK to send, or None where PX4 sends none."""
     handler = _HANDLERS.get(cmd.command)
     if handler is None:
         return _ack(cmd, MavResult.UNSUPPORTED)  # Commander.cpp default: -> UNSUPPORTED
@@ -69,12 +71,12 @@ def _arm_disarm(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck | 
     p1 = cmd.param(1)
     # SAFER THAN PX4: lroundf(NaN/inf) is undefined in C (x86 gives LONG_MIN, others may give 0 = disarm); we treat
     # a non-finite param1 like any other invalid value: the text and no ACK.
-    action = lround(p1) if math.isfinite(p1) else None
+    action = lround(p1) if isfinite(p1) else None
     if action not in (0, 1):
         c.say(Severity.CRITICAL, f"Unsupported ARM_DISARM param: {p1:.3f}", is_event=False)
         return None  # cmd_result stays UNSUPPORTED, which this path never answers
     p2 = cmd.param(2)
-    forced = math.isfinite(p2) and lround(p2) == FORCE_MAGIC
+    forced = isfinite(p2) and lround(p2) == FORCE_MAGIC
     if action == 1:
         # arm(reason, run_preflight_checks = from_external || !forced): -f only bypasses checks from the shell
         ok = c.arm(now_us, external=cmd.from_external, run_checks=cmd.from_external or not forced)
@@ -131,7 +133,7 @@ def _takeoff(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     ack = _switch(c, cmd, now_us, NavState.AUTO_TAKEOFF, None)
     if ack.result == MavResult.ACCEPTED:
         # navigator: param7 = target altitude AMSL (NaN -> MIS_TAKEOFF_ALT above here), param5/6 lat/lon; yaw ignored
-        c.nav_commands.append(NavCommand("takeoff", cmd.param(5), cmd.param(6), cmd.param(7)))
+        c.nav_commands.append(NavCommand(NavCommandKind.TAKEOFF, cmd.param(5), cmd.param(6), cmd.param(7)))
     return ack
 
 
@@ -146,25 +148,25 @@ def _rtl(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 
 def _reposition(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     p2 = cmd.param(2)
-    flags = int(p2) if math.isfinite(p2) else 0
+    flags = int(p2) if isfinite(p2) else 0
     if flags != REPOSITION_FLAG_CHANGE_MODE:
         return _ack(cmd, MavResult.UNSUPPORTED)  # v1.15-v1.17: only "change mode" is supported
     ack = _switch(c, cmd, now_us, NavState.AUTO_LOITER, None)
     if ack.result == MavResult.ACCEPTED and c.armed:
         # navigator_main.cpp: lat p5, lon p6, alt p7 AMSL (NaN -> current), yaw p4 rad, ground speed p1
-        c.nav_commands.append(NavCommand("reposition", cmd.param(5), cmd.param(6), cmd.param(7), cmd.param(4),
-                                         cmd.param(1)))
+        c.nav_commands.append(NavCommand(NavCommandKind.REPOSITION, cmd.param(5), cmd.param(6), cmd.param(7),
+                                         cmd.param(4), cmd.param(1)))
     return ack
 
 
 def _change_altitude(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
-    if c.nav_state not in (NavState.AUTO_LOITER, NavState.GUIDED_COURSE) or not math.isfinite(cmd.param(1)):
+    if c.nav_state not in (NavState.AUTO_LOITER, NavState.GUIDED_COURSE) or not isfinite(cmd.param(1)):
         return _ack(cmd, MavResult.DENIED)
     alt = cmd.param(1)
     if _uint8(cmd.param(2)) == 3 and c.home is not None:  # MAV_FRAME_GLOBAL_RELATIVE_ALT: above home
         alt += c.home.alt_amsl_m
     if c.armed:
-        c.nav_commands.append(NavCommand("change_altitude", alt_amsl_m=alt))
+        c.nav_commands.append(NavCommand(NavCommandKind.CHANGE_ALTITUDE, alt_amsl_m=alt))
     return _ack(cmd, MavResult.ACCEPTED)
 
 
@@ -174,10 +176,10 @@ def _set_home(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
         ok = c.home_here()
     else:
         lat, lon, alt = cmd.param(5), cmd.param(6), cmd.param(7)
-        if not (math.isfinite(lat) and math.isfinite(lon) and math.isfinite(alt)):
+        if not (isfinite(lat) and isfinite(lon) and isfinite(alt)):
             return _ack(cmd, MavResult.DENIED)
         yaw_deg = cmd.param(4)
-        yaw = math.radians(yaw_deg) % (2 * math.pi) if math.isfinite(yaw_deg) else math.nan
+        yaw = math.radians(yaw_deg) % (2 * math.pi) if isfinite(yaw_deg) else math.nan
         ok = c.home_from_global(lat, lon, alt, yaw)
     return _ack(cmd, MavResult.ACCEPTED if ok else MavResult.TEMPORARILY_REJECTED)
 
@@ -205,7 +207,7 @@ def _calibration(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 def _reboot(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     """Commander.cpp: `const int param1 = cmd.param1`; 0 nothing, 1 reboot, 2 shutdown, only while disarmed."""
     p1 = cmd.param(1)
-    action = int(p1) if math.isfinite(p1) else -1
+    action = int(p1) if isfinite(p1) else -1
     if action == 0:
         return _ack(cmd, MavResult.ACCEPTED)
     if action not in (1, 2) or c.armed:

@@ -14,25 +14,27 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from enum import Enum
 
+from sitl_emu.flight.arming import CheckInputs, can_run
 from sitl_emu.px4 import NavState
 
 
-class Action(Enum):
-    NONE = "none"
-    MODE = "mode"
-    DISARM = "disarm"
-
-
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Decision:
+    """The mode in force and what to do (made every commander cycle, so not frozen and with its __init__ written
+    out, as arming.CheckInputs). Treat it as read-only."""
+
     nav_state: NavState
     failsafe: bool
     disarm: bool = False
     activated: bool = False  # the failsafe started at this update: say "Failsafe activated"
+
+    def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False) -> None:
+        self.nav_state = nav_state
+        self.failsafe = failsafe
+        self.disarm = disarm
+        self.activated = activated
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
@@ -57,7 +59,7 @@ class FallbackSettings:
 
 def _initial_fallback(user: NavState, s: FallbackSettings) -> NavState | None:
     """The first fallback for a user mode that cannot run; None means disarm."""
-    if user == NavState.OFFBOARD:
+    if user is NavState.OFFBOARD:
         return _OBL_ACTIONS.get(s.obl_rc_act, NavState.POSCTL)
     if user in (NavState.POSITION_SLOW, NavState.POSCTL):
         return NavState.ALTCTL
@@ -68,11 +70,11 @@ def _initial_fallback(user: NavState, s: FallbackSettings) -> NavState | None:
     return NavState.AUTO_LAND
 
 
-def resolve_fallback(user: NavState, s: FallbackSettings, can_run: Callable[[NavState], bool]) -> NavState | None:
+def resolve_fallback(user: NavState, s: FallbackSettings, inputs: CheckInputs) -> NavState | None:
     """Walk the fallback chain until a mode can run; None means disarm (DESCEND needs only an attitude)."""
     mode = _initial_fallback(user, s)
     for _ in range(8):  # every chain ends in DESCEND, TERMINATION or disarm within a few steps
-        if mode is None or mode in (NavState.TERMINATION, NavState.DESCEND) or can_run(mode):
+        if mode is None or mode in (NavState.TERMINATION, NavState.DESCEND) or can_run(mode, inputs):
             return mode
         if mode in _MANUAL_CHAIN:
             idx = _MANUAL_CHAIN.index(mode)
@@ -96,17 +98,18 @@ class Failsafe:
     def reset(self) -> None:
         self.active = False
 
-    def update(self, *, armed: bool, user: NavState, can_run: Callable[[NavState], bool], settings: FallbackSettings,
+    def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False) -> Decision:
+        """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.active = False
             return Decision(user, False)
         if terminated:
             return self._enter(NavState.TERMINATION)
-        if can_run(user):
+        if can_run(user, inputs):
             self.active = False
             return Decision(user, False)
-        fallback = resolve_fallback(user, settings, can_run)
+        fallback = resolve_fallback(user, settings, inputs)
         if fallback is None:
             decision = self._enter(user)
             return Decision(user, True, disarm=True, activated=decision.activated)

@@ -15,18 +15,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 
-FREEFALL_ACC_M_S2 = 2.0  # MulticopterLandDetector::_get_freefall_state
-FREEFALL_TRIGGER_US = 300_000  # LandDetector.h FREEFALL_TRIGGER_TIME_US
-DESCENT_FACTOR = 1.1  # in descent: velocity setpoint z >= 1.1 * LNDMC_Z_VEL_MAX
-WIDEN_FACTOR = 2.5  # thresholds widen once maybe landed
+FREEFALL_ACC_M_S2: Final = 2.0  # MulticopterLandDetector::_get_freefall_state
+FREEFALL_TRIGGER_US: Final = 300_000  # LandDetector.h FREEFALL_TRIGGER_TIME_US
+DESCENT_FACTOR: Final = 1.1  # in descent: velocity setpoint z >= 1.1 * LNDMC_Z_VEL_MAX
+WIDEN_FACTOR: Final = 2.5  # thresholds widen once maybe landed
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class LandDetectorInput:
+    """One detector cycle's input. Made every cycle, so not frozen and with its __init__ written out (as
+    LandDetectorState and arming.CheckInputs): treat both as read-only."""
+
     time_us: int
     armed: bool
     vel_ned_m_s: Vec3
@@ -37,13 +42,32 @@ class LandDetectorInput:
     setpoint_vz_m_s: float  # vertical velocity setpoint (NaN if none)
     in_descent_mode: bool  # climb rate controlled (PX4 flag_control_climb_rate_enabled), e.g. land/idle/position
 
+    def __init__(self, time_us: int, armed: bool, vel_ned_m_s: Vec3, rates_frd_rad_s: Vec3,
+                 specific_force_norm_m_s2: float, thrust_setpoint: float, hover_thrust: float, setpoint_vz_m_s: float,
+                 in_descent_mode: bool) -> None:
+        self.time_us = time_us
+        self.armed = armed
+        self.vel_ned_m_s = vel_ned_m_s
+        self.rates_frd_rad_s = rates_frd_rad_s
+        self.specific_force_norm_m_s2 = specific_force_norm_m_s2
+        self.thrust_setpoint = thrust_setpoint
+        self.hover_thrust = hover_thrust
+        self.setpoint_vz_m_s = setpoint_vz_m_s
+        self.in_descent_mode = in_descent_mode
 
-@dataclass(frozen=True, slots=True)
+
+@dataclass(slots=True)
 class LandDetectorState:
     landed: bool
     maybe_landed: bool
     ground_contact: bool
     freefall: bool
+
+    def __init__(self, landed: bool, maybe_landed: bool, ground_contact: bool, freefall: bool) -> None:
+        self.landed = landed
+        self.maybe_landed = maybe_landed
+        self.ground_contact = ground_contact
+        self.freefall = freefall
 
 
 class Hysteresis:
@@ -112,31 +136,19 @@ class LandDetector:
         self._freefall.reset(False)
 
     def update(self, inp: LandDetectorInput) -> LandDetectorState:
-        self.update_values(inp.time_us, inp.armed, inp.vel_ned_m_s, inp.rates_frd_rad_s, inp.specific_force_norm_m_s2,
-                           inp.thrust_setpoint, inp.hover_thrust, inp.setpoint_vz_m_s, inp.in_descent_mode)
-        return self.state
-
-    def update_values(self, time_us: int, armed: bool, vel_ned_m_s: Vec3, rates_frd_rad_s: Vec3,
-                      specific_force_norm_m_s2: float, thrust_setpoint: float, hover_thrust: float,
-                      setpoint_vz_m_s: float, in_descent_mode: bool) -> tuple[bool, bool, bool]:
-        """update() with the LandDetectorInput fields as arguments (no allocation per cycle);
-        returns (landed, maybe_landed, ground_contact)."""
-        if self._params.version != self._version:
-            self._refresh()
-        freefall, ground_contact, maybe_landed, landed = self._freefall, self._ground_contact, self._maybe_landed, \
-            self._landed
-        freefall.set_state_and_update(specific_force_norm_m_s2 < FREEFALL_ACC_M_S2, time_us)
-        if armed:
-            ground_contact.set_state_and_update(self._ground_contact_now(
-                vel_ned_m_s, thrust_setpoint, hover_thrust, setpoint_vz_m_s, in_descent_mode), time_us)
-            maybe_landed.set_state_and_update(self._maybe_landed_now(
-                rates_frd_rad_s, thrust_setpoint, hover_thrust, in_descent_mode), time_us)
-            landed.set_state_and_update(maybe_landed.state, time_us)
+        """One detector cycle (PX4 runs it at 50 Hz): the published land-detected state."""
+        self._refresh()
+        now_us = inp.time_us
+        self._freefall.set_state_and_update(inp.specific_force_norm_m_s2 < FREEFALL_ACC_M_S2, now_us)
+        if inp.armed:
+            self._ground_contact.set_state_and_update(self._ground_contact_now(inp), now_us)
+            self._maybe_landed.set_state_and_update(self._maybe_landed_now(inp), now_us)
+            self._landed.set_state_and_update(self._maybe_landed.state, now_us)
         else:  # disarmed: every stage is requested true (freefall aside)
-            ground_contact.set_state_and_update(True, time_us)
-            maybe_landed.set_state_and_update(True, time_us)
-            landed.set_state_and_update(True, time_us)
-        return landed.state, maybe_landed.state, ground_contact.state
+            self._ground_contact.set_state_and_update(True, now_us)
+            self._maybe_landed.set_state_and_update(True, now_us)
+            self._landed.set_state_and_update(True, now_us)
+        return self.state
 
     @property
     def state(self) -> LandDetectorState:
@@ -151,30 +163,29 @@ class LandDetector:
         for h in (self._ground_contact, self._maybe_landed, self._landed):
             h.time_from_false_us = self._s.stage_us
 
-    def _ground_contact_now(self, vel_ned_m_s: Vec3, thrust_setpoint: float, hover_thrust: float,
-                            setpoint_vz_m_s: float, in_descent_mode: bool) -> bool:
+    def _ground_contact_now(self, inp: LandDetectorInput) -> bool:
         """Armed only (disarmed: true)."""
         s = self._s
+        vel = inp.vel_ned_m_s
         vz_limit = s.z_vel_max * (WIDEN_FACTOR if self._maybe_landed.state else 1.0)
-        vertical_movement = abs(vel_ned_m_s[2]) > vz_limit
-        horizontal_movement = math.hypot(vel_ned_m_s[0], vel_ned_m_s[1]) > s.xy_vel_max
+        vertical_movement = abs(vel[2]) > vz_limit
+        horizontal_movement = math.hypot(vel[0], vel[1]) > s.xy_vel_max
         share = 0.6 if s.use_hte else 0.3  # 60 % of the min..hover range with a hover-thrust estimate, else 30 %
-        contact = thrust_setpoint <= s.thr_min + (hover_thrust - s.thr_min) * share
-        if in_descent_mode and not self._maybe_landed.state and not self._landed.state:
-            vz_sp = setpoint_vz_m_s
-            contact = contact and math.isfinite(vz_sp) and vz_sp >= DESCENT_FACTOR * s.z_vel_max
+        contact = inp.thrust_setpoint <= s.thr_min + (inp.hover_thrust - s.thr_min) * share
+        if inp.in_descent_mode and not self._maybe_landed.state and not self._landed.state:
+            vz_sp = inp.setpoint_vz_m_s
+            contact = contact and isfinite(vz_sp) and vz_sp >= DESCENT_FACTOR * s.z_vel_max
         return contact and not horizontal_movement and not vertical_movement
 
-    def _maybe_landed_now(self, rates_frd_rad_s: Vec3, thrust_setpoint: float, hover_thrust: float,
-                          in_descent_mode: bool) -> bool:
+    def _maybe_landed_now(self, inp: LandDetectorInput) -> bool:
         """Armed only (disarmed: true)."""
         s = self._s
-        min_thrust = s.thr_min + (hover_thrust - s.thr_min) * 0.1
-        if not in_descent_mode:
+        min_thrust = s.thr_min + (inp.hover_thrust - s.thr_min) * 0.1
+        if not inp.in_descent_mode:
             min_thrust = s.man_thr_min + 0.01
-        if thrust_setpoint > min_thrust or self._freefall.state:
+        if inp.thrust_setpoint > min_thrust or self._freefall.state:
             return False
         rot_limit = s.rot_max_rad_s * (WIDEN_FACTOR if self._maybe_landed.state else 1.0)
-        if math.hypot(rates_frd_rad_s[0], rates_frd_rad_s[1]) > rot_limit:
+        if math.hypot(inp.rates_frd_rad_s[0], inp.rates_frd_rad_s[1]) > rot_limit:
             return False
         return self._ground_contact.state

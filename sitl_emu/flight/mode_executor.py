@@ -15,19 +15,21 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Final
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks
-from sitl_emu.flight.commander import NavCommand
+from sitl_emu.flight.commander import NavCommand, NavCommandKind
+from sitl_emu.flight.tasks import SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
 # flight_mode_manager runs the task on each estimator update; sitl_emu runs it with the position controller (125 Hz)
-TASK_PERIOD_US = 8000
+TASK_PERIOD_US: Final = 8000
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
                          NavState.AUTO_RTL})
-_OFFBOARD = NavState.OFFBOARD  # a module constant: enum member lookups cost on the per-tick path
 
 
 @dataclass(slots=True)
@@ -36,13 +38,13 @@ class ExecutorOutput:
 
     trajectory: TrajectorySetpoint | None
     attitude: AttitudeSetpoint | None
-    setpoint_type: str  # "idle" | "position" | "takeoff" | "land" | "offboard" | "none"
+    setpoint_type: SetpointType
     task_finished: bool
     messages: Sequence[tuple[Severity, str]]
     want_takeoff: bool | None = None  # the task's vehicle_constraints.want_takeoff; None: from the setpoint
 
-    def __init__(self, trajectory: TrajectorySetpoint | None, attitude: AttitudeSetpoint | None, setpoint_type: str,
-                 task_finished: bool, messages: Sequence[tuple[Severity, str]],
+    def __init__(self, trajectory: TrajectorySetpoint | None, attitude: AttitudeSetpoint | None,
+                 setpoint_type: SetpointType, task_finished: bool, messages: Sequence[tuple[Severity, str]],
                  want_takeoff: bool | None = None) -> None:
         self.trajectory = trajectory
         self.attitude = attitude
@@ -52,7 +54,7 @@ class ExecutorOutput:
         self.want_takeoff = want_takeoff
 
 
-_NO_SETPOINT = ExecutorOutput(None, None, "none", False, ())
+_NO_SETPOINT = ExecutorOutput(None, None, SetpointType.NONE, False, ())
 
 
 class ModeExecutor:
@@ -61,14 +63,14 @@ class ModeExecutor:
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
         self.task: tasks.Task | None = None
-        self._task_mode: NavState | None = None
+        self._task_mode: NavState | None = None  # the mode self.task flies; None exactly when no task runs
         self._pending_takeoff: NavCommand | None = None  # NAV_TAKEOFF parameters, used when the takeoff starts
         self._offboard_kind: OffboardControlMode | None = None
         self._offboard_traj: TrajectorySetpoint | None = None
         self._offboard_att: AttitudeSetpoint | None = None
-        self._held: ExecutorOutput | None = None  # the last task output, reused until TASK_PERIOD_US has passed
-        self._last_us = 0
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
+        self._held: ExecutorOutput | None = None  # the task's last output, reused until TASK_PERIOD_US has passed
+        self._last_us = 0  # when the task last ran
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -82,23 +84,24 @@ class ModeExecutor:
     def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
                commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
-        mode = self._task_mode  # None exactly when no task runs
-        if commands or self._pending_takeoff is not None or (
-                (not armed or nav_state != mode) if mode is not None else (armed and nav_state in _TASK_MODES)):
-            new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
-        else:
-            new_task = False  # no command and the task (or its absence) still fits: _select_task changes nothing
-        if nav_state == _OFFBOARD:
-            out = self._offboard_out
-            if out is None:
-                out = self._offboard_out = self._offboard_output()
-            return out
+        new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
+        if nav_state is NavState.OFFBOARD:
+            if self._offboard_out is None:
+                self._offboard_out = self._offboard_output()
+            return self._offboard_out
         if self.task is None:
             return _NO_SETPOINT
-        if not new_task and self._held is not None and now_us - self._last_us < TASK_PERIOD_US:
-            return self._held
-        dt = dt_s if new_task or self._held is None else (now_us - self._last_us) * 1e-6
-        task = self.task
+        return self._run_task(self.task, now_us, nav_fn, dt_s, new_task)
+
+    def _run_task(self, task: tasks.Task, now_us: int, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
+                  new_task: bool) -> ExecutorOutput:
+        """The task's setpoint, computed every TASK_PERIOD_US (the last one is held in between)."""
+        held = self._held
+        dt = dt_s
+        if held is not None and not new_task:
+            if now_us - self._last_us < TASK_PERIOD_US:
+                return held
+            dt = (now_us - self._last_us) * 1e-6
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
         self._last_us = now_us
@@ -111,8 +114,8 @@ class ModeExecutor:
         kind = self._offboard_kind
         use_traj = kind is not None and (kind.position or kind.velocity or kind.acceleration)
         if use_traj or self._offboard_att is None:
-            return ExecutorOutput(self._offboard_traj, None, "offboard", False, ())
-        return ExecutorOutput(None, self._offboard_att, "offboard", False, ())
+            return ExecutorOutput(self._offboard_traj, None, SetpointType.OFFBOARD, False, ())
+        return ExecutorOutput(None, self._offboard_att, SetpointType.OFFBOARD, False, ())
 
     # ---- task selection -----------------------------------------------------------------------------------------
     def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], tasks.NavInput],
@@ -121,51 +124,59 @@ class ModeExecutor:
 
         navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
         the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
-        for cmd in commands:
-            if cmd.kind == "takeoff":
-                self._pending_takeoff = cmd
-        command = commands[-1] if commands and commands[-1].kind != "takeoff" else None
-        commands.clear()
+        command = self._take_commands(commands) if commands else None
         if nav_state not in _TASK_MODES or not armed:
             self.task, self._task_mode, self._held = None, None, None
-            if nav_state != NavState.AUTO_TAKEOFF:
+            if nav_state is not NavState.AUTO_TAKEOFF:
                 self._pending_takeoff = None
             return False
-        previous = self._task_mode
-        takeoff_target: Vec3 | None = None
-        if previous == NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
+        new_takeoff = self._pending_takeoff is not None and nav_state is NavState.AUTO_TAKEOFF
+        if nav_state is self._task_mode and command is None and not new_takeoff:
+            return False  # the running task still fits
+        self._start_task(nav_state, nav_fn(), command, ref)
+        return True
+
+    def _take_commands(self, commands: list[NavCommand]) -> NavCommand | None:
+        """Empty the commander's (non-empty) queue: a NAV_TAKEOFF waits for the takeoff to start; the last command is
+        returned unless it is a NAV_TAKEOFF (a reposition or altitude change restarts Hold)."""
+        for cmd in commands:
+            if cmd.kind is NavCommandKind.TAKEOFF:
+                self._pending_takeoff = cmd
+        last = commands[-1]
+        commands.clear()
+        return None if last.kind is NavCommandKind.TAKEOFF else last
+
+    def _start_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
+        takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
+        if self._task_mode is NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
-        new_takeoff = nav_state == NavState.AUTO_TAKEOFF and self._pending_takeoff is not None
-        if nav_state == previous and command is None and not new_takeoff:
-            return False
-        nav = nav_fn()
         self._task_mode = nav_state
-        if nav_state == NavState.AUTO_TAKEOFF:
+        if nav_state is NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, self._pending_takeoff, ref)
             self._pending_takeoff = None
-        elif nav_state == NavState.AUTO_LOITER:
+        elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
-        elif nav_state == NavState.AUTO_RTL:
+        elif nav_state is NavState.AUTO_RTL:
             self.task = tasks.make_rtl(nav, self.params)
         else:
             self.task = tasks.make_land(nav, self.params)
-        return True
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None
-        if command is not None and command.kind == "takeoff" and math.isfinite(command.alt_amsl_m):
+        if command is not None and command.kind is NavCommandKind.TAKEOFF and isfinite(command.alt_amsl_m):
             alt_up = command.alt_amsl_m - ref.alt_amsl_m  # param7 is AMSL; the local origin is at ref altitude
         return tasks.make_takeoff(nav, self.params, alt_up)
 
     def _make_loiter(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
                      takeoff_target: Vec3 | None) -> tasks.Task:
-        if command is not None and command.kind in ("reposition", "change_altitude") and nav.armed:
+        moves = (NavCommandKind.REPOSITION, NavCommandKind.CHANGE_ALTITUDE)
+        if command is not None and command.kind in moves and nav.armed:
             target = _command_target(command, nav, ref)
-            speed = command.speed_m_s if math.isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
+            speed = command.speed_m_s if isfinite(command.speed_m_s) and command.speed_m_s > 0 else math.nan
             # DO_REPOSITION with yaw NaN: PX4 passes NaN on and the vehicle faces the target (MPC_YAW_MODE 0,
             # navigator_main.cpp); a change of altitude keeps the current heading.
-            keep = nav.yaw_rad if command.kind == "change_altitude" else math.nan
-            yaw = command.yaw_rad if math.isfinite(command.yaw_rad) else keep
+            keep = nav.yaw_rad if command.kind is NavCommandKind.CHANGE_ALTITUDE else math.nan
+            yaw = command.yaw_rad if isfinite(command.yaw_rad) else keep
             return tasks.make_reposition(nav, self.params, target, yaw, speed)
         if takeoff_target is not None:
             return tasks.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
@@ -175,8 +186,8 @@ class ModeExecutor:
 def _command_target(command: NavCommand, nav: tasks.NavInput, ref: GeoRef) -> Vec3:
     """The reposition target in NED; NaN lat/lon/alt keep the current position's component."""
     x, y, z = nav.pos_ned_m
-    if math.isfinite(command.lat_deg) and math.isfinite(command.lon_deg):
+    if isfinite(command.lat_deg) and isfinite(command.lon_deg):
         x, y, _ = global_to_ned(ref, command.lat_deg, command.lon_deg, ref.alt_amsl_m)
-    if math.isfinite(command.alt_amsl_m):
+    if isfinite(command.alt_amsl_m):
         z = ref.alt_amsl_m - command.alt_amsl_m
     return x, y, z

@@ -29,7 +29,7 @@ class ModeIntention:
         if not allowed:
             return False
         self.user_intended = nav_state
-        if not mode_prevents_arming(nav_state) or nav_state == NavState.TERMINATION:
+        if not mode_prevents_arming(nav_state) or nav_state is NavState.TERMINATION:
             self.after_disarming = nav_state
         return True
 

@@ -5,20 +5,18 @@ segments T1 (jerk up), T2 (constant acceleration), T3 (jerk down) that bring the
 `PositionSmoothing.cpp` (a velocity target per axis derived from the distance to a waypoint, the time stretch that
 waits for a lagging vehicle) and `src/lib/mathlib/math/TrajMath.hpp` (speed from braking distance).
 Only the single-waypoint case the navigator tasks use is implemented (no L1 turns between waypoints).
-
-Speed: this runs every position-controller cycle in every auto mode, so the hot methods avoid min()/max() builtins
-(`b if b < a else a` is exactly min(a, b), `b if b > a else a` exactly max(a, b), NaN and -0.0 included),
-generators and small helper calls; the arithmetic itself is unchanged (same operations in the same order).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Sequence
+from typing import Final
 
+from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3
 
-_EPS = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
+_EPS: Final = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
 
 
 def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_speed: float) -> float:
@@ -26,7 +24,7 @@ def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_
     b = 4.0 * accel * accel / jerk
     c = -2.0 * accel * distance_m - final_speed * final_speed
     speed = 0.5 * (-b + math.sqrt(b * b - 4.0 * c))
-    return final_speed if final_speed > speed else speed  # max(speed, final_speed)
+    return max(speed, final_speed)
 
 
 def braking_distance(speed: float, jerk: float, accel: float, accel_delay_max: float) -> float:
@@ -36,6 +34,12 @@ def braking_distance(speed: float, jerk: float, accel: float, accel_delay_max: f
 
 def _sign(x: float) -> int:
     return (x > 0.0) - (x < 0.0)
+
+
+def _evaluate_poly(j: float, a0: float, v0: float, x0: float, t: float) -> tuple[float, float, float, float]:
+    """(jerk, acceleration, velocity, position) after t seconds of constant jerk j (VelocitySmoothing::evaluatePoly;
+    update_traj never passes a negative t)."""
+    return j, a0 + j * t, v0 + a0 * t + 0.5 * j * t * t, x0 + v0 * t + 0.5 * a0 * t * t + j * t * t * t / 6.0
 
 
 class AxisSmoother:
@@ -66,14 +70,11 @@ class AxisSmoother:
 
     def update_durations(self, vel_setpoint: float) -> None:
         """Plan the fastest jerk-limited profile from the current state to `vel_setpoint` (clamped to max_vel)."""
-        max_vel = self.max_vel
-        low = -max_vel
-        vel_sp = low if low > vel_setpoint else vel_setpoint  # min(max(vel_setpoint, -max_vel), max_vel)
-        vel_sp = self._vel_sp = max_vel if max_vel < vel_sp else vel_sp
+        vel_sp = self._vel_sp = constrain(vel_setpoint, -self.max_vel, self.max_vel)
         self._time = 0.0
         a, v = self.a, self.v
         self._a0, self._v0, self._x0 = a, v, self.x
-        if a == 0.0 and v == vel_sp:  # steady: nothing to plan (fast path, same result)
+        if a == 0.0 and v == vel_sp:  # steady: nothing to plan
             self._dir = 0
             self._t1 = self._t2 = self._t3 = 0.0
             return
@@ -93,15 +94,14 @@ class AxisSmoother:
             return
         dv = vel_sp - v
         t1 = self._t1 = self._t1_min_time(a, dv, jerk)
-        t3 = a / jerk + t1
-        t3 = self._t3 = 0.0 if t3 < 0.0 else t3  # max(t3, 0.0)
+        t3 = self._t3 = max(a / jerk + t1, 0.0)
         # T2 from the velocity the jerk phases leave to the constant-acceleration phase
         den = a + jerk * t1
         if abs(den) <= _EPS:
             self._t2 = 0.0
             return
         t2 = (-0.5 * t1 * t1 * jerk - t1 * t3 * jerk - t1 * a + 0.5 * t3 * t3 * jerk - t3 * a + dv) / den
-        self._t2 = 0.0 if t2 < 0.0 else t2  # max(t2, 0.0)
+        self._t2 = max(t2, 0.0)
 
     def update_durations_given_total_time(self, total_s: float) -> None:
         """Stretch the current plan so that it lasts `total_s` (used to synchronise the axes)."""
@@ -110,53 +110,31 @@ class AxisSmoother:
             self._t1 = self._t2 = self._t3 = 0.0
             return
         t1 = self._t1 = self._t1_given_total(total_s, self.a, self._vel_sp - self.v, jerk)
-        t3 = self.a / jerk + t1
-        t3 = self._t3 = 0.0 if t3 < 0.0 else t3  # max(t3, 0.0)
-        t2 = total_s - t1 - t3
-        self._t2 = 0.0 if t2 < 0.0 else t2
+        t3 = self._t3 = max(self.a / jerk + t1, 0.0)
+        self._t2 = max(total_s - t1 - t3, 0.0)
 
     def update_traj(self, dt_s: float, time_stretch: float = 1.0) -> None:
-        """Advance along the planned profile by `dt_s` (scaled by `time_stretch`, 0..1)."""
+        """Advance along the planned profile by `dt_s` (>= 0) scaled by `time_stretch` (0..1)
+        (VelocitySmoothing::updateTraj): T1 at +jerk, T2 at constant acceleration, T3 at -jerk, then constant
+        velocity."""
         rest = self._time = self._time + dt_s * time_stretch
-        t1, t2, t3 = self._t1, self._t2, self._t3
-        if t1 == 0.0 and t2 == 0.0 and t3 == 0.0:  # constant velocity (fast path)
+        if self._t1 == 0.0 and self._t2 == 0.0 and self._t3 == 0.0:  # nothing planned: constant velocity
             if rest > 0.0:
                 self.j, self.a, self.v, self.x = 0.0, 0.0, self._v0, self._x0 + self._v0 * rest
             else:
                 self.j, self.a, self.v, self.x = 0.0, self._a0, self._v0, self._x0
             return
-        # the segments, each as _eval(j, a, v, x, t) with t = max(min(rest, T), 0.0), written out
-        j = self._dir * self.max_jerk
-        a, v, x = self._a0, self._v0, self._x0
-        t = t1 if t1 < rest else rest
-        if t < 0.0:
-            t = 0.0
-        a, v, x = a + j * t, v + a * t + 0.5 * j * t * t, x + v * t + 0.5 * a * t * t + j * t * t * t / 6.0
-        rest -= t1
+        j, a, v, x = _evaluate_poly(self._dir * self.max_jerk, self._a0, self._v0, self._x0, min(rest, self._t1))
+        rest -= self._t1
         if rest > 0.0:
-            j = 0.0
-            t = t2 if t2 < rest else rest
-            if t < 0.0:
-                t = 0.0
-            a, v, x = a + j * t, v + a * t + 0.5 * j * t * t, x + v * t + 0.5 * a * t * t + j * t * t * t / 6.0
-            rest -= t2
+            j, a, v, x = _evaluate_poly(0.0, a, v, x, min(rest, self._t2))
+            rest -= self._t2
         if rest > 0.0:
-            j = -self._dir * self.max_jerk
-            t = t3 if t3 < rest else rest
-            if t < 0.0:
-                t = 0.0
-            a, v, x = a + j * t, v + a * t + 0.5 * j * t * t, x + v * t + 0.5 * a * t * t + j * t * t * t / 6.0
-            rest -= t3
+            j, a, v, x = _evaluate_poly(-self._dir * self.max_jerk, a, v, x, min(rest, self._t3))
+            rest -= self._t3
         if rest > 0.0:
-            j, a, t = 0.0, 0.0, rest
-            a, v, x = a + j * t, v + a * t + 0.5 * j * t * t, x + v * t + 0.5 * a * t * t + j * t * t * t / 6.0
+            j, a, v, x = _evaluate_poly(0.0, 0.0, v, x, rest)
         self.j, self.a, self.v, self.x = j, a, v, x
-
-    @staticmethod
-    def _eval(j: float, a0: float, v0: float, x0: float, t: float) -> tuple[float, float, float, float]:
-        """The state after t seconds of constant jerk (update_traj has this written out per segment)."""
-        t = max(t, 0.0)
-        return j, a0 + j * t, v0 + a0 * t + 0.5 * j * t * t, x0 + v0 * t + 0.5 * a0 * t * t + j * t * t * t / 6.0
 
     def _saturate_t1(self, a0: float, jerk: float, t1: float) -> float:
         accel_t1 = a0 + jerk * t1
@@ -179,8 +157,7 @@ class AxisSmoother:
             cand = (-a0 - 0.5 * root) / jerk
             if cand >= 0.0 and a0 / jerk + cand >= 0.0:
                 t1 = cand
-        t1 = self._saturate_t1(a0, jerk, t1)
-        return 0.0 if t1 < 0.0 else t1  # max(t1, 0.0)
+        return max(self._saturate_t1(a0, jerk, t1), 0.0)
 
     def _t1_given_total(self, total: float, a0: float, dv: float, jerk: float) -> float:
         qa, qb = -jerk, jerk * total - a0
@@ -189,28 +166,25 @@ class AxisSmoother:
             return 0.0
         root = math.sqrt(delta)
         t1 = 0.0
-        cand = (-qb + root) / (2.0 * qa)
-        cand = 0.0 if cand < 0.0 else cand  # max(cand, 0.0)
+        cand = max((-qb + root) / (2.0 * qa), 0.0)
         t3 = a0 / jerk + cand
         if t3 >= 0.0 and cand + t3 <= total:
             t1 = cand
         else:
-            cand = (-qb - root) / (2.0 * qa)
-            cand = 0.0 if cand < 0.0 else cand
+            cand = max((-qb - root) / (2.0 * qa), 0.0)
             t3 = a0 / jerk + cand
             if t3 >= 0.0 and cand + t3 <= total:
                 t1 = cand
         return self._saturate_t1(a0, jerk, t1)
 
 
-def synchronize(axes: list[AxisSmoother]) -> None:
-    """Make every axis finish its velocity change together with the slowest one (VelocitySmoothing::timeSync)."""
-    totals = [a._t1 + a._t2 + a._t3 for a in axes]  # total_time, each read before its own axis changes
-    if all(t <= _EPS for t in totals):
-        return
-    longest = 0  # the first index of the largest total, as max(range(n), key=...) picks it
-    for i in range(1, len(totals)):
-        if totals[i] > totals[longest]:
+def synchronize(axes: Sequence[AxisSmoother]) -> None:
+    """Make every axis finish its velocity change together with the slowest one
+    (VelocitySmoothing::timeSynchronization)."""
+    totals = [axis.total_time for axis in axes]  # each read before its own axis changes
+    longest = 0
+    for i, total in enumerate(totals):
+        if total > totals[longest]:
             longest = i
     desired = totals[longest]
     if desired <= _EPS:
@@ -220,18 +194,11 @@ def synchronize(axes: list[AxisSmoother]) -> None:
             axis.update_durations_given_total_time(desired)
 
 
-@dataclass(frozen=True, slots=True)
-class SmoothedSetpoint:
-    position_ned_m: Vec3
-    velocity_ned_m_s: Vec3
-    acceleration_ned_m_s2: Vec3
-    unsmoothed_velocity_ned_m_s: Vec3
-
-
 class PositionSmoother:
     """Three jerk-limited axes driven towards one waypoint (PX4 PositionSmoothing, single-waypoint case).
 
-    Limits are public attributes the caller sets before each `generate` (as FlightTaskAuto does every cycle).
+    Limits are public attributes the caller sets before each `update` (as FlightTaskAuto does every cycle); the
+    axes hold the smoothed setpoint (x, v, a) after it.
     """
 
     def __init__(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
@@ -250,48 +217,27 @@ class PositionSmoother:
         ay.max_jerk, ay.max_accel, ay.max_vel = jerk, accel_xy, vel_xy
         az.max_jerk, az.max_accel, az.max_vel = jerk, accel_z, vel_z
 
-    @property
-    def position(self) -> Vec3:
-        return (self.axes[0].x, self.axes[1].x, self.axes[2].x)
-
-    @property
-    def velocity(self) -> Vec3:
-        return (self.axes[0].v, self.axes[1].v, self.axes[2].v)
-
-    def generate(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> SmoothedSetpoint:
-        """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis)."""
-        vel_sp = self.update(vehicle_pos, target, feedforward_vel, dt_s)
-        ax = self.axes
-        return SmoothedSetpoint((ax[0].x, ax[1].x, ax[2].x), (ax[0].v, ax[1].v, ax[2].v),
-                                (ax[0].a, ax[1].a, ax[2].a), vel_sp)
-
     def update(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> Vec3:
-        """generate() without building its result: the axes hold the new state; returns the unsmoothed velocity."""
+        """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis).
+        The axes hold the new setpoint; returns the unsmoothed velocity target."""
         vel_sp = self._velocity_target(target, feedforward_vel)
-        isfinite = math.isfinite
         if isfinite(vel_sp[0]) and isfinite(vel_sp[1]) and isfinite(vel_sp[2]):
             self._advance(vehicle_pos, vel_sp, dt_s)
         return vel_sp
 
     def _velocity_target(self, target: Vec3, ff: Vec3) -> Vec3:
-        isfinite = math.isfinite
         out0, out1, out2 = ff
-        ax, _, az = self.axes
+        ax, ay, az = self.axes
         if isfinite(target[0]) and isfinite(target[1]):
-            dx, dy = target[0] - ax.x, target[1] - self.axes[1].x
+            dx, dy = target[0] - ax.x, target[1] - ay.x
             dist = math.hypot(dx, dy)
-            speed = max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0)
-            cruise = self.cruise_speed_m_s
-            if not speed < cruise:  # min(cruise, speed)
-                speed = cruise
+            speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
             out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
             out1 = uy * speed + (ff[1] if isfinite(ff[1]) else 0.0)
         if isfinite(target[2]):
             dz = target[2] - az.x
-            speed = max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0)
-            if not speed < az.max_vel:  # min(max_vel, speed)
-                speed = az.max_vel
+            speed = min(az.max_vel, max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0))
             out2 = _sign(dz) * speed + (ff[2] if isfinite(ff[2]) else 0.0)
         return (out0, out1, out2)
 
@@ -305,21 +251,7 @@ class PositionSmoother:
         ax.update_durations(vel_sp[0])
         ay.update_durations(vel_sp[1])
         az.update_durations(vel_sp[2])
-        # synchronize(self.axes), written out for three axes
-        tx, ty, tz = ax._t1 + ax._t2 + ax._t3, ay._t1 + ay._t2 + ay._t3, az._t1 + az._t2 + az._t3
-        if tx <= _EPS and ty <= _EPS and tz <= _EPS:
-            return
-        longest, desired = (1, ty) if ty > tx else (0, tx)
-        if tz > desired:
-            longest, desired = 2, tz
-        if desired <= _EPS:
-            return
-        if longest != 0 and tx < desired:
-            ax.update_durations_given_total_time(desired)
-        if longest != 1 and ty < desired:
-            ay.update_durations_given_total_time(desired)
-        if longest != 2 and tz < desired:
-            az.update_durations_given_total_time(desired)
+        synchronize(self.axes)
 
     def _stretch_xy(self, vehicle_pos: Vec3) -> float:
         """Slow the trajectory while the vehicle lags behind it (PositionSmoothing::_generateTrajectory)."""
@@ -327,13 +259,10 @@ class PositionSmoother:
         ex, ey = ax.x - vehicle_pos[0], ay.x - vehicle_pos[1]
         if self.max_xy_error_m <= _EPS or ex * ax.v + ey * ay.v < 0.0:
             return 1.0
-        r = math.hypot(ex, ey) / self.max_xy_error_m
-        r = 0.0 if r < 0.0 else r
-        return 1.0 - (1.0 if r > 1.0 else r)  # 1 - min(max(r, 0), 1)
+        return 1.0 - constrain(math.hypot(ex, ey) / self.max_xy_error_m, 0.0, 1.0)
 
     def _stretch_z(self, vehicle_pos: Vec3) -> float:
         ez = self.axes[2].x - vehicle_pos[2]
         if self.max_z_error_m <= _EPS or ez * self.axes[2].v < 0.0:
             return 1.0
-        r = abs(ez) / self.max_z_error_m
-        return 1.0 - (1.0 if r > 1.0 else r)  # 1 - min(r, 1)
+        return 1.0 - min(abs(ez) / self.max_z_error_m, 1.0)

@@ -9,25 +9,25 @@ from __future__ import annotations
 
 import math
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight.smoothing import braking_distance
-from sitl_emu.flight.tasks_core import AutoSettings, NavInput, Task, Waypoint
+from sitl_emu.flight.tasks_core import AutoSettings, NavInput, SetpointType, Task, Waypoint
 from sitl_emu.flight.tasks_rtl import RtlTask
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3
 
-__all__ = ["NavInput", "Task", "make_land", "make_loiter", "make_reposition", "make_rtl", "make_takeoff"]
+__all__ = ["NavInput", "SetpointType", "Task", "make_land", "make_loiter", "make_reposition", "make_rtl",
+           "make_takeoff"]
 
 
 class TakeoffTask(Task):
     """AUTO.TAKEOFF (navigator takeoff.cpp): climb straight up to the target, then loiter there."""
 
-    kind = "takeoff"
-
     def __init__(self, nav: NavInput, params: ParamRegistry, target_alt_up_m: float | None) -> None:
         super().__init__(nav, params)
         current_up = -nav.pos_ned_m[2]
-        if target_alt_up_m is None or not math.isfinite(target_alt_up_m):
+        if target_alt_up_m is None or not isfinite(target_alt_up_m):
             target_alt_up_m = current_up + self._settings.takeoff_alt
             self._say(Severity.INFO, f"Using default takeoff altitude: {self._settings.takeoff_alt:.1f} m")
         if target_alt_up_m < current_up:
@@ -38,9 +38,9 @@ class TakeoffTask(Task):
         self._alt_acceptance_m = min(self._settings.nav_mc_alt_rad, 0.5 * (target_alt_up_m - current_up))
         self._finished = False
         # the three waypoints this task can give (frozen, so built once)
-        self._wp_climb = Waypoint("takeoff", self._target)
-        self._wp_idle = Waypoint("idle", self._target)
-        self._wp_hold = Waypoint("position", self._target)
+        self._wp_climb = Waypoint(SetpointType.TAKEOFF, self._target)
+        self._wp_idle = Waypoint(SetpointType.IDLE, self._target)
+        self._wp_hold = Waypoint(SetpointType.POSITION, self._target)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -62,11 +62,9 @@ class TakeoffTask(Task):
 class LoiterTask(Task):
     """AUTO.LOITER (Hold, loiter.cpp): idle on the ground, else hold the braking point (or the given point)."""
 
-    kind = "loiter"
-
     def __init__(self, nav: NavInput, params: ParamRegistry, hold_at: Vec3 | None, yaw_rad: float | None) -> None:
         super().__init__(nav, params)
-        self._yaw = yaw_rad if yaw_rad is not None and math.isfinite(yaw_rad) else nav.yaw_rad
+        self._yaw = yaw_rad if yaw_rad is not None and isfinite(yaw_rad) else nav.yaw_rad
         if hold_at is not None:
             self._target = _fill_nan(hold_at, nav.pos_ned_m)
             near = abs(self._target[2] - nav.pos_ned_m[2]) <= self._settings.nav_mc_alt_rad
@@ -74,7 +72,10 @@ class LoiterTask(Task):
         else:
             self._target = braking_point(nav, self._settings)
             self._idle = nav.landed or not nav.armed
-        self._wp = Waypoint("idle", self._target) if self._idle else Waypoint("position", self._target, self._yaw)
+        if self._idle:
+            self._wp = Waypoint(SetpointType.IDLE, self._target)
+        else:
+            self._wp = Waypoint(SetpointType.POSITION, self._target, self._yaw)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -87,12 +88,10 @@ class LoiterTask(Task):
 class LandTask(Task):
     """AUTO.LAND (land.cpp): descend at the braking stop point with PX4's land speed profile."""
 
-    kind = "land"
-
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         super().__init__(nav, params)
         self._target = braking_point(nav, self._settings)
-        self._wp = Waypoint("land", self._target)
+        self._wp = Waypoint(SetpointType.LAND, self._target)
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
         return self._wp
@@ -101,15 +100,13 @@ class LandTask(Task):
 class RepositionTask(Task):
     """DO_REPOSITION in Hold (navigator_main.cpp reposition triplet): fly to the point at the given speed."""
 
-    kind = "reposition"
-
     def __init__(self, nav: NavInput, params: ParamRegistry, target_ned_m: Vec3, yaw_rad: float,
                  speed_m_s: float) -> None:
         super().__init__(nav, params)
         self._target = _fill_nan(target_ned_m, nav.pos_ned_m)
         self._yaw = yaw_rad
-        self._speed = speed_m_s if math.isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
-        self._wp = Waypoint("position", self._target, self._yaw, self._speed)
+        self._speed = speed_m_s if isfinite(speed_m_s) and speed_m_s > 0.0 else NAN
+        self._wp = Waypoint(SetpointType.POSITION, self._target, self._yaw, self._speed)
 
     @property
     def target_ned_m(self) -> Vec3:
@@ -131,9 +128,9 @@ def braking_point(nav: NavInput, settings: AutoSettings) -> Vec3:
 
 def _fill_nan(target: Vec3, fallback: Vec3) -> Vec3:
     return (
-        target[0] if math.isfinite(target[0]) else fallback[0],
-        target[1] if math.isfinite(target[1]) else fallback[1],
-        target[2] if math.isfinite(target[2]) else fallback[2],
+        target[0] if isfinite(target[0]) else fallback[0],
+        target[1] if isfinite(target[1]) else fallback[1],
+        target[2] if isfinite(target[2]) else fallback[2],
     )
 
 

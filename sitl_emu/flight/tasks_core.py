@@ -13,31 +13,44 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from enum import Enum
+from typing import Any, Final
 
+from sitl_emu.control.qmath import constrain, isfinite
+from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
 
-# TakeoffHandling states before the ramp (sitl_emu.control's takeoff_state names, PX4 takeoff_status values).
-PRE_RAMP_STATES = frozenset({"disarmed", "spoolup", "ready_for_takeoff"})
-WANT_TAKEOFF_VZ_M_S = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
-REACTIVATE_VZ_M_S = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
-IDLE_ACC_Z_M_S2 = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
+WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
+REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
+IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
 _NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
-_TWO_PI = 2.0 * math.pi
+_TWO_PI: Final = 2.0 * math.pi
+
+
+class SetpointType(Enum):
+    """What drives the controllers: a navigator position_setpoint.type (IDLE, POSITION, TAKEOFF, LAND), the offboard
+    stream, or nothing (manual and termination modes, disarmed)."""
+
+    IDLE = "idle"
+    POSITION = "position"
+    TAKEOFF = "takeoff"
+    LAND = "land"
+    OFFBOARD = "offboard"
+    NONE = "none"
 
 
 @dataclass(slots=True)
 class NavInput:
     """What the navigator tasks see of the vehicle, in the local NED frame (z = 0 is the ground at home).
 
-    `takeoff_state` is the control cascade's TakeoffHandling state (`MulticopterControl.takeoff_state`): while it is
-    before the ramp ("disarmed", "spoolup", "ready_for_takeoff") the trajectory is held at the vehicle, as PX4's
-    FlightModeManager does; the default "flight" disables that. `ref_alt_amsl_m` is the AMSL altitude of the local
-    origin (only used for the RTL message, which PX4 prints in AMSL).
+    `takeoff_state` is the control cascade's TakeoffHandling state: while it is before the ramp (disarmed, spoolup,
+    ready for takeoff) the trajectory is held at the vehicle, as PX4's FlightModeManager does; the default FLIGHT
+    disables that. `ref_alt_amsl_m` is the AMSL altitude of the local origin (only used for the RTL message, which
+    PX4 prints in AMSL).
 
     Built on every tick, so not frozen and with its __init__ written out (the same as the generated one): a frozen
     dataclass sets each field through object.__setattr__, and `make speedups` (mypyc) compiles only a written-out
@@ -52,11 +65,11 @@ class NavInput:
     home_yaw_rad: float
     landed: bool
     armed: bool
-    takeoff_state: str = "flight"
+    takeoff_state: TakeoffState = TakeoffState.FLIGHT
     ref_alt_amsl_m: float = 488.0
 
     def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
-                 home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: str = "flight",
+                 home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: TakeoffState = TakeoffState.FLIGHT,
                  ref_alt_amsl_m: float = 488.0) -> None:
         self.time_us = time_us
         self.pos_ned_m = pos_ned_m
@@ -136,9 +149,9 @@ def wrap_pi(angle: float) -> float:
 
 @dataclass(frozen=True, slots=True)
 class Waypoint:
-    """One navigator position setpoint: kind is "idle" | "takeoff" | "position" | "land"; NaN = not given."""
+    """One navigator position setpoint (kind IDLE, TAKEOFF, POSITION or LAND); NaN = not given."""
 
-    kind: str
+    kind: SetpointType
     target_ned_m: Vec3
     yaw_rad: float = NAN
     cruise_m_s: float = NAN
@@ -154,17 +167,17 @@ class AutoCore:
         self._yaw_sp_prev = nav.yaw_rad
         self._yaw_lock: float | None = None
         self._yawspeed_filt = 0.0
-        self._kind_prev = ""
+        self._kind_prev: SetpointType | None = None
         self._land_heading = NAN
         self.want_takeoff = False
 
     def step(self, nav: NavInput, dt_s: float, wp: Waypoint) -> TrajectorySetpoint:
         kind = wp.kind
-        if kind == "idle":
+        if kind is SetpointType.IDLE:
             return self._idle(nav)
         self._set_constraints(nav, wp)
         target, ff = wp.target_ned_m, _NO_FEEDFORWARD
-        if kind == "land":
+        if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
         vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
@@ -172,13 +185,13 @@ class AutoCore:
         self._kind_prev = kind
         ax, ay, az = self.smoother.axes
         out = TrajectorySetpoint((ax.x, ay.x, az.x), (ax.v, ay.v, az.v), (ax.a, ay.a, az.a), yaw, yawspeed)
-        if nav.takeoff_state in PRE_RAMP_STATES:
+        if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
             out = self._hold_before_ramp(nav, out)
         return out
 
     def _idle(self, nav: NavInput) -> TrajectorySetpoint:
         self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), nav.pos_ned_m)
-        self._kind_prev, self.want_takeoff, self._yaw_sp_prev = "idle", False, nav.yaw_rad
+        self._kind_prev, self.want_takeoff, self._yaw_sp_prev = SetpointType.IDLE, False, nav.yaw_rad
         return _IDLE_SETPOINT  # frozen: one shared instance
 
     def _hold_before_ramp(self, nav: NavInput, out: TrajectorySetpoint) -> TrajectorySetpoint:
@@ -191,15 +204,15 @@ class AutoCore:
     def _set_constraints(self, nav: NavInput, wp: Waypoint) -> None:
         """FlightTaskAuto::_updateTrajConstraints."""
         s, sm = self.s, self.smoother
-        cruise = wp.cruise_m_s if math.isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
+        cruise = wp.cruise_m_s if isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
         vel_max = s.xy_vel_max
-        sm.cruise_speed_m_s = vel_max if vel_max < cruise else cruise  # min(cruise, xy_vel_max)
+        sm.cruise_speed_m_s = min(cruise, vel_max)
         sm.max_xy_error_m = s.xy_err_max
         if self._unsmoothed_vz < 0.0:  # going up
             acc_z, vel_z = s.acc_up, s.z_v_auto_up
-            if wp.kind == "takeoff" and self._dist_to_ground(nav) < s.land_alt1:
+            if wp.kind is SetpointType.TAKEOFF and self._dist_to_ground(nav) < s.land_alt1:
                 ramp_acc = s.tko_speed / s.tko_ramp_t
-                vel_z, acc_z = s.tko_speed, ramp_acc if ramp_acc < acc_z else acc_z  # min(acc_z, ramp_acc)
+                vel_z, acc_z = s.tko_speed, min(acc_z, ramp_acc)
                 for axis in sm.axes[2:]:  # keep the altitude setpoint at the vehicle during the ramp
                     axis.set_position(nav.pos_ned_m[2])
         else:
@@ -208,14 +221,13 @@ class AutoCore:
 
     @staticmethod
     def _dist_to_ground(nav: NavInput) -> float:
-        up = -nav.pos_ned_m[2]
-        return 0.0 if up < 0.0 else up  # max(up, 0.0)
+        return max(-nav.pos_ned_m[2], 0.0)
 
     def _land_speed(self, nav: NavInput) -> float:
         """FlightTaskAuto::_prepareLandSetpoints: MPC_LAND_SPEED below ALT2, MPC_Z_VEL_MAX_DN above ALT1, linear in
         between; MPC_LAND_CRWL below ALT3 (SIH has a distance sensor, so the crawl applies)."""
         s, d = self.s, self._dist_to_ground(nav)
-        alt1 = s.land_alt2 if s.land_alt2 > s.land_alt1 else s.land_alt1  # max(land_alt1, land_alt2)
+        alt1 = max(s.land_alt1, s.land_alt2)
         if d <= s.land_alt3:
             return s.land_crawl
         if d <= s.land_alt2:
@@ -225,16 +237,16 @@ class AutoCore:
         return s.land_speed + (d - s.land_alt2) / (alt1 - s.land_alt2) * (s.z_vel_max_dn - s.land_speed)
 
     def _yaw_target(self, nav: NavInput, wp: Waypoint) -> float:
-        if wp.kind == "land":
-            if self._kind_prev != "land" or not math.isfinite(self._land_heading):
-                self._land_heading = wp.yaw_rad if math.isfinite(wp.yaw_rad) else self._yaw_sp_prev
+        if wp.kind is SetpointType.LAND:
+            if self._kind_prev is not SetpointType.LAND or not isfinite(self._land_heading):
+                self._land_heading = wp.yaw_rad if isfinite(wp.yaw_rad) else self._yaw_sp_prev
             return self._land_heading
-        if math.isfinite(wp.yaw_rad):
+        if isfinite(wp.yaw_rad):
             return wp.yaw_rad
         # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
         dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
         dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
-        if self.s.yaw_mode in (0, 4) and math.isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
+        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
             self._yaw_lock = math.atan2(dy, dx)
         if self._yaw_lock is None:
             self._yaw_lock = nav.yaw_rad
@@ -242,32 +254,20 @@ class AutoCore:
 
     def _limit_yaw_rate(self, nav: NavInput, yaw_sp: float, dt_s: float) -> tuple[float, float]:
         """FlightTaskAuto::_limitYawRate: rate-limit the heading and feed its filtered rate forward."""
-        prev = self._yaw_sp_prev if math.isfinite(self._yaw_sp_prev) else nav.yaw_rad
+        prev = self._yaw_sp_prev if isfinite(self._yaw_sp_prev) else nav.yaw_rad
         max_rate = self.s.yawrate_max_rad_s
-        pi = math.pi
-        # dyaw = min(max(wrap_pi(yaw_sp - prev), -max_rate * dt_s), max_rate * dt_s), written out
-        dyaw = (yaw_sp - prev + pi) % _TWO_PI - pi
-        low, high = -max_rate * dt_s, max_rate * dt_s
-        if low > dyaw:
-            dyaw = low
-        if high < dyaw:
-            dyaw = high
-        yaw_sp = (prev + dyaw + pi) % _TWO_PI - pi  # wrap_pi
-        filt = self._yawspeed_filt
+        max_step = max_rate * dt_s
+        dyaw = constrain(wrap_pi(yaw_sp - prev), -max_step, max_step)
+        yaw_sp = wrap_pi(prev + dyaw)
         if dt_s > 0.0:
             alpha = dt_s / (dt_s + 0.2)
-            filt = self._yawspeed_filt = filt + alpha * (dyaw / dt_s - filt)
+            self._yawspeed_filt += alpha * (dyaw / dt_s - self._yawspeed_filt)
         self._yaw_sp_prev = yaw_sp
-        low = -max_rate  # min(max(filt, -max_rate), max_rate)
-        if low > filt:
-            filt = low
-        return yaw_sp, (max_rate if max_rate < filt else filt)
+        return yaw_sp, constrain(self._yawspeed_filt, -max_rate, max_rate)
 
 
 class Task:
-    """One activation of an auto mode. Subclasses set `kind` and implement `_waypoint(nav)`."""
-
-    kind = ""
+    """One activation of an auto mode. Subclasses implement `_waypoint(nav)`."""
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params = params
@@ -275,7 +275,7 @@ class Task:
         self._settings = AutoSettings.from_params(params)
         self._core = AutoCore(nav, self._settings)
         self._messages: list[tuple[Severity, str]] = []
-        self._type = "position"
+        self._type = SetpointType.POSITION
 
     def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
         """The trajectory setpoint for this cycle (NaN = not controlled)."""
@@ -291,8 +291,8 @@ class Task:
         raise NotImplementedError
 
     @property
-    def setpoint_type(self) -> str:
-        """position_setpoint.type: "idle" | "position" | "takeoff" | "land"."""
+    def setpoint_type(self) -> SetpointType:
+        """position_setpoint.type of the last update: IDLE, POSITION, TAKEOFF or LAND."""
         return self._type
 
     @property

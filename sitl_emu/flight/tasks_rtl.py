@@ -9,32 +9,45 @@ RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RT
 from __future__ import annotations
 
 import math
+from enum import Enum
 
-from sitl_emu.flight.tasks_core import NavInput, Task, Waypoint
+from sitl_emu.flight.tasks_core import NavInput, SetpointType, Task, Waypoint
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3
 
 
-class RtlTask(Task):
-    kind = "rtl"
+class RtlState(Enum):
+    """RtlDirect's states (rtl_direct.h RTLState), named for what the vehicle does."""
 
+    CLIMB = "climb"  # CLIMBING
+    RETURN = "return"  # MOVE_TO_LOITER
+    DESCEND = "descend"  # LOITER_DOWN
+    HOLD = "hold"  # LOITER_HOLD
+    HOVER = "hover"  # MOVE_TO_LAND_HOVER
+    LAND = "land"  # LAND
+    IDLE = "idle"  # IDLE (on the ground)
+
+
+class RtlTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         super().__init__(nav, params)
         self._home: Vec3 = nav.home_ned_m
         self._home_yaw = nav.home_yaw_rad
         self._rtl_up_m = self._return_altitude_up(nav)
-        self._state = ""
+        self._state = RtlState.IDLE
         self._hold_until_us = 0
-        self._enter("idle" if nav.landed else ("climb" if -nav.pos_ned_m[2] < self._rtl_up_m else "return"), nav)
+        if nav.landed:
+            self._enter(RtlState.IDLE, nav)
+        else:
+            self._enter(RtlState.CLIMB if -nav.pos_ned_m[2] < self._rtl_up_m else RtlState.RETURN, nav)
         home_up = -self._home[2]
         amsl = nav.ref_alt_amsl_m + self._rtl_up_m
         self._say(Severity.INFO, f"RTL: start return at {math.ceil(amsl):d} m "
                                  f"({math.ceil(self._rtl_up_m - home_up):d} m above destination)")
 
     @property
-    def state(self) -> str:
-        """"climb" | "return" | "descend" | "hold" | "hover" | "land" | "idle"."""
+    def state(self) -> RtlState:
         return self._state
 
     @property
@@ -61,19 +74,19 @@ class RtlTask(Task):
     def _dist_xy(self, nav: NavInput) -> float:
         return math.hypot(self._home[0] - nav.pos_ned_m[0], self._home[1] - nav.pos_ned_m[1])
 
-    def _enter(self, state: str, nav: NavInput) -> None:
+    def _enter(self, state: RtlState, nav: NavInput) -> None:
         self._state = state
         s = self._settings
-        if state == "climb":
+        if state is RtlState.CLIMB:
             self._climb_xy = (nav.pos_ned_m[0], nav.pos_ned_m[1])
             self._climb_yaw = nav.yaw_rad
-        elif state == "return":
+        elif state is RtlState.RETURN:
             self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN
-        elif state == "hold":
+        elif state is RtlState.HOLD:
             self._hold_until_us = nav.time_us + int(s.rtl_land_delay * 1e6)
             if s.rtl_land_delay < 0.0:
                 self._say(Severity.INFO, "RTL: completed, loitering")
-        elif state == "land":
+        elif state is RtlState.LAND:
             self._say(Severity.INFO, "RTL: land at destination")
 
     def _loiter_up_m(self) -> float:
@@ -86,15 +99,16 @@ class RtlTask(Task):
     def _current_waypoint(self) -> Waypoint:
         hx, hy = self._home[0], self._home[1]
         st = self._state
-        if st == "climb":
-            return Waypoint("position", (self._climb_xy[0], self._climb_xy[1], -self._rtl_up_m), self._climb_yaw)
-        if st == "return":
-            return Waypoint("position", (hx, hy, -self._rtl_up_m), self._return_yaw)
-        if st in ("descend", "hold", "hover"):
-            return Waypoint("position", (hx, hy, -self._loiter_up_m()), self._home_yaw)
-        if st == "land":
-            return Waypoint("land", (hx, hy, NAN), self._home_yaw)
-        return Waypoint("idle", self._home)
+        if st is RtlState.CLIMB:
+            return Waypoint(SetpointType.POSITION, (self._climb_xy[0], self._climb_xy[1], -self._rtl_up_m),
+                            self._climb_yaw)
+        if st is RtlState.RETURN:
+            return Waypoint(SetpointType.POSITION, (hx, hy, -self._rtl_up_m), self._return_yaw)
+        if st in (RtlState.DESCEND, RtlState.HOLD, RtlState.HOVER):
+            return Waypoint(SetpointType.POSITION, (hx, hy, -self._loiter_up_m()), self._home_yaw)
+        if st is RtlState.LAND:
+            return Waypoint(SetpointType.LAND, (hx, hy, NAN), self._home_yaw)
+        return Waypoint(SetpointType.IDLE, self._home)
 
     def _advance(self, nav: NavInput) -> None:
         """RtlDirect::_updateRtlState once the current item is reached (mission_block acceptance rules)."""
@@ -102,13 +116,13 @@ class RtlTask(Task):
         up = -nav.pos_ned_m[2]
         near_xy = self._dist_xy(nav) <= s.nav_acc_rad
         st = self._state
-        if st == "climb" and up >= self._rtl_up_m - s.nav_mc_alt_rad:
-            self._enter("return", nav)
-        elif st == "return" and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad:
-            self._enter("land" if s.rtl_land_delay == 0.0 else "descend", nav)
-        elif st == "descend" and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
-            self._enter("hold", nav)
-        elif st == "hold" and s.rtl_land_delay >= 0.0 and nav.time_us >= self._hold_until_us:
-            self._enter("hover", nav)
-        elif st == "hover" and near_xy:
-            self._enter("land", nav)
+        if st is RtlState.CLIMB and up >= self._rtl_up_m - s.nav_mc_alt_rad:
+            self._enter(RtlState.RETURN, nav)
+        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad:
+            self._enter(RtlState.LAND if s.rtl_land_delay == 0.0 else RtlState.DESCEND, nav)
+        elif st is RtlState.DESCEND and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
+            self._enter(RtlState.HOLD, nav)
+        elif st is RtlState.HOLD and s.rtl_land_delay >= 0.0 and nav.time_us >= self._hold_until_us:
+            self._enter(RtlState.HOVER, nav)
+        elif st is RtlState.HOVER and near_xy:
+            self._enter(RtlState.LAND, nav)
