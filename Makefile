@@ -22,13 +22,9 @@ test: $(STAMP)
 	$(MAKE) test-compiled
 
 # The opt-in compiled build, checked in a scratch copy (your tree is left as it is): build it, then the vehicle-core
-# tests, including tests/test_speedups_exact.py (compiled and pure Python fly bit-identically).
+# tests (the `core` marker, given in tests/conftest.py), including tests/sitl_emu/core/test_speedups_exact.py
+# (compiled and pure Python fly bit-identically).
 CHECK_DIR := build/compiled-check
-CORE_TESTS := tests/test_speedups_exact.py tests/test_determinism.py tests/test_vehicle_scenarios.py \
-	tests/test_fidelity_takeoff_land.py tests/test_fidelity_xy.py tests/test_control.py \
-	tests/test_tasks.py tests/test_commander.py tests/test_land_detector.py \
-	tests/test_physics.py tests/test_api.py tests/test_vehicle_snapshot.py \
-	tests/test_arming_table.py
 test-compiled: $(STAMP)
 	@if ! command -v "$$($(BIN)/python -c 'import sysconfig; print((sysconfig.get_config_var("CC") or "cc").split()[0])')" \
 	    >/dev/null; then echo "No C compiler here: the compiled-core check is skipped."; exit 0; fi; \
@@ -38,7 +34,7 @@ compiled-check:
 	rm -rf $(CHECK_DIR) && mkdir -p $(CHECK_DIR)
 	cp -r sitl_emu tests tools pyproject.toml $(CHECK_DIR)/
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
-	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider $(CORE_TESTS)
+	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m core
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -68,8 +68,8 @@ def core_speed() -> tuple[float, float]:
 def core_speed_with_io() -> float:
     """Simulated s per CPU s of the same manoeuvre with a node doing its MAVLink I/O after every step (default
     streams on both links, sent to a socket nobody reads; a link is read when the runners' socket watch says so)."""
-    from sitl_emu.api import Sim
-    from sitl_emu.runner import SocketWatch
+    from sitl_emu.runtime.runner import SocketWatch
+    from sitl_emu.testing.sim import Sim
 
     with Sim() as sim:
         node = sim.nodes[0]

@@ -16,9 +16,9 @@ from typing import Any
 
 from sitl_emu.mavlink.telemetry import BUILDERS
 from sitl_emu.px4 import MavCmd
-from sitl_emu.runner import RealTimeRunner
-from sitl_emu.server import LinkSettings, VehicleNode
-from sitl_emu.swarm import SwarmRunner
+from sitl_emu.runtime.node import LinkSettings, VehicleNode
+from sitl_emu.runtime.runner import RealTimeRunner
+from sitl_emu.runtime.swarm import SwarmRunner
 from sitl_emu.types import VehicleCommand, VehicleEvent, VehicleSnapshot
 from sitl_emu.vehicle import Vehicle
 
@@ -94,7 +94,7 @@ def real_time_share(seconds: float, min_wake_s: float = 0.0, streams: bool = Tru
 def swarm_tick_cost(count: int, sim_seconds: float, streams: bool = True) -> float:
     """CPU µs per vehicle-tick of SwarmRunner with `count` stub nodes, as fast as it goes (no sleeping)."""
     nodes, sink = stub_nodes(count, streams)
-    swarm_log = logging.getLogger("sitl_emu.swarm")
+    swarm_log = logging.getLogger("sitl_emu.runtime.swarm")
     level = swarm_log.level
     swarm_log.setLevel(logging.ERROR)  # it falls behind on purpose: no lag warnings
     try:

@@ -1,7 +1,7 @@
 """Scale: how many vehicles one process keeps on time at real time on ONE core, default streams on both links.
 
 Each trial runs in a fresh child process pinned to one CPU (`python -m bench.scale N SECONDS`): N vehicles built as
-`sitl-emu serve --count N` builds them (sitl_emu.swarm), all armed and taking off (then hovering), run by the
+`sitl-emu serve --count N` builds them (sitl_emu.runtime.swarm), all armed and taking off (then hovering), run by the
 SwarmRunner at speed 1 with serve's default batching. The trial passes when the runner never had to drop time, the
 slowest vehicle's simulated time never lagged the wall clock by more than LAG_LIMIT_S after the first second, and every
 vehicle is still in the air at the end. CPU is this process's time over wall time: on a shared core a trial can be
@@ -62,10 +62,10 @@ def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int
 
 
 def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
-    from sitl_emu.api import Sim
     from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
     from sitl_emu.px4 import MavCmd
-    from sitl_emu.swarm import SwarmRunner
+    from sitl_emu.runtime.swarm import SwarmRunner
+    from sitl_emu.testing.sim import Sim
     from sitl_emu.types import VehicleCommand
 
     if cpu is not None:

@@ -1,7 +1,7 @@
 """`sitl-emu serve` in its own process, measured from outside: start-up, CPU share at real time, fastest flight.
 
 Each measurement starts `python -m sitl_emu serve` on free loopback ports; the API link sends to our scripted client
-(sitl_emu.api_client.FlightClient), the GCS link to a socket nobody reads (the kernel drops what overflows).
+(sitl_emu.testing.client.FlightClient), the GCS link to a socket nobody reads (the kernel drops what overflows).
 CPU is the server process's own user+system time from /proc, so the client's work is not counted.
 """
 
@@ -16,9 +16,9 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from sitl_emu.api import ScaledWallClock, Sim
-from sitl_emu.api_client import FlightClient, FlightResult, fly_square
 from sitl_emu.px4 import MavCmd
+from sitl_emu.testing.client import FlightClient, FlightResult, fly_square
+from sitl_emu.testing.sim import ScaledWallClock, Sim
 
 REPO = Path(__file__).resolve().parent.parent
 TICKS_S = os.sysconf("SC_CLK_TCK")

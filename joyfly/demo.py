@@ -75,8 +75,8 @@ class EmbeddedVehicle:
     def __init__(self, joyfly_port: int, speed: float) -> None:
         try:
             from sitl_emu.cli import build_params, build_vehicle
-            from sitl_emu.runner import RealTimeRunner
-            from sitl_emu.server import LinkSettings, VehicleNode
+            from sitl_emu.runtime.node import LinkSettings, VehicleNode
+            from sitl_emu.runtime.runner import RealTimeRunner
         except ImportError as exc:
             raise DemoError(f"The bundled emulator cannot be imported ({exc}): reinstall with `make demo`.") from None
         settings = LinkSettings(bind_host="127.0.0.1", api_port=0, api_remote=("127.0.0.1", joyfly_port),

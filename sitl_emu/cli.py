@@ -36,9 +36,9 @@ from sitl_emu.cli_options import (
 )
 from sitl_emu.console import attach_console
 from sitl_emu.mavlink.link import PortInUseError
-from sitl_emu.runner import RealTimeRunner, stop_on_signals
-from sitl_emu.server import LinkSettings
-from sitl_emu.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
+from sitl_emu.runtime.node import LinkSettings
+from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
+from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
 log = logging.getLogger(__name__)
 

@@ -5,7 +5,7 @@ usage: .venv/bin/python tools/golden_flights.py [--record FILE | --check FILE]
 
 Without options it prints one sha256 per flight. The flights cover the auto modes (takeoff, hold, land), offboard
 position / velocity / acceleration / attitude / body-rate setpoints, an invalid setpoint (the failsafe), parameter
-changes in flight, wind, estimate noise, and the bare physics + control loop (sitl_emu.control.harness).
+changes in flight, wind, estimate noise, and the bare physics + control loop (sitl_emu.testing.harness).
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from sitl_emu.control.harness import ClosedLoop, hover_loop
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
+from sitl_emu.testing.harness import ClosedLoop, hover_loop
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle import Vehicle
 

@@ -50,7 +50,7 @@ class LinkContext(Protocol):
 
 
 class NodeView(Protocol):
-    """What an endpoint's parts ask of the node that owns the links (sitl_emu/server.py VehicleNode)."""
+    """What an endpoint's parts ask of the node that owns the links (sitl_emu/runtime/node.py VehicleNode)."""
 
     epoch_unix_us: int  # wall time of simulated time 0 (SYSTEM_TIME)
 

@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink.commands import CommandHandler
 from sitl_emu.mavlink.context import NodeView
 from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
+from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.telemetry import StreamMode, Streams
 

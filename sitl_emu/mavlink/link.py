@@ -56,7 +56,7 @@ class UdpLink:
     def receive(self, max_datagrams: int = 256) -> list[bytes]:
         """Datagrams waiting now (never blocks). The first one's sender becomes the peer.
 
-        Runners call this only for a socket their SocketWatch saw readable (sitl_emu/runner.py), so an idle link
+        Runners call this only for a socket their SocketWatch saw readable (sitl_emu/runtime/runner.py), so an idle link
         costs nothing here and this does not look again before reading."""
         out: list[bytes] = []
         while len(out) < max_datagrams:

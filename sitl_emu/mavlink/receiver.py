@@ -17,7 +17,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from sitl_emu.mavlink import setpoints
-from sitl_emu.mavlink.commands import ANY_COMPONENT, CommandHandler
+from sitl_emu.mavlink.link_commands import ANY_COMPONENT, CommandHandler
 from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
 from sitl_emu.types import VehicleCommand
 

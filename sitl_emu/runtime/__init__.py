@@ -1,0 +1,1 @@
+"""Running vehicles: the node (a vehicle and its MAVLink links), the real-time runner and the swarm."""

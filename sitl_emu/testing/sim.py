@@ -1,0 +1,234 @@
+"""In-process Python API for tests: one or more emulated vehicles on loopback UDP, stepped in lockstep.
+
+    with Sim(count=2, params={"MIS_TAKEOFF_ALT": 5}) as sim:
+        port = sim.ports(0).api[1]            # a real MAVLink client sends here (and is answered from here)
+        client = FlightClient(sim.ports(0).api, sim.clock)    # or pymavlink, MAVSDK (with sim.start()), joyfly
+        sim.run_for(3.0)                      # 3 s of simulated time, as fast as the CPU allows
+
+Lockstep: simulated time advances only when the script asks (`run_for`, `run_until`, or `sim.clock.sleep(s)`), in
+the vehicles' 4 ms ticks, and every node does its MAVLink I/O after each tick. A client in the same process that
+sends a datagram and then sleeps on `sim.clock` is therefore answered at a deterministic simulated instant: the same
+script, seed and params give the same trajectory every run. `sim.clock` satisfies joyfly's Clock protocol (now() in
+seconds, sleep(seconds)), so a joyfly FlightSession can fly a Sim vehicle in lockstep.
+
+Clients that keep their own wall-clock timers (MAVSDK, MAVROS) need `sim.start(speed)`, which runs the vehicles in a
+background thread at `speed` x real time (the runner of `sitl-emu serve --count`); `stop()` returns to lockstep.
+
+Until a client talks, a vehicle sends its telemetry to a private sink socket, so parallel tests never see each
+other's vehicles. Pass `api_remote=("127.0.0.1", 14540)` to send to where PX4 SITL sends instead (port + instance).
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from sitl_emu.mavlink.link import Address
+from sitl_emu.params import default_registry
+from sitl_emu.runtime.node import IO_BUDGET_DATAGRAMS, LinkSettings, VehicleNode
+from sitl_emu.runtime.runner import SocketWatch
+from sitl_emu.runtime.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner, build_nodes
+from sitl_emu.vehicle import Vehicle
+
+__all__ = ["LockstepClock", "ScaledWallClock", "Sim", "VehiclePorts"]
+
+
+@dataclass(frozen=True, slots=True)
+class VehiclePorts:
+    """Where vehicle `index` listens: send to `api` (the offboard/API link) or `gcs` (the GCS link)."""
+
+    index: int
+    sysid: int
+    api: Address
+    gcs: Address
+
+
+class LockstepClock:
+    """Simulated seconds since the Sim started; `sleep` advances the vehicles (joyfly's Clock protocol)."""
+
+    def __init__(self, sim: Sim) -> None:
+        self._sim = sim
+
+    def now(self) -> float:
+        return self._sim.time_us / 1e6
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            self._sim.advance_to(self._sim.time_us + round(seconds * 1e6))
+
+
+class ScaledWallClock:
+    """Wall time x `speed`, for a client in another thread or process paired with a vehicle run at that speed.
+
+    joyfly.clock.ScaledClock is its twin on purpose: sitl_emu and joyfly never import each other (DESIGN.md).
+    """
+
+    def __init__(self, speed: float = 1.0) -> None:
+        self.speed = float(speed)
+        self._t0 = time.monotonic()
+
+    def now(self) -> float:
+        return (time.monotonic() - self._t0) * self.speed
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            time.sleep(seconds / self.speed)
+
+
+class _Track:
+    """Maps one vehicle's time (which restarts at 0 after a reboot) onto the Sim's monotonic clock."""
+
+    __slots__ = ("base_us",)
+
+    def __init__(self) -> None:
+        self.base_us = 0
+
+
+class Sim:
+    """`count` vehicles (sysids 1..count, homes `spacing_m` apart eastwards) on free loopback ports."""
+
+    def __init__(self, count: int = 1, *, params: Mapping[str, float] | None = None, seed: int = 0,
+                 home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
+                 api_remote: Address | None = None, gcs_remote: Address | None = None,
+                 bind_host: str = "127.0.0.1", vehicle_options: Mapping[str, Any] | None = None) -> None:
+        self._sink = _sink_socket(bind_host)
+        sink: Address = self._sink.getsockname()
+        self._param_values = dict(params or {})
+        self._seed = seed
+        self._vehicle_options = dict(vehicle_options or {})
+        settings = LinkSettings(bind_host, 0, api_remote or sink, 0, gcs_remote or sink)
+        try:
+            self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,
+                                                        spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6))
+        except BaseException:
+            self._sink.close()
+            raise
+        if api_remote is None:  # every instance shares the sink (for_instance offset the port)
+            for node in self.nodes:
+                node.api.link.remote = sink
+        self._tracks = [_Track() for _ in self.nodes]
+        self._watch = SocketWatch(self.nodes)
+        self._time_us = 0
+        self.clock = LockstepClock(self)
+        self._runner: SwarmRunner | None = None
+        self._background_start_us = 0
+        self._thread: threading.Thread | None = None
+
+    def _make_vehicle(self, instance: int, home: tuple[float, float, float]) -> Vehicle:
+        registry = default_registry()
+        if "MAV_SYS_ID" in registry:  # rcS: param set MAV_SYS_ID $((px4_instance+1))
+            registry.set("MAV_SYS_ID", instance + 1)
+        for name, value in self._param_values.items():
+            registry.set(name, float(value))
+        return Vehicle(params=registry, home=home, seed=self._seed + instance, sysid=instance + 1,
+                       **self._vehicle_options)
+
+    # --- what a script reads ---------------------------------------------------------------------------------
+    @property
+    def vehicles(self) -> list[Vehicle]:
+        return [node.vehicle for node in self.nodes]
+
+    def vehicle(self, index: int = 0) -> Vehicle:
+        return self.nodes[index].vehicle
+
+    def ports(self, index: int = 0) -> VehiclePorts:
+        node = self.nodes[index]
+        return VehiclePorts(index, node.sysid, _reachable(node.api.link.local_address),
+                            _reachable(node.gcs.link.local_address))
+
+    @property
+    def time_us(self) -> int:
+        """Simulated time since the Sim started (µs); unlike a vehicle's own time it never restarts."""
+        if self._runner is not None:
+            return self._background_start_us + self._runner.timeline_us
+        return self._time_us
+
+    # --- lockstep ----------------------------------------------------------------------------------------------
+    def advance_to(self, target_us: int) -> None:
+        """Step every vehicle tick by tick up to `target_us` of Sim time, with each node's I/O after its tick."""
+        self._require_lockstep()
+        look = self._watch.ready
+        stepped = True
+        while stepped:
+            stepped = False
+            ready = look()  # one look at every socket per tick: a node reads only the links with data waiting
+            for index, (node, track) in enumerate(zip(self.nodes, self._tracks, strict=True)):
+                vehicle = node.vehicle
+                before = vehicle.time_us
+                if track.base_us + before + vehicle.dt_us > target_us:
+                    continue
+                vehicle.step()
+                if vehicle.time_us < before:  # rebooted: its time restarts at 0 now
+                    track.base_us += before
+                node.step_io(vehicle.time_us, ready.get(index, 0) if ready else 0)
+                stepped = True
+        self._time_us = max(self._time_us, target_us)
+
+    def run_for(self, seconds: float) -> None:
+        self.advance_to(self._time_us + round(seconds * 1e6))
+
+    def run_until(self, predicate: Callable[[], bool], timeout_s: float, poll_s: float = 0.004) -> bool:
+        """Run until `predicate()` holds (checked every `poll_s` of simulated time); False on timeout."""
+        end_us = self._time_us + round(timeout_s * 1e6)
+        while not predicate():
+            if self._time_us >= end_us:
+                return False
+            self.advance_to(min(end_us, self._time_us + round(poll_s * 1e6)))
+        return True
+
+    # --- real time in the background -----------------------------------------------------------------------
+    def start(self, speed: float = 1.0) -> None:
+        """Run the vehicles at `speed` x wall time in a daemon thread until `stop()`."""
+        if self._runner is not None:
+            raise RuntimeError("The Sim is already running in the background; call stop() first.")
+        self._background_start_us = self._time_us
+        self._runner = SwarmRunner(self.nodes, speed=speed, io_budget=IO_BUDGET_DATAGRAMS)
+        self._thread = threading.Thread(target=self._runner.run, name="sitl-emu-sim", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop the background runner; lockstep methods work again from the time reached."""
+        if self._runner is None or self._thread is None:
+            return
+        self._runner.stop()
+        self._thread.join(5.0)
+        self._time_us = self.time_us
+        for track, node in zip(self._tracks, self.nodes, strict=True):
+            track.base_us = self._time_us - int(node.vehicle.time_us)
+        self._runner = None
+        self._thread = None
+
+    def _require_lockstep(self) -> None:
+        if self._runner is not None:
+            raise RuntimeError("The Sim runs in the background (start()); call stop() before stepping it.")
+
+    # --- lifetime ----------------------------------------------------------------------------------------------
+    def close(self) -> None:
+        self.stop()
+        self._watch.close()
+        for node in self.nodes:
+            node.close()
+        self._sink.close()
+
+    def __enter__(self) -> Sim:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _sink_socket(bind_host: str) -> socket.socket:
+    """A bound socket nobody reads, with a small buffer: telemetry sent before a client talks ends here."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    sock.bind((bind_host if bind_host not in ("0.0.0.0", "") else "127.0.0.1", 0))
+    return sock
+
+
+def _reachable(address: Address) -> Address:
+    host, port = address
+    return ("127.0.0.1" if host in ("0.0.0.0", "") else host, port)

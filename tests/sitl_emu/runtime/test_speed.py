@@ -1,0 +1,95 @@
+"""Simulated time at any speed: `sitl-emu serve --speed F` flies the same flight as the in-process lockstep API.
+
+The speed-1 flight would take ~35 s of wall time, so the comparison is in-process lockstep (as fast as the CPU
+allows) against `serve --speed 20` in another process, flown by the same scripted pymavlink client (its clock is the
+Sim clock in lockstep, wall time x 20 against the server). Heartbeats and stream rates are checked per simulated
+second at --speed 10, waking for every tick, with the default batching and with --batch-ms 400 (0.4 s of simulated
+ticks per wake-up).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+from pymavlink.dialects.v20 import development as dialect
+from support import REPO_ROOT
+from support.ports import free_udp_ports
+
+from sitl_emu.testing.client import FlightClient, fly_square
+from sitl_emu.testing.sim import ScaledWallClock, Sim
+
+REPO = REPO_ROOT
+
+
+
+
+def _serve(speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int, *extra: str) -> subprocess.Popen:
+    args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs), "--remote", f"127.0.0.1:{api_remote}",
+            "--gcs-remote", f"127.0.0.1:{gcs_remote}", *extra]
+    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONPATH": str(REPO)})
+
+
+def _stop(proc: subprocess.Popen) -> str:
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=10)
+    return err
+
+
+def test_speed_20_flies_the_same_flight_as_lockstep():
+    with Sim() as sim:
+        client = FlightClient(sim.ports(0).api, sim.clock)
+        lockstep = fly_square(client)
+        client.close()
+    api, gcs, sink = free_udp_ports(3)
+    proc = _serve(20.0, api, gcs, sink, sink)
+    try:
+        assert proc.stdout is not None
+        proc.stdout.readline()
+        client = FlightClient(("127.0.0.1", api), ScaledWallClock(20.0))
+        fast = fly_square(client)
+        client.close()
+    finally:
+        err = _stop(proc)
+    assert lockstep.ok, lockstep.error
+    assert fast.ok, f"{fast.error}\n{err}"
+    assert fast.modes == lockstep.modes
+    assert lockstep.landing_ned_m is not None and fast.landing_ned_m is not None
+    assert math.dist(fast.landing_ned_m, lockstep.landing_ned_m) < 0.25
+
+
+@pytest.mark.parametrize("batch", [("--batch-ms", "0"), (), ("--batch-ms", "400")],
+                         ids=["every-tick", "default-batch", "batch-400ms"])
+def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10(batch):
+    api, gcs, listen, gcs_sink = free_udp_ports(4)
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
+    sock.bind(("127.0.0.1", listen))
+    sock.settimeout(5.0)
+    proc = _serve(10.0, api, gcs, listen, gcs_sink, *batch)  # the API link streams to us from boot (initial remote)
+    parser = dialect.MAVLink(None)
+    beats, attitude_ms = 0, []
+    try:
+        end = time.monotonic() + 1.5  # ~15 s of simulated time
+        while time.monotonic() < end:
+            data, _ = sock.recvfrom(65535)
+            for msg in parser.parse_buffer(data) or []:
+                if msg.get_type() == "HEARTBEAT" and attitude_ms:
+                    beats += 1
+                elif msg.get_type() == "ATTITUDE":
+                    attitude_ms.append(msg.time_boot_ms)
+    finally:
+        _stop(proc)
+        sock.close()
+    span_s = (attitude_ms[-1] - attitude_ms[0]) / 1000.0
+    assert span_s > 5.0  # simulated time did run faster than the wall clock
+    assert abs(beats - span_s) <= 1.5  # HEARTBEAT 1 Hz of simulated time
+    assert abs(len(attitude_ms) / span_s - 100.0) < 10.0  # onboard ATTITUDE 100 Hz of simulated time

@@ -1,0 +1,264 @@
+"""Conformance: MAVSDK (the native `mavsdk` >= 4 binding, MAVSDK's C++ core) flies `sitl-emu serve` as it flies PX4.
+
+One test runs a whole session against a server started on free ports: connect, health, MAVLink shell, parameters
+(REAL32 and INT32), arm, takeoff, offboard position / velocity NED / velocity body, hold, return and land.
+Every MAVSDK call and its outcome is printed at the end (run with -s to see the table).
+
+MAVSDK's timeouts run on the wall clock (0.5 s command retries, 3 s heartbeat timeout), so the server runs only a few
+times faster than real time. The test skips only when the MAVSDK library cannot be loaded on this machine.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import subprocess
+import sys
+import time
+from collections.abc import Awaitable, Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from support import REPO_ROOT
+from support.ports import free_udp_ports
+
+REPO = REPO_ROOT
+SPEED = 4.0  # simulated seconds per wall second
+CALL_TIMEOUT_S = 15.0  # no single MAVSDK call may hang the test
+
+
+
+
+def _load_mavsdk() -> Any:
+    try:
+        import mavsdk.asyncio as mavsdk_asyncio
+    except Exception as err:  # no package, or its native library cannot be loaded here
+        pytest.skip(f"MAVSDK cannot start on this machine: {err}")
+    return mavsdk_asyncio
+
+
+@pytest.fixture()
+def server(tmp_path: Path):
+    """`sitl-emu serve` on free ports; yields the UDP port MAVSDK must listen on (the API link's remote)."""
+    client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
+    args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
+            "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
+            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
+    log_path = tmp_path / "serve.log"
+    with log_path.open("w") as log_file:
+        proc = subprocess.Popen(args, cwd=REPO, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        try:
+            yield client_port
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(timeout=5)
+            print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-3000:])
+
+
+class Session:
+    """Runs MAVSDK calls with a timeout each and records every call and its outcome."""
+
+    def __init__(self) -> None:
+        self.calls: list[tuple[str, str]] = []
+
+    async def call(self, name: str, awaitable: Awaitable[Any], timeout_s: float = CALL_TIMEOUT_S) -> Any:
+        try:
+            result = await asyncio.wait_for(awaitable, timeout_s)
+        except Exception as err:
+            self.calls.append((name, f"FAILED: {type(err).__name__}: {err}"))
+            raise
+        self.calls.append((name, "ok" if result is None else f"ok -> {_short(result)}"))
+        return result
+
+    async def wait_for(self, what: str, probe: Callable[[], Awaitable[Any]], accept: Callable[[Any], bool],
+                       timeout_s: float) -> Any:
+        """Poll `probe` until `accept(value)`; fail with the last value seen."""
+        deadline = time.monotonic() + timeout_s
+        value: Any = None
+        while time.monotonic() < deadline:
+            value = await asyncio.wait_for(probe(), CALL_TIMEOUT_S)
+            if accept(value):
+                self.calls.append((f"wait: {what}", f"ok -> {_short(value)}"))
+                return value
+            await asyncio.sleep(0.1)
+        self.calls.append((f"wait: {what}", f"TIMED OUT, last {_short(value)}"))
+        raise AssertionError(f"timed out after {timeout_s} s waiting for {what}; last value: {value}")
+
+    def table(self) -> str:
+        return "\n".join(f"  {name:<48} {outcome}" for name, outcome in self.calls)
+
+
+def _short(value: Any) -> str:
+    text = str(value).replace("\n", " ")
+    return text if len(text) <= 110 else text[:107] + "..."
+
+
+def _dist(a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
+    return math.dist(a, b)
+
+
+@pytest.mark.timeout(420)
+def test_mavsdk_flies_the_emulator(server: int) -> None:
+    mavsdk_asyncio = _load_mavsdk()
+    session = Session()
+    try:
+        asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, server, session), timeout=360))
+    finally:
+        print("\nMAVSDK calls and outcomes:\n" + session.table())
+
+
+async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
+    from mavsdk.asyncio.plugins.action import ActionAsync
+    from mavsdk.asyncio.plugins.offboard import OffboardAsync
+    from mavsdk.asyncio.plugins.param import ParamAsync
+    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+
+    config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
+    async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
+        await s.call("Mavsdk.add_any_connection(udpin)", mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
+        system = await s.call("Mavsdk.first_autopilot", mavsdk.first_autopilot(timeout_s=20.0), timeout_s=25.0)
+        assert system is not None, "MAVSDK found no autopilot"
+        assert (await s.call("System.autopilot_type", system.autopilot_type())).name == "PX4"
+        telemetry, action = TelemetryAsync(system), ActionAsync(system)
+        await s.wait_for("health_all_ok", telemetry.health_all_ok, bool, timeout_s=30)
+        await s.call("Telemetry.health", telemetry.health())
+        await _check_shell(system, s)
+        await _check_missions(system, s)
+        await _check_params(ParamAsync(system), action, s)
+        await _take_off(telemetry, action, s)
+        await _offboard(telemetry, OffboardAsync(system), s)
+        await _return_and_land(telemetry, action, s)
+
+
+async def _check_shell(system: Any, s: Session) -> None:
+    from mavsdk.asyncio.plugins.shell import Device, ShellAsync
+
+    shell = ShellAsync(system)
+    received: list[str] = []
+
+    async def collect() -> None:
+        async for chunk in shell.subscribe_receive():
+            received.append(chunk.data)
+
+    reader = asyncio.create_task(collect())
+    await asyncio.sleep(0.2)
+    await s.call("Shell.send('commander status')", shell.send("commander status\n", Device.SHELL))
+    await s.wait_for("shell reply", lambda: _echo("".join(received)), lambda text: "pxh> " in text, timeout_s=10)
+    reader.cancel()
+    text = "".join(received)
+    assert "INFO  [commander] Disarmed" in text and "navigation mode: Hold" in text
+
+
+async def _check_missions(system: Any, s: Session) -> None:
+    """No plan is stored: downloads are empty, an upload is refused at once (not left to time out)."""
+    from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
+    from mavsdk.plugins.mission_raw import MissionItem, MissionRawError, MissionRawResult
+
+    mission_raw = MissionRawAsync(system)
+    assert await s.call("MissionRaw.download_mission", mission_raw.download_mission()) in ([], None)
+    item = MissionItem(seq=0, frame=6, command=16, current=1, autocontinue=1, x=473977420, y=85455940, z=10.0,
+                       mission_type=0)
+    started = time.monotonic()
+    with pytest.raises(MissionRawError) as refused:
+        await asyncio.wait_for(mission_raw.upload_mission([item]), CALL_TIMEOUT_S)
+    elapsed_s = time.monotonic() - started
+    s.calls.append(("MissionRaw.upload_mission(1 waypoint)", f"refused as expected: {refused.value.result.name} "
+                    f"after {elapsed_s:.2f} s"))
+    assert refused.value.result == MissionRawResult.UNSUPPORTED
+    assert elapsed_s < 3.0
+
+
+async def _echo(value: Any) -> Any:
+    return value
+
+
+async def _check_params(param: Any, action: Any, s: Session) -> None:
+    await s.call("Param.set_param_float(MIS_TAKEOFF_ALT, 3.0)", param.set_param_float("MIS_TAKEOFF_ALT", 3.0))
+    assert await s.call("Param.get_param_float(MIS_TAKEOFF_ALT)", param.get_param_float("MIS_TAKEOFF_ALT")) == 3.0
+    assert await s.call("Action.get_takeoff_altitude", action.get_takeoff_altitude()) == pytest.approx(3.0)
+    await s.call("Param.set_param_int(BAT1_N_CELLS, 6)", param.set_param_int("BAT1_N_CELLS", 6))
+    assert await s.call("Param.get_param_int(BAT1_N_CELLS)", param.get_param_int("BAT1_N_CELLS")) == 6
+    await s.call("Param.set_param_int(BAT1_N_CELLS, 4)", param.set_param_int("BAT1_N_CELLS", 4))
+    assert await s.call("Param.get_param_int(MAV_SYS_ID)", param.get_param_int("MAV_SYS_ID")) == 1
+    all_params = await s.call("Param.get_all_params", param.get_all_params(), timeout_s=30)
+    ints = {p.name: p.value for p in all_params.int_params}
+    floats = {p.name: p.value for p in all_params.float_params}
+    assert ints["MAV_SYS_ID"] == 1 and ints["SYS_AUTOSTART"] == 10040 and floats["MIS_TAKEOFF_ALT"] == 3.0
+    assert "_HASH_CHECK" not in ints and "_HASH_CHECK" not in floats
+
+
+async def _take_off(telemetry: Any, action: Any, s: Session) -> None:
+    from mavsdk.plugins.telemetry import FlightMode
+
+    await s.call("Action.arm", action.arm())
+    await s.wait_for("armed", telemetry.armed, bool, timeout_s=5)
+    await s.call("Action.takeoff", action.takeoff())
+    await s.wait_for("in_air", telemetry.in_air, bool, timeout_s=20)
+    pos = await s.wait_for("relative altitude ~3.0 m (MIS_TAKEOFF_ALT)", telemetry.position,
+                           lambda p: abs(p.relative_altitude_m - 3.0) < 0.3, timeout_s=30)
+    assert pos.relative_altitude_m == pytest.approx(3.0, abs=0.3)
+    await s.wait_for("flight mode HOLD after takeoff", telemetry.flight_mode, lambda m: m == FlightMode.HOLD,
+                     timeout_s=15)
+
+
+async def _ned(telemetry: Any) -> tuple[float, float, float]:
+    p = (await telemetry.position_velocity_ned()).position
+    return (p.north_m, p.east_m, p.down_m)
+
+
+async def _offboard(telemetry: Any, offboard: Any, s: Session) -> None:
+    from mavsdk.plugins.offboard import PositionNedYaw, VelocityBodyYawspeed, VelocityNedYaw
+    from mavsdk.plugins.telemetry import FlightMode
+
+    here = await _ned(telemetry)
+    await s.call("Offboard.set_position_ned(current)", offboard.set_position_ned(PositionNedYaw(*here, 0.0)))
+    await s.call("Offboard.start", offboard.start())
+    await s.wait_for("flight mode OFFBOARD", telemetry.flight_mode, lambda m: m == FlightMode.OFFBOARD, timeout_s=5)
+    target = (here[0] + 5.0, here[1], -3.0)
+    await s.call("Offboard.set_position_ned(+5 m north)", offboard.set_position_ned(PositionNedYaw(*target, 0.0)))
+    await s.wait_for("position setpoint reached (0.5 m)", lambda: _ned(telemetry),
+                     lambda p: _dist(p, target) < 0.5, timeout_s=30)
+
+    start = await _ned(telemetry)
+    await s.call("Offboard.set_velocity_ned(east 1 m/s)", offboard.set_velocity_ned(VelocityNedYaw(0.0, 1.0, 0.0, 0.0)))
+    await s.wait_for("moving east at ~1 m/s", telemetry.velocity_ned, lambda v: abs(v.east_m_s - 1.0) < 0.2,
+                     timeout_s=15)
+    await s.wait_for("3 m east", lambda: _ned(telemetry), lambda p: p[1] - start[1] > 3.0, timeout_s=15)
+
+    start = await _ned(telemetry)
+    await s.call("Offboard.set_velocity_body(forward 1 m/s)",
+                 offboard.set_velocity_body(VelocityBodyYawspeed(1.0, 0.0, 0.0, 0.0)))
+    await s.wait_for("moving forward (north, yaw 0) at ~1 m/s", telemetry.velocity_ned,
+                     lambda v: abs(v.north_m_s - 1.0) < 0.2 and abs(v.east_m_s) < 0.2, timeout_s=15)
+    await s.wait_for("2 m north", lambda: _ned(telemetry), lambda p: p[0] - start[0] > 2.0, timeout_s=15)
+
+    await s.call("Offboard.stop", offboard.stop())
+    await s.wait_for("flight mode HOLD after offboard", telemetry.flight_mode, lambda m: m == FlightMode.HOLD,
+                     timeout_s=5)
+    await s.wait_for("stopped in Hold", telemetry.velocity_ned,
+                     lambda v: math.hypot(v.north_m_s, v.east_m_s) < 0.1, timeout_s=15)
+    held = await _ned(telemetry)
+    await asyncio.sleep(1.0)
+    assert _dist(await _ned(telemetry), held) < 0.5, "Hold drifted"
+
+
+async def _return_and_land(telemetry: Any, action: Any, s: Session) -> None:
+    from mavsdk.plugins.telemetry import FlightMode
+
+    await s.call("Action.return_to_launch", action.return_to_launch())
+    await s.wait_for("flight mode RETURN_TO_LAUNCH", telemetry.flight_mode,
+                     lambda m: m == FlightMode.RETURN_TO_LAUNCH, timeout_s=5)
+
+    async def state() -> tuple[bool, Any, tuple[float, float, float]]:
+        return await telemetry.armed(), await telemetry.landed_state(), await _ned(telemetry)
+
+    await s.wait_for("landed and disarmed", state, lambda st: not st[0], timeout_s=120)
+    assert not await s.call("Telemetry.in_air", telemetry.in_air())
+    home_dist = math.hypot(*(await _ned(telemetry))[:2])
+    s.calls.append(("landed distance from home (m)", f"{home_dist:.2f}"))
+    assert home_dist < 1.5

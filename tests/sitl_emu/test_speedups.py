@@ -1,0 +1,173 @@
+"""The opt-in compiled build (`make speedups`): a stale or foreign build is never used silently.
+
+Nothing is compiled here: a fake package with a garbage "extension module" beside its .py stands in for a build, and
+the manifest is written by hand to match it or not.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib
+import importlib.machinery
+import importlib.util
+import json
+import logging
+import sys
+from pathlib import Path
+
+import pytest
+from support import REPO_ROOT
+
+from sitl_emu import _speedups
+from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
+
+SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]
+ROOT = REPO_ROOT
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _fake_build(tmp_path: Path, name: str = "fakepkg") -> Path:
+    """A package whose module `mod` has a .py and a (not loadable) extension module, with a matching manifest."""
+    pkg = tmp_path / name
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "mod.py").write_text("WHERE = 'source'\n")
+    (pkg / "helper.py").write_text("X = 1\n")
+    (pkg / f"mod{SUFFIX}").write_bytes(b"not a real shared object")
+    (pkg / f"_native__mypyc{SUFFIX}").write_bytes(b"not a real shared library either")
+    manifest = {
+        "compiled": {f"{name}.mod": {"py": f"{name}/mod.py", "py_sha256": _sha(pkg / "mod.py"),
+                                     "so": f"{name}/mod{SUFFIX}", "so_sha256": _sha(pkg / f"mod{SUFFIX}")}},
+        "shared_lib": {"so": f"{name}/_native__mypyc{SUFFIX}", "so_sha256": _sha(pkg / f"_native__mypyc{SUFFIX}")},
+        "depends": {f"{name}/helper.py": _sha(pkg / "helper.py")},
+    }
+    (pkg / _speedups.MANIFEST_NAME).write_text(json.dumps(manifest))
+    return pkg
+
+
+def test_pure_tree_needs_no_fallback(tmp_path):
+    pkg = tmp_path / "purepkg"
+    pkg.mkdir()
+    (pkg / "mod.py").write_text("")
+    assert _speedups.plan(pkg, {}) == _speedups.Plan()
+
+
+def test_a_build_that_matches_its_manifest_is_used(tmp_path):
+    assert _speedups.plan(_fake_build(tmp_path), {}) == _speedups.Plan()
+
+
+def test_an_edited_source_falls_back_to_the_py_with_a_warning(tmp_path):
+    pkg = _fake_build(tmp_path)
+    (pkg / "mod.py").write_text("WHERE = 'edited source'\n")
+    decided = _speedups.plan(pkg, {})
+    assert decided.sources == {"fakepkg.mod": str(pkg / "mod.py")}
+    assert decided.warning is not None
+    assert "fakepkg/mod.py changed" in decided.warning
+    assert "make speedups" in decided.warning
+
+
+def test_an_edited_dependency_also_makes_the_build_stale(tmp_path):
+    pkg = _fake_build(tmp_path)
+    (pkg / "helper.py").write_text("X = 2\n")
+    decided = _speedups.plan(pkg, {})
+    assert "fakepkg.mod" in decided.sources
+    assert decided.warning is not None and "fakepkg/helper.py changed" in decided.warning
+
+
+@pytest.mark.parametrize("damage", ["no manifest", "foreign module", "replaced binary", "missing binary"])
+def test_a_foreign_or_incomplete_build_falls_back(tmp_path, damage):
+    pkg = _fake_build(tmp_path)
+    if damage == "no manifest":
+        (pkg / _speedups.MANIFEST_NAME).unlink()
+    elif damage == "foreign module":
+        (pkg / f"helper{SUFFIX}").write_bytes(b"built by someone else")
+    elif damage == "replaced binary":
+        (pkg / f"mod{SUFFIX}").write_bytes(b"another build")
+    else:
+        (pkg / f"_native__mypyc{SUFFIX}").unlink()
+    decided = _speedups.plan(pkg, {})
+    assert "fakepkg.mod" in decided.sources
+    assert decided.warning is not None and "make speedups" in decided.warning
+
+
+def test_pure_env_var_bypasses_a_good_build_silently(tmp_path):
+    decided = _speedups.plan(_fake_build(tmp_path), {_speedups.PURE_ENV: "1"})
+    assert decided.sources == {"fakepkg.mod": str(tmp_path / "fakepkg" / "mod.py")}
+    assert decided.warning is None
+
+
+@pytest.fixture
+def importable(tmp_path):
+    """tmp_path on sys.path for the test; imported fake modules and installed finders removed afterwards."""
+    sys.path.insert(0, str(tmp_path))
+    finders = list(sys.meta_path)
+    yield tmp_path
+    sys.path.remove(str(tmp_path))
+    sys.meta_path[:] = finders
+    for name in [n for n in sys.modules if n.startswith("stalepkg")]:
+        del sys.modules[name]
+    importlib.invalidate_caches()
+
+
+def test_guard_imports_the_source_instead_of_a_stale_extension_and_warns_once(importable, caplog):
+    pkg = _fake_build(importable, "stalepkg")
+    (pkg / "mod.py").write_text("WHERE = 'edited source'\n")
+    importlib.invalidate_caches()
+    with pytest.raises(ImportError):  # without the guard Python prefers the extension module beside the .py
+        importlib.import_module("stalepkg.mod")
+    sys.modules.pop("stalepkg.mod", None)
+    with caplog.at_level(logging.WARNING, logger="sitl_emu"):
+        _speedups.guard(pkg)
+    assert importlib.import_module("stalepkg.mod").WHERE == "edited source"
+    warnings = [r for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1
+    assert "run `make speedups` again" in warnings[0].getMessage().lower()
+
+
+def test_rigid_body_field_tuple_lists_every_state_field():
+    # vehicle.py copies a state with it: a compiled RigidBodyState has no __slots__ to read the names from.
+    assert tuple(f.name for f in dataclasses.fields(RigidBodyState)) == RIGID_BODY_FIELDS
+
+
+def _build_script():
+    spec = importlib.util.spec_from_file_location("build_speedups", ROOT / "tools" / "build_speedups.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_build_records_every_source_the_compiled_modules_import():
+    build = _build_script()
+    deps = build.dependency_sources(list(build.DEFAULT_MODULES))
+    assert "sitl_emu/__init__.py" in deps
+    assert "sitl_emu/types.py" in deps
+    assert "sitl_emu/params/__init__.py" in deps
+    assert not set(deps) & set(build.DEFAULT_MODULES)
+    assert all((ROOT / m).is_file() for m in build.DEFAULT_MODULES)
+
+
+def test_build_flags_keep_floats_exact():
+    assert "-ffp-contract=off" in _build_script().EXACT_FLOAT_FLAGS
+
+
+def test_this_interpreter_reports_what_runs_compiled():
+    import sitl_emu.physics  # noqa: F401
+
+    names = _speedups.compiled_modules()
+    assert _speedups.describe() == (f"compiled (mypyc): {len(names)} modules" if names else "pure Python")
+
+
+@pytest.mark.parametrize("x", [0.0, -0.0, 1.5, -2.5e-300, 5e-324, 1.7976931348623157e308, -1.7976931348623157e308,
+                               float("inf"), float("-inf"), float("nan"), 3, -7])
+def test_the_controllers_isfinite_is_exactly_math_isfinite(x):
+    # qmath.isfinite is arithmetic so that mypyc compiles it (it has no primitive for math.isfinite)
+    import math
+
+    from sitl_emu.control.qmath import isfinite
+
+    assert isfinite(x) is math.isfinite(x)
