@@ -21,18 +21,13 @@ from typing import Any
 
 from sitl_emu import listener
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
-from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavResult, NavState, main_sub
+from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavCmd, MavResult, NavState, main_sub
 from sitl_emu.types import VehicleCommand
 
 log = logging.getLogger(__name__)
 
 NAN = math.nan
 FORCE_MAGIC = 21196.0  # ARM_DISARM param2: force (Commander.cpp)
-CMD_NAV_LAND = 21
-CMD_NAV_TAKEOFF = 22
-CMD_DO_SET_MODE = 176
-CMD_ARM_DISARM = 400
-CMD_RUN_PREARM_CHECKS = 401
 
 # commander subcommands PX4 has and sitl_emu does not emulate (Commander.cpp custom_command, usage)
 _PX4_ONLY_SUBCOMMANDS = frozenset({"start", "stop", "calibrate", "transition", "lockdown", "pair", "set_ekf_origin",
@@ -147,22 +142,22 @@ class Shell:
         sub = args[0] if args else ""
         force = len(args) > 1 and args[1] == "-f"
         if sub == "arm":
-            self._send(CMD_ARM_DISARM, 1.0, FORCE_MAGIC if force else 0.0)
+            self._send(MavCmd.COMPONENT_ARM_DISARM, 1.0, FORCE_MAGIC if force else 0.0)
             return 0, ""
         if sub == "disarm":
-            self._send(CMD_ARM_DISARM, 0.0, FORCE_MAGIC if force else 0.0)
+            self._send(MavCmd.COMPONENT_ARM_DISARM, 0.0, FORCE_MAGIC if force else 0.0)
             return 0, ""
         if sub == "takeoff":
             return self._takeoff()
         if sub == "land":
-            self._send(CMD_NAV_LAND)
+            self._send(MavCmd.NAV_LAND)
             return 0, ""
         if sub == "mode":
             return self._mode(args[1:])
         if sub == "status":
             return 0, self._status()
         if sub == "check":
-            self._send(CMD_RUN_PREARM_CHECKS)
+            self._send(MavCmd.RUN_PREARM_CHECKS)
             ok = self.vehicle.snapshot().pre_flight_checks_pass
             return 0, log_line("INFO", "commander", f"Preflight check: {'OK' if ok else 'FAILED'}")
         reason = f"{sub}: not supported by sitl_emu" if sub in _PX4_ONLY_SUBCOMMANDS else "unknown command"
@@ -170,9 +165,9 @@ class Shell:
 
     def _takeoff(self) -> tuple[int, str]:
         """NAV_TAKEOFF with every param NaN (MIS_TAKEOFF_ALT above ground), then arm if it was accepted."""
-        ack = self._send(CMD_NAV_TAKEOFF)
+        ack = self._send(MavCmd.NAV_TAKEOFF)
         if ack is not None and ack.result == MavResult.ACCEPTED:
-            self._send(CMD_ARM_DISARM, 1.0, 0.0)  # Commander.cpp sends param2 0 here: not forced, checks run
+            self._send(MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0)  # Commander.cpp: param2 0, checks run
         return 0, ""
 
     def _mode(self, args: list[str]) -> tuple[int, str]:
@@ -183,7 +178,7 @@ class Shell:
             return 0, log_line("ERROR", "commander", f"argument {args[0]} unsupported.")
         main, sub = main_sub(nav_state)
         # base_mode 1 = custom; PX4 passes NaN as sub mode for non-AUTO modes, read as 0 by the (uint8) cast.
-        self._send(CMD_DO_SET_MODE, 1.0, float(main), float(sub))
+        self._send(MavCmd.DO_SET_MODE, 1.0, float(main), float(sub))
         return 0, ""
 
     def _status(self) -> str:

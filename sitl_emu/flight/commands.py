@@ -18,26 +18,13 @@ from sitl_emu.px4 import (
     MODE_FLAG_MANUAL_INPUT_ENABLED,
     MODE_FLAG_STABILIZE_ENABLED,
     MainMode,
+    MavCmd,
     MavResult,
     NavState,
     Severity,
     nav_state_from_main_sub,
 )
 from sitl_emu.types import CommandAck, VehicleCommand
-
-CMD_NAV_RETURN_TO_LAUNCH = 20
-CMD_NAV_LAND = 21
-CMD_NAV_TAKEOFF = 22
-CMD_DO_SET_MODE = 176
-CMD_DO_SET_HOME = 179
-CMD_DO_FLIGHTTERMINATION = 185
-CMD_DO_CHANGE_ALTITUDE = 186
-CMD_DO_REPOSITION = 192
-CMD_PREFLIGHT_CALIBRATION = 241
-CMD_PREFLIGHT_REBOOT_SHUTDOWN = 246
-CMD_MISSION_START = 300
-CMD_COMPONENT_ARM_DISARM = 400
-CMD_RUN_PREARM_CHECKS = 401
 
 FORCE_MAGIC = 21196  # param2 of ARM_DISARM that forces (Commander.cpp)
 MISSION_PLANNER_COMPID = 190  # MAV_COMP_ID_MISSIONPLANNER: only it gets "Switching to ... not available"
@@ -223,17 +210,17 @@ def _prearm_checks(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck
 
 _Handler = Callable[[Commander, VehicleCommand, int], "CommandAck | None"]
 _HANDLERS: dict[int, _Handler] = {
-    CMD_COMPONENT_ARM_DISARM: _arm_disarm,
-    CMD_DO_SET_MODE: _set_mode,
-    CMD_NAV_TAKEOFF: _takeoff,
-    CMD_NAV_LAND: _land,
-    CMD_NAV_RETURN_TO_LAUNCH: _rtl,
-    CMD_DO_REPOSITION: _reposition,
-    CMD_DO_SET_HOME: _set_home,
-    CMD_MISSION_START: _mission_start,
-    CMD_DO_FLIGHTTERMINATION: _termination,
-    CMD_DO_CHANGE_ALTITUDE: _change_altitude,
-    CMD_PREFLIGHT_CALIBRATION: _calibration,
-    CMD_PREFLIGHT_REBOOT_SHUTDOWN: _reboot,
-    CMD_RUN_PREARM_CHECKS: _prearm_checks,
+    MavCmd.COMPONENT_ARM_DISARM: _arm_disarm,
+    MavCmd.DO_SET_MODE: _set_mode,
+    MavCmd.NAV_TAKEOFF: _takeoff,
+    MavCmd.NAV_LAND: _land,
+    MavCmd.NAV_RETURN_TO_LAUNCH: _rtl,
+    MavCmd.DO_REPOSITION: _reposition,
+    MavCmd.DO_SET_HOME: _set_home,
+    MavCmd.MISSION_START: _mission_start,
+    MavCmd.DO_FLIGHTTERMINATION: _termination,
+    MavCmd.DO_CHANGE_ALTITUDE: _change_altitude,
+    MavCmd.PREFLIGHT_CALIBRATION: _calibration,
+    MavCmd.PREFLIGHT_REBOOT_SHUTDOWN: _reboot,
+    MavCmd.RUN_PREARM_CHECKS: _prearm_checks,
 }
