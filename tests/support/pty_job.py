@@ -19,10 +19,9 @@ import termios
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
-from support import REPO_ROOT
-
-REPO = REPO_ROOT
+REPO = Path(__file__).resolve().parents[2]  # this file also runs as a script: no `support` import
 
 
 class PtyJob:
