@@ -25,6 +25,7 @@ from types import FrameType
 from typing import Any
 
 from sitl_emu.runtime.node import READ_API, READ_GCS
+from sitl_emu.runtime.timeline import Timeline
 
 log = logging.getLogger(__name__)
 
@@ -95,8 +96,8 @@ class RealTimeRunner:
         self.hooks = list(hooks)
         self._stop = threading.Event()
         self.iterations = 0
-        self.steps = 0
         self.dropped_us = 0
+        self.timeline = Timeline(self.nodes)  # the one tick loop (runtime/timeline.py); it never goes back
         # Sleep at least this long (wall time) between wake-ups and run the ticks due in one batch; 0 wakes for every
         # tick. Each wake-up costs more CPU than most ticks (cold caches), so batches save CPU; telemetry then leaves
         # in bursts (each message still stamped at its own tick) and a datagram still wakes us at once. `serve` sets
@@ -120,14 +121,21 @@ class RealTimeRunner:
             self._watch.close()
             self._watch = None
 
-    def _sim_us(self) -> int:
-        """The simulated time this runner keeps on the wall clock: the lead vehicle's (SwarmRunner: its timeline)."""
-        return int(self.nodes[0].vehicle.time_us)
+    @property
+    def steps(self) -> int:
+        """Vehicle ticks run so far, all vehicles together."""
+        return self.timeline.steps
+
+    @property
+    def timeline_us(self) -> int:
+        """Simulated time since this runner was created; unlike a vehicle's own time it never restarts."""
+        return self.timeline.time_us
 
     def _run(self, duration_s: float | None, watch: SocketWatch) -> None:
         """Run until stopped, or for `duration_s` more of simulated time (run() opens `watch`)."""
-        dt_us = int(self.nodes[0].vehicle.dt_us)
-        anchor_us, start_wall = self._sim_us(), time.monotonic()  # simulated time `anchor_us` at wall `start_wall`
+        timeline = self.timeline
+        dt_us = timeline.dt_us
+        anchor_us, start_wall = timeline.time_us, time.monotonic()  # simulated time `anchor_us` at wall `start_wall`
         end_us = None if duration_s is None else anchor_us + round(duration_s * 1e6)
         ready: dict[int, int] | None = None  # None: not known, look before the first tick
         stop = self._stop
@@ -136,23 +144,21 @@ class RealTimeRunner:
             target_us = anchor_us + int((woke - start_wall) * 1e6 * self.speed)
             if end_us is not None and end_us < target_us:
                 target_us = end_us
-            lag_us = target_us - self._sim_us()
+            lag_us = target_us - timeline.time_us
             if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
                 skipped = lag_us - MAX_LAG_US
                 self._warn_lag(lag_us)
                 anchor_us -= skipped
                 target_us -= skipped
                 self.dropped_us += skipped
-            before_us = self._sim_us()
-            self._advance(target_us, dt_us, ready)
-            if self._sim_us() < before_us:  # rebooted: simulated time restarted at 0, so does the wall-clock anchor
-                anchor_us, start_wall = self._sim_us(), time.monotonic()
+            if not timeline.advance_to(target_us, watch.ready, ready):  # woken by a datagram between ticks
+                timeline.answer(watch.ready() if ready is None else ready)
             for hook in self.hooks:
                 hook()
             self.iterations += 1
-            if end_us is not None and self._sim_us() >= end_us:
+            if end_us is not None and timeline.time_us >= end_us:
                 break
-            next_wall = start_wall + (self._sim_us() + dt_us - anchor_us) / 1e6 / self.speed
+            next_wall = start_wall + (timeline.time_us + dt_us - anchor_us) / 1e6 / self.speed
             if next_wall < woke + self.min_wake_s:  # batching: wake at a steady period, however long this batch took
                 next_wall = woke + self.min_wake_s
             timeout = next_wall - time.monotonic()
@@ -161,29 +167,6 @@ class RealTimeRunner:
     def _warn_lag(self, lag_us: int) -> None:
         if self.dropped_us == 0:
             log.warning("cannot keep up with --speed %g: simulated time falls behind the wall clock", self.speed)
-
-    def _advance(self, target_us: int, dt_us: int, ready: dict[int, int] | None) -> None:
-        """Run every tick due by `target_us`; `ready` (what the wake-up saw) serves the first, later ones look again."""
-        assert self._watch is not None
-        look = self._watch.ready
-        stepped = False
-        for index, node in enumerate(self.nodes):
-            vehicle = node.vehicle
-            step, step_io = vehicle.step, node.step_io
-            for _ in range((target_us - vehicle.time_us) // dt_us):
-                before_us = vehicle.time_us
-                step()
-                if stepped or ready is None:
-                    ready = look()
-                step_io(vehicle.time_us, ready.get(index, 0) if ready else 0)
-                self.steps += 1
-                stepped = True
-                if vehicle.time_us < before_us:  # rebooted: time restarted, the caller re-anchors
-                    break
-        if not stepped:  # woken by a datagram between steps: answer it now
-            for index, readable in (look() if ready is None else ready).items():
-                node = self.nodes[index]
-                node.step_io(node.vehicle.time_us, readable)
 
 
 @contextmanager

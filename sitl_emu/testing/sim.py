@@ -32,6 +32,7 @@ from sitl_emu.params import default_registry
 from sitl_emu.runtime.node import IO_BUDGET_DATAGRAMS, LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import SocketWatch
 from sitl_emu.runtime.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner, build_nodes
+from sitl_emu.runtime.timeline import Timeline
 from sitl_emu.vehicle import Vehicle
 
 __all__ = ["LockstepClock", "ScaledWallClock", "Sim", "VehiclePorts"]
@@ -79,15 +80,6 @@ class ScaledWallClock:
             time.sleep(seconds / self.speed)
 
 
-class _Track:
-    """Maps one vehicle's time (which restarts at 0 after a reboot) onto the Sim's monotonic clock."""
-
-    __slots__ = ("base_us",)
-
-    def __init__(self) -> None:
-        self.base_us = 0
-
-
 class Sim:
     """`count` vehicles (sysids 1..count, homes `spacing_m` apart eastwards) on free loopback ports."""
 
@@ -110,7 +102,7 @@ class Sim:
         if api_remote is None:  # every instance shares the sink (for_instance offset the port)
             for node in self.nodes:
                 node.api.link.remote = sink
-        self._tracks = [_Track() for _ in self.nodes]
+        self._timeline = Timeline(self.nodes)  # the lockstep tick loop (runtime/timeline.py)
         self._watch = SocketWatch(self.nodes)
         self._time_us = 0
         self.clock = LockstepClock(self)
@@ -151,21 +143,7 @@ class Sim:
     def advance_to(self, target_us: int) -> None:
         """Step every vehicle tick by tick up to `target_us` of Sim time, with each node's I/O after its tick."""
         self._require_lockstep()
-        look = self._watch.ready
-        stepped = True
-        while stepped:
-            stepped = False
-            ready = look()  # one look at every socket per tick: a node reads only the links with data waiting
-            for index, (node, track) in enumerate(zip(self.nodes, self._tracks, strict=True)):
-                vehicle = node.vehicle
-                before = vehicle.time_us
-                if track.base_us + before + vehicle.dt_us > target_us:
-                    continue
-                vehicle.step()
-                if vehicle.time_us < before:  # rebooted: its time restarts at 0 now
-                    track.base_us += before
-                node.step_io(vehicle.time_us, ready.get(index, 0) if ready else 0)
-                stepped = True
+        self._timeline.advance_to(target_us, self._watch.ready)
         self._time_us = max(self._time_us, target_us)
 
     def run_for(self, seconds: float) -> None:
@@ -197,8 +175,7 @@ class Sim:
         self._runner.stop()
         self._thread.join(5.0)
         self._time_us = self.time_us
-        for track, node in zip(self._tracks, self.nodes, strict=True):
-            track.base_us = self._time_us - int(node.vehicle.time_us)
+        self._timeline = Timeline(self.nodes, start_us=self._time_us)
         self._runner = None
         self._thread = None
 
