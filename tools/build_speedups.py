@@ -53,6 +53,7 @@ DEFAULT_MODULES = (
     "sitl_emu/flight/land_detector.py",
     "sitl_emu/flight/mode_executor.py",
     "sitl_emu/flight/mode_intention.py",
+    "sitl_emu/flight/offboard.py",
     "sitl_emu/flight/smoothing.py",
     "sitl_emu/flight/tasks.py",
     "sitl_emu/flight/tasks_core.py",

@@ -17,6 +17,7 @@ from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.mode_intention import ModeIntention
+from sitl_emu.flight.offboard import OffboardSignal
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
 from sitl_emu.types import NAN, HomePosition, OffboardControlMode, Vec3
@@ -103,8 +104,7 @@ class Commander:
         self._ready_announced = False
         self._armed_at_us = 0
         self._landed_since_us: int | None = None
-        self._offboard_last_us: int | None = None
-        self._offboard_mode: OffboardControlMode | None = None
+        self._offboard = OffboardSignal()  # flight/offboard.py: what happens when the setpoints stop
         self._last_reject_text_us: int | None = None
 
     @property
@@ -124,19 +124,15 @@ class Commander:
 
     def offboard_signal(self, now_us: int, mode: OffboardControlMode) -> None:
         """An offboard_control_mode arrived (any mode): refresh the COM_OF_LOSS_T watchdog."""
-        self._offboard_last_us = now_us
-        self._offboard_mode = mode
+        self._offboard.refresh(now_us, mode)
 
     def offboard_fresh(self, now_us: int) -> bool:
-        """offboardCheck.cpp: a setpoint kind is set and now < timestamp + COM_OF_LOSS_T."""
-        if self._offboard_last_us is None or self._offboard_mode is None or not self._offboard_mode.any():
-            return False
-        return now_us < self._offboard_last_us + self.settings.of_loss_us
+        return self._offboard.fresh(now_us, self.settings.of_loss_us)
 
     @property
     def offboard_mode(self) -> OffboardControlMode | None:
         """The last offboard signal kinds while the signal is fresh, else None."""
-        return self._offboard_mode if self.offboard_fresh(self.now_us) else None
+        return self._offboard.mode if self.offboard_fresh(self.now_us) else None
 
     # ---- checks -------------------------------------------------------------------------------------------------
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
