@@ -20,11 +20,12 @@ from typing import Final
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
+from sitl_emu.flight.manual_control import CENTRED
 from sitl_emu.flight.tasks import SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
-from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
+from sitl_emu.types import AttitudeSetpoint, ManualControlSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
 # flight_mode_manager runs the task on each estimator update; sitl_emu runs it with the position controller (125 Hz)
 TASK_PERIOD_US: Final = 8000
@@ -71,6 +72,7 @@ class ModeExecutor:
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
         self._held: ExecutorOutput | None = None  # the task's last output, reused until TASK_PERIOD_US has passed
         self._last_us = 0  # when the task last ran
+        self.sticks: ManualControlSetpoint = CENTRED  # the last manual input (flight/manual_control.py)
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -80,6 +82,9 @@ class ModeExecutor:
         if attitude is not None:
             self._offboard_att = attitude
         self._offboard_out = None
+
+    def manual(self, setpoint: ManualControlSetpoint) -> None:
+        self.sticks = setpoint
 
     def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
                commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
