@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from support.fakes import FakeVehicle, Harness
-from support.ftp_client import FtpClient
+from support.ftp_client import FtpClient, request_payload
 
 from sitl_emu.mavlink import version
 from sitl_emu.mavlink.endpoint import load_handler_classes
@@ -24,6 +24,7 @@ from sitl_emu.mavlink.ftp_protocol import (
     Err,
     FtpProtocol,
     Op,
+    Payload,
 )
 
 MAV_PROTOCOL_CAPABILITY_FTP = 32
@@ -283,3 +284,31 @@ def test_default_root_is_fs_in_the_working_directory(tmp_path, monkeypatch):
     finally:
         harness.close()
     assert (tmp_path / "fs" / "hello.txt").read_bytes() == b"hi"
+
+
+def test_a_sim_vehicle_serves_ftp_and_the_empty_log_list_on_both_links(tmp_path, monkeypatch):
+    """The default handler list of a real node (sitl_emu.testing.Sim), reached with pymavlink's own connection."""
+    from pymavlink import mavutil
+
+    from sitl_emu.testing import Sim
+
+    monkeypatch.setattr(FtpProtocol, "root", tmp_path / "fs")
+    (tmp_path / "fs").mkdir()
+    (tmp_path / "fs" / "params.txt").write_bytes(b"MPC_XY_CRUISE 5\n")
+    with Sim() as sim:
+        for host, port in (sim.ports(0).api, sim.ports(0).gcs):
+            conn = mavutil.mavlink_connection(f"udpout:{host}:{port}", source_system=255, source_component=190)
+            try:
+                conn.mav.file_transfer_protocol_send(0, 1, 1, request_payload(Op.LIST_DIRECTORY, b"/\0", seq=7))
+                conn.mav.log_request_list_send(1, 1, 0, 0xFFFF)
+                sim.run_for(0.05)
+                got = {}
+                while (msg := conn.recv_match(type=["FILE_TRANSFER_PROTOCOL", "LOG_ENTRY"], blocking=False)):
+                    got[msg.get_type()] = msg
+            finally:
+                conn.close()
+            reply = Payload.unpack(bytes(got["FILE_TRANSFER_PROTOCOL"].payload))
+            assert (reply.seq, reply.opcode) == (8, Op.ACK)
+            assert bytes(reply.data[:reply.size]) == b"S\0S\0Fparams.txt\t16\0"
+            entry = got["LOG_ENTRY"]
+            assert (entry.id, entry.num_logs, entry.last_log_num, entry.time_utc, entry.size) == (0, 0, 0, 0, 0)
