@@ -7,7 +7,7 @@ module's name to catalog.DOMAINS). catalog.py says how the two are reconciled.
 
 from __future__ import annotations
 
-from sitl_emu.params.catalog import catalog, emulator_definitions
+from sitl_emu.params.catalog import emulator_definitions, px4_catalog
 from sitl_emu.params.registry import ParamDef, ParamError, ParamRegistry, ParamType, integer, real
 
 __all__ = ["ParamDef", "ParamError", "ParamRegistry", "ParamType", "all_definitions", "default_registry", "integer",
@@ -21,5 +21,5 @@ def all_definitions() -> list[ParamDef]:
 
 def default_registry() -> ParamRegistry:
     """A fresh registry at the defaults: PX4's list used (listed), the emulator's other definitions known."""
-    cat = catalog()
+    cat = px4_catalog()
     return ParamRegistry(cat.defs, used=cat.used)

@@ -67,7 +67,7 @@ def read_px4_rows(text: str) -> list[tuple[str, ParamType, float]]:
 
 
 @lru_cache(maxsize=1)
-def catalog() -> Catalog:
+def px4_catalog() -> Catalog:
     """PX4's list and the emulator's definitions reconciled (built once per process; the ParamDefs are immutable)."""
     text = resources.files("sitl_emu.params").joinpath(DATA_FILE).read_text(encoding="ascii")
     rows = read_px4_rows(text)

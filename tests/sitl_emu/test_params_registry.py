@@ -16,7 +16,7 @@ from sitl_emu.params import (
     integer,
     real,
 )
-from sitl_emu.params.catalog import EMULATOR_DEFAULTS, VOLATILE, catalog
+from sitl_emu.params.catalog import EMULATOR_DEFAULTS, VOLATILE, px4_catalog
 from sitl_emu.params.registry import same_value
 
 # The recorded PX4 list (../shared/reference, beside the repository or beside the main checkout of a worktree)
@@ -28,7 +28,7 @@ def px4_list() -> dict[str, dict]:
     found = next((path for path in REFERENCES if path.exists()), None)
     if found is not None:
         return json.loads(found.read_text())["params"]
-    cat = catalog()
+    cat = px4_catalog()
     return {name: {"type": cat.defs[i].type.value, "value": cat.px4_defaults[name], "index": i}
             for i, name in enumerate(cat.used)}
 
