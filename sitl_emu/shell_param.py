@@ -101,6 +101,7 @@ def _set(registry: ParamRegistry, name: str, text: str, fail: bool) -> tuple[int
         value = float(text)  # BE SAFER THAN PX4: strtol/strtod would turn "abc" into 0 and set it
     except ValueError:
         return 1, log_line("ERROR", "param", f"'{text}' is not a number.")
+    registry.mark_used(name)  # param.cpp do_set finds it with param_find, which marks it used
     old = format_value(registry, name)
     marker = " " if registry.is_default(name) else "+"
     if registry.get(name) == value:

@@ -28,6 +28,8 @@ import struct
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar, cast
 
+from pymavlink.dialects.v20 import development as _dialect
+
 from sitl_emu.mavlink.fastpack import ENCODER, Packed
 from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import Severity
@@ -61,6 +63,7 @@ PARAM_ERROR_TYPE_UNSUPPORTED = 6
 PARAM_ERROR_TYPE_MISMATCH = 7
 
 _TYPE_CODES = {ParamType.INT32: MAV_PARAM_TYPE_INT32, ParamType.REAL32: MAV_PARAM_TYPE_REAL32}
+_HAS_PARAM_ERROR = hasattr(_dialect, "MAVLink_param_error_message")  # an old pymavlink may lack it
 
 
 def int32_to_float_bits(value: int) -> float:
@@ -239,8 +242,10 @@ def _set_problem(registry: ParamRegistry, name: str, type_code: int) -> int:
 
 
 def _error(ctx: LinkContext, request: MAVLink_message, name: str, index: int, code: int) -> None:
-    """PARAM_ERROR (#345) to the component that asked."""
+    """PARAM_ERROR (#345) to the component that asked (none if pymavlink's dialect lacks it: PX4 v1.16's silence)."""
     log.debug("%s %r (index %d): PARAM_ERROR %d", request.get_type(), name, index, code)
+    if not _HAS_PARAM_ERROR:
+        return
     ctx.send(ENCODER.param_error_encode(request.get_srcSystem(), request.get_srcComponent(),
                                         name.encode("ascii", errors="replace"), index, code))
 

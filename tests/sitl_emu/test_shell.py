@@ -130,6 +130,9 @@ def test_param_show_lists_unused_parameters_only_with_a(vehicle):
         shell.execute("param show -a MIS_*").splitlines()
     assert shell.execute("param touch MIS_DIST_1WP NO_SUCH") == ""
     assert "x   MIS_DIST_1WP" in shell.execute("param show MIS_DIST_1WP")
+    count = len(vehicle.params)
+    shell.execute("param set MIS_TKO_LAND_REQ 1")  # PX4's param set looks the parameter up: it is used from now on
+    assert len(vehicle.params) == count + 1 and "x + MIS_TKO_LAND_REQ" in shell.execute("param show MIS_TKO*")
 
 
 def test_param_reset_and_reset_all(vehicle):
