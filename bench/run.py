@@ -11,6 +11,8 @@ Figures (targets from issue 4 in brackets):
               in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
   latency     joyfly joystick event -> setpoint datagram, median and p99 [p99 < 5 ms] (bench/joyfly_latency.py)
   scale       largest --count N kept on time at real time on one core, hovering, default streams [100]
+  params      full parameter download (PARAM_REQUEST_LIST to the last PARAM_VALUE) from `serve` at real time, wall
+              time [< 1 s; PX4 SITL 0.98 s] (bench/params.py)
 Every figure is measured here and now; the machine line says how busy the host was.
 """
 
@@ -29,10 +31,10 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
-from bench import core, runner, scale, serve  # noqa: E402
+from bench import core, params, runner, scale, serve  # noqa: E402
 from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
-NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale")
+NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params")
 
 
 def say(line: str) -> None:
@@ -143,9 +145,16 @@ def bench_scale(quick: bool) -> None:
         f"CPU {cpu}; target 100{estimate}): {tried}")
 
 
+def bench_params(quick: bool) -> None:
+    runs = 1 if quick else 3
+    seconds, count = params.download_time(runs)
+    say(f"parameter download: {seconds:.3f} s wall for {count} parameters + _HASH_CHECK from serve at real time "
+        f"(best of {runs}; target < 1, PX4 SITL 0.981 s)")
+
+
 BENCHES: dict[str, Callable[[bool], None]] = {
     "core": bench_core, "runner": bench_runner, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
-    "latency": bench_latency, "scale": bench_scale,
+    "latency": bench_latency, "scale": bench_scale, "params": bench_params,
 }
 
 

@@ -63,47 +63,78 @@ def wake_period_s(batch_ms: float, speed: float) -> float:
     return period_s if period_s > MIN_BATCH_WALL_S else MIN_BATCH_WALL_S
 
 
-def read_params_file(path: Path) -> list[tuple[str, str, str]]:
+def read_params_file(path: Path) -> list[tuple[str, float, str]]:
     """(name, value, where) from lines `NAME VALUE`, or QGC .params lines `SYSID COMPID NAME VALUE TYPE`; '#' starts
     a comment; `where` is FILE:LINE for messages."""
+    from sitl_emu.params.store import ParamFileError, read_file
+
     try:
-        lines = path.read_text().splitlines()
-    except OSError as err:
-        raise UsageProblem(f"Cannot read the parameter file {path}: {err.strerror}.") from None
-    except UnicodeDecodeError:
-        raise UsageProblem(f"{path} is not a text file: give --params a file of 'NAME VALUE' lines.") from None
-    pairs: list[tuple[str, str, str]] = []
-    for n, raw in enumerate(lines, 1):
-        parts = raw.split("#", 1)[0].split()
-        if not parts:
-            continue
-        if len(parts) >= 4 and parts[0].isdigit() and parts[1].isdigit():
-            pairs.append((parts[2], parts[3], f"{path}:{n}"))
-        elif len(parts) == 2:
-            pairs.append((parts[0], parts[1], f"{path}:{n}"))
-        else:
-            raise UsageProblem(f"{path}:{n}: expected 'NAME VALUE' or a QGC .params line, not '{raw.strip()}'.")
-    return pairs
+        return read_file(path)
+    except ParamFileError as err:
+        raise UsageProblem(str(err)) from None
 
 
-def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
-    from sitl_emu.params import ParamError, default_registry
+def parse_assignments(assignments: tuple[str, ...]) -> list[tuple[str, float, str]]:
+    from sitl_emu.params.store import ParamFileError, parse_value
 
-    registry = default_registry()
-    pairs = read_params_file(params_file) if params_file is not None else []
+    entries = []
     for item in assignments:
         name, sep, value = item.partition("=")
         if not sep or not name:
             raise UsageProblem(f"--param must look like NAME=VALUE (for example MIS_TAKEOFF_ALT=5), not '{item}'.")
-        pairs.append((name.strip(), value.strip(), "--param"))
-    for name, value, where in pairs:
         try:
-            registry.set(name, float(value))
-        except ValueError as err:
-            if isinstance(err, ParamError):
-                raise UsageProblem(f"{where}: {err}") from None
-            raise UsageProblem(f"{where}: parameter {name} needs a number, not '{value}'.") from None
+            entries.append((name.strip(), parse_value(name.strip(), value.strip(), "--param"), "--param"))
+        except ParamFileError as err:
+            raise UsageProblem(str(err)) from None
+    return entries
+
+
+def apply_params(registry: Any, entries: list[tuple[str, float, str]]) -> None:
+    from sitl_emu.params import ParamError
+    from sitl_emu.params.store import apply_entry
+
+    for entry in entries:
+        try:
+            apply_entry(registry, entry)
+        except ParamError as err:
+            raise UsageProblem(str(err)) from None
+
+
+def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
+    """A registry with the file's values and then the --param ones (no persistence: see stored_params)."""
+    from sitl_emu.params import default_registry
+
+    registry = default_registry()
+    entries = read_params_file(params_file) if params_file is not None and params_file.exists() else []
+    apply_params(registry, entries + parse_assignments(assignments))
     return registry
+
+
+def stored_params(params_file: Path | None, instance: int, first: int, reset: bool) -> tuple[Any, Any, str | None]:
+    """Vehicle `instance`'s registry with its saved values, its ParamStore, and a warning sentence (or None).
+
+    The file is --params FILE, or parameters.params in the working directory (PX4 SITL's parameters.bson);
+    other vehicles of a --count get `<stem>-<instance><suffix>` beside it (params/store.py instance_path). A missing
+    file starts from the defaults (with --params FILE and --count, from FILE's values). --params-reset ignores it.
+    A bad --params FILE is the user's mistake (UsageProblem, as before); a bad default file is a warning.
+    """
+    from sitl_emu.params import default_registry
+    from sitl_emu.params.store import DEFAULT_FILE, ParamStore, instance_path
+
+    registry = default_registry()
+    base = params_file if params_file is not None else Path(DEFAULT_FILE)
+    store = ParamStore(registry, instance_path(base, instance, first if params_file is not None else 0), instance + 1)
+    if reset:
+        return registry, store, None
+    if params_file is None:
+        return registry, store, store.load()
+    source = store.path if store.path.exists() else base
+    if not source.exists():
+        return registry, store, (f"{store.path} does not exist yet, so vehicle {instance + 1} starts from the "
+                                 "defaults and saves its changes there.")
+    apply_params(registry, read_params_file(source))
+    store.mark_saved()
+    return registry, store, None
 
 
 def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int) -> Any:
@@ -151,13 +182,17 @@ def main(verbose: int) -> None:
 @click.option("--home", default=None, help="Home as LAT,LON,ALT (deg, deg, m AMSL).")
 @click.option("--param", "assignments", multiple=True, metavar="NAME=VALUE", help="Set a parameter (repeatable).")
 @click.option("--params", "params_file", type=click.Path(path_type=Path), default=None,
-              help="Parameter file: lines 'NAME VALUE' or QGC .params format.")
+              help="Parameter file, loaded at start and saved after every change (QGC .params format; lines 'NAME "
+                   "VALUE' are read too). Default: parameters.params in the working directory (parameters-N.params "
+                   "for instance N), as PX4 SITL keeps parameters.bson.")
+@click.option("--params-reset", is_flag=True,
+              help="Start from PX4's defaults: ignore the saved parameters (the file is overwritten).")
 @click.option("--seed", type=WholeRange(0, SEED_MAX), default=0, show_default=True,
               help="Random seed for the sensor noise: the same seed, parameters and inputs fly the same trajectory.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
-          seed: int, no_console: bool) -> None:
+          params_reset: bool, seed: int, no_console: bool) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         check_host(bind_host, "--bind")
@@ -165,10 +200,23 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
                                 parse_address(gcs_remote, "--gcs-remote"))
         home_lla = parse_home(home) if home else DEFAULT_HOME
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
-        build_params(params_file, assignments)  # report a bad --param once, before any port is opened
-        nodes = build_nodes(count, settings, lambda i, h: build_vehicle(
-            build_params(params_file, assignments), h, seed + i - instance, i + 1), first_instance=instance,
-            home=home_lla, epoch_unix_us=int(time.time() * 1e6))
+        build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
+        stores: list[Any] = []
+
+        def vehicle(i: int, h: tuple[float, float, float]) -> Any:
+            registry, store, warning = stored_params(params_file, i, instance, params_reset)
+            if warning:
+                click.echo(f"{TOOL}: {warning}", err=True)
+            built = build_vehicle(registry, h, seed + i - instance, i + 1)
+            store.mark_saved()  # PX4's rcS sets MAV_SYS_ID at every boot: nothing to save for that
+            apply_params(registry, parse_assignments(assignments))  # saved like any change (PX4's `param set`)
+            if params_reset and store.path.exists():
+                _save_or_fail(store)  # the saved values are gone: the next start is from the defaults too
+            stores.append(store)
+            return built
+
+        nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
+                            epoch_unix_us=int(time.time() * 1e6))
     except (UsageProblem, PortInUseError) as err:
         raise UserError(str(err)) from None
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
@@ -176,10 +224,28 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
+    runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
     console = attach_console([node.vehicle for node in nodes], runner, not no_console)
     _run_until_signalled(runner, console)
     for node in nodes:
         node.close()
+    _save_all(stores)
+
+
+def _save_or_fail(store: Any) -> None:
+    try:
+        store.save()
+    except OSError as err:
+        raise UsageProblem(f"Cannot write the parameter file {store.path}: {err.strerror}.") from None
+
+
+def _save_all(stores: list[Any]) -> None:
+    for store in stores:
+        if store.unsaved:
+            try:
+                store.save()
+            except OSError as err:
+                click.echo(f"{TOOL}: cannot save the parameters to {store.path}: {err.strerror}.", err=True)
 
 
 def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:

@@ -3,7 +3,7 @@
 What each command sends and prints follows PX4 (v1.15):
 - `commander ...`: src/modules/commander/Commander.cpp custom_command(): every subcommand publishes an internal
   vehicle_command (from_external false, source = own sysid/compid); results appear later as log lines (events).
-- `param ...`: src/systemcmds/param/param.cpp (show/set formats); `param get` is our addition (= `param show -q`).
+- `param ...`: sitl_emu/shell_param.py (src/systemcmds/param/param.cpp).
 - `listener ...`: src/systemcmds/topic_listener/listener_main.cpp (see sitl_emu/listener.py). With -n N the messages
   come one by one as the topic is published, so the command keeps running after `execute` returns: the caller prints
   `poll()`'s output each loop and shows the next prompt once `busy` is False, as pxh does when the command returns.
@@ -13,15 +13,14 @@ Log-style output uses PX4's console format "%-5s [%s] %s" (platforms/common/px4_
 
 from __future__ import annotations
 
-import fnmatch
 import logging
 import math
 from collections.abc import Callable
 from typing import Any
 
 from sitl_emu import listener
-from sitl_emu.params.registry import ParamError, ParamRegistry, ParamType
 from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavCmd, MavResult, NavState, main_sub
+from sitl_emu.shell_param import log_line, param_command
 from sitl_emu.types import VehicleCommand
 
 log = logging.getLogger(__name__)
@@ -45,25 +44,6 @@ _COMMANDER_USAGE = """Usage: commander <command> [arguments...]
      manual|altctl|posctl|position:slow|altitude_cruise|auto:mission|auto:loiter|auto:course|auto:rtl|acro|
      offboard|stabilized|auto:takeoff|auto:land|auto:precland Flight mode
 """
-
-_PARAM_USAGE = """Usage: param <command> [arguments...]
- Commands:
-   show          Show parameter values
-     [-c]        Show only changed params
-     [-q]        quiet mode, print only param value (name needs to be exact)
-     [<filter>]  Filter by param name (wildcard at end allowed, eg. sys_*)
-   set           Set parameter to a value
-     <param_name> <value> Parameter name and value to set
-     [fail]      If provided, let the command fail if param is not found
-   get           Print a parameter's value (sitl_emu addition; same as show -q)
-     <param_name> Parameter name
-"""
-
-
-def log_line(level: str, module: str, text: str) -> str:
-    """One PX4 console log line, e.g. 'INFO  [commander] Armed by internal command'."""
-    return f"{level:<5} [{module}] {text}\n"
-
 
 App = Callable[[list[str]], tuple[int, str]]  # arguments -> (status, output)
 
@@ -218,20 +198,7 @@ class Shell:
 
     # --- param -------------------------------------------------------------------------------------------------
     def _param(self, args: list[str]) -> tuple[int, str]:
-        registry: ParamRegistry = self.vehicle.params
-        sub = args[0] if args else ""
-        if sub == "show":
-            return _param_show(registry, args[1:])
-        if sub == "set" and len(args) >= 3:
-            return _param_set(registry, args[1], args[2], fail=len(args) > 3 and args[3] == "fail")
-        if sub == "set":
-            name = args[1] if len(args) > 1 else "PARAM_NAME"
-            return 1, log_line("ERROR", "param", f"not enough arguments.\nTry 'param set {name} 3 [fail]'")
-        if sub == "get" and len(args) == 2:
-            if args[1] not in registry:
-                return 1, log_line("ERROR", "param", f"Parameter {args[1]} not found")
-            return 0, _format_value(registry, args[1]) + "\n"
-        return 1, _PARAM_USAGE
+        return param_command(self.vehicle.params, args, int(self.vehicle.sysid))
 
     # --- system ------------------------------------------------------------------------------------------------
     def _shutdown(self, args: list[str]) -> tuple[int, str]:
@@ -260,55 +227,3 @@ def _listener_options(args: list[str]) -> tuple[int, int, int] | None:
 
 def _nav_name(nav_state: NavState) -> str:
     return UI_NAMES.get(nav_state, str(int(nav_state)))
-
-
-def _matches(name: str, pattern: str | None) -> bool:
-    """param.cpp do_show_print: case-insensitive, exact unless a '*' wildcard is given."""
-    return pattern is None or fnmatch.fnmatchcase(name, pattern.upper())
-
-
-def _format_value(registry: ParamRegistry, name: str) -> str:
-    value = registry.get(name)
-    if registry.definition(name).type is ParamType.INT32:
-        return f"{int(value)}"
-    return f"{float(value):4.4f}"
-
-
-def _param_show(registry: ParamRegistry, args: list[str]) -> tuple[int, str]:
-    if args[:1] == ["-q"]:
-        if len(args) < 2 or args[1] not in registry:
-            return 1, ""
-        return 0, _format_value(registry, args[1]) + "\n"
-    only_changed = args[:1] == ["-c"]
-    if only_changed:
-        args = args[1:]
-    pattern = args[0] if args else None
-    lines = ["Symbols: x = used, + = saved, * = unsaved\n"]
-    for d in registry:
-        if not _matches(d.name, pattern):
-            continue
-        changed = registry.get(d.name) != d.default
-        if only_changed and not changed:
-            continue
-        index = registry.index_of(d.name)
-        lines.append(f"x {'+' if changed else ' '} {d.name} [{index},{index}] : {_format_value(registry, d.name)}\n")
-    lines.append(f"\n {len(registry)}/{len(registry)} parameters used.\n")
-    return 0, "".join(lines)
-
-
-def _param_set(registry: ParamRegistry, name: str, text: str, fail: bool) -> tuple[int, str]:
-    if name not in registry:
-        return (1 if fail else 0), log_line("ERROR", "param", f"Parameter {name} not found.")
-    try:
-        value = float(text)  # BE SAFER THAN PX4: strtol/strtod would turn "abc" into 0 and set it
-    except ValueError:
-        return 1, log_line("ERROR", "param", f"'{text}' is not a number.")
-    old = _format_value(registry, name)
-    marker = "+" if registry.get(name) != registry.definition(name).default else " "
-    if registry.get(name) == value:
-        return 0, ""
-    try:
-        registry.set(name, value)
-    except ParamError as err:
-        return 1, log_line("ERROR", "param", str(err))
-    return 0, f"{marker} {name}: curr: {old} -> new: {_format_value(registry, name)}\n"

@@ -41,6 +41,8 @@ HANDLER_CLASSES: tuple[tuple[str, str], ...] = (
     ("sitl_emu.mavlink.params_protocol", "ParamProtocol"),
     ("sitl_emu.mavlink.mission_protocol", "MissionProtocol"),
     ("sitl_emu.mavlink.shell_bridge", "ShellBridge"),
+    ("sitl_emu.mavlink.ftp_protocol", "FtpProtocol"),
+    ("sitl_emu.mavlink.log_protocol", "LogProtocol"),
 )
 
 

@@ -1,32 +1,25 @@
-"""The parameter registry and PX4's parameter definitions.
+"""The parameter registry and PX4's parameters.
 
-Each domain owns one `defs_<domain>.py` module exporting `PARAMS: list[ParamDef]`; add a new module's name to
-`_DOMAINS` below.
+`default_registry()` gives every PX4 parameter (sitl_emu/params/px4_params.csv, PX4's order and defaults) plus the
+emulator's own definitions (`defs_<domain>.py`, one module per domain, exporting `PARAMS: list[ParamDef]`; add a new
+module's name to catalog.DOMAINS). catalog.py says how the two are reconciled.
 """
 
 from __future__ import annotations
 
-import importlib
-
+from sitl_emu.params.catalog import emulator_definitions, px4_catalog
 from sitl_emu.params.registry import ParamDef, ParamError, ParamRegistry, ParamType, integer, real
 
-__all__ = ["ParamDef", "ParamError", "ParamRegistry", "ParamType", "default_registry", "integer", "real"]
-
-_DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system")
+__all__ = ["ParamDef", "ParamError", "ParamRegistry", "ParamType", "all_definitions", "default_registry", "integer",
+           "real"]
 
 
 def all_definitions() -> list[ParamDef]:
-    defs: list[ParamDef] = []
-    for domain in _DOMAINS:
-        try:
-            module = importlib.import_module(f"sitl_emu.params.defs_{domain}")
-        except ModuleNotFoundError as err:
-            if err.name != f"sitl_emu.params.defs_{domain}":
-                raise
-            continue
-        defs.extend(module.PARAMS)
-    return defs
+    """The emulator's own definitions (the parameters its code reads by name)."""
+    return emulator_definitions()
 
 
 def default_registry() -> ParamRegistry:
-    return ParamRegistry(all_definitions())
+    """A fresh registry at the defaults: PX4's list used (listed), the emulator's other definitions known."""
+    cat = px4_catalog()
+    return ParamRegistry(cat.defs, used=cat.used)

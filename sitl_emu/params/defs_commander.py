@@ -17,7 +17,7 @@ PARAMS: list[ParamDef] = [
     real("COM_DISARM_PRFLT", 10.0, -1.0, 20.0, "s", "Disarm this long after arming without takeoff (<=0 disables)"),
     real("COM_SPOOLUP_TIME", 1.0, 0.0, 5.0, "s", "Motor spool-up time after arming"),
     real("COM_FAIL_ACT_T", 5.0, 0.0, 25.0, "s", "Hold this long before a generic failsafe action"),
-    real("COM_DL_LOSS_T", 10.0, 5.0, 300.0, "s", "GCS data link loss timeout"),
+    integer("COM_DL_LOSS_T", 10, 5, 300, "s", "GCS data link loss timeout"),
     real("COM_RC_LOSS_T", 0.5, 0.0, 35.0, "s", "Manual control loss timeout"),
     integer("NAV_DLL_ACT", 0, 0, 6, "", "Data link loss action: 0 Disabled, 1 Hold, 2 Return, 3 Land, "
                                          "5 Terminate, 6 Disarm"),

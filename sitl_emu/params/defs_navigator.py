@@ -21,6 +21,15 @@ _NAVIGATOR: list[ParamDef] = [
     integer("RTL_CONE_ANG", 45, 0, 90, "deg", "Half-angle of the return altitude cone (0: always RTL_RETURN_ALT)."),
 ]
 
+# PX4's navigator looks these up only when a mission is uploaded, so PX4 lists them only from then on (catalog.py: not
+# in PX4's boot list, hence known but unused until ParamRegistry.mark_used). mission_params.yaml.
+_MISSION_CHECKS: list[ParamDef] = [
+    real("MIS_DIST_1WP", 10000.0, -1.0, 100000.0, "m",
+         "Warn when the first waypoint is farther than this from home (0 or less: never)."),
+    integer("MIS_TKO_LAND_REQ", 0, 0, 5, "", "Whether a mission must contain a takeoff and/or a landing "
+                                              "(0: no requirement)."),
+]
+
 _LAND_DETECTOR: list[ParamDef] = [
     real("LNDMC_Z_VEL_MAX", 0.25, 0.0, 10.0, "m/s", "Maximum vertical speed to detect landing."),
     real("LNDMC_XY_VEL_MAX", 1.5, 0.0, 10.0, "m/s", "Maximum horizontal speed to detect landing."),
@@ -30,4 +39,4 @@ _LAND_DETECTOR: list[ParamDef] = [
     real("LNDMC_ALT_MAX", -1.0, -1.0, 10000.0, "m", "Maximum altitude for multicopters (-1: no limit)."),
 ]
 
-PARAMS: list[ParamDef] = _NAVIGATOR + _LAND_DETECTOR
+PARAMS: list[ParamDef] = _NAVIGATOR + _MISSION_CHECKS + _LAND_DETECTOR

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import os
 import subprocess
 import sys
 import time
@@ -47,7 +48,9 @@ def server(tmp_path: Path):
             "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
     log_path = tmp_path / "serve.log"
     with log_path.open("w") as log_file:
-        proc = subprocess.Popen(args, cwd=REPO, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        # in tmp_path: the parameters it sets are saved there (parameters.params), not in the repository
+        proc = subprocess.Popen(args, cwd=tmp_path, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                env={**os.environ, "PYTHONPATH": str(REPO)})
         try:
             yield client_port
         finally:

@@ -105,16 +105,62 @@ def test_param_show_format_and_pattern(vehicle):
     out = Shell(vehicle).execute("param show bat_*")
     lines = out.splitlines()
     assert lines[0] == "Symbols: x = used, + = saved, * = unsaved"
-    index = vehicle.params.index_of("BAT_LOW_THR")
-    assert f"x   BAT_LOW_THR [{index},{index}] : 0.1500" in lines
+    assert f"x   BAT_LOW_THR [{_table_index(vehicle, 'BAT_LOW_THR')},{vehicle.params.index_of('BAT_LOW_THR')}] : " \
+           "0.1500" in lines
     assert all("BAT" in line for line in lines[1:-2])
-    assert lines[-1] == f" {len(vehicle.params)}/{len(vehicle.params)} parameters used."
+    known = sum(1 for _ in vehicle.params.known())
+    assert lines[-1] == f" {len(vehicle.params)}/{known} parameters used." == " 994/1002 parameters used."
+
+
+def _table_index(vehicle, name: str) -> int:
+    """The index among every known parameter (param.cpp's first number; the second is the used index)."""
+    return [d.name for d in vehicle.params.known()].index(name)
 
 
 def test_param_show_exact_name_without_wildcard(vehicle):
     out = Shell(vehicle).execute("param show MAV_SYS_ID")
     assert [ln for ln in out.splitlines() if ln.startswith("x")] == [
-        f"x   MAV_SYS_ID [{vehicle.params.index_of('MAV_SYS_ID')},{vehicle.params.index_of('MAV_SYS_ID')}] : 1"]
+        f"x   MAV_SYS_ID [{_table_index(vehicle, 'MAV_SYS_ID')},{vehicle.params.index_of('MAV_SYS_ID')}] : 1"]
+
+
+def test_param_show_lists_unused_parameters_only_with_a(vehicle):
+    shell = Shell(vehicle)
+    assert "MIS_DIST_1WP" not in shell.execute("param show MIS_*")
+    assert f"    MIS_DIST_1WP [{_table_index(vehicle, 'MIS_DIST_1WP')},-1] : 10000.0000" in \
+        shell.execute("param show -a MIS_*").splitlines()
+    assert shell.execute("param touch MIS_DIST_1WP NO_SUCH") == ""
+    assert "x   MIS_DIST_1WP" in shell.execute("param show MIS_DIST_1WP")
+    count = len(vehicle.params)
+    shell.execute("param set MIS_TKO_LAND_REQ 1")  # PX4's param set looks the parameter up: it is used from now on
+    assert len(vehicle.params) == count + 1 and "x + MIS_TKO_LAND_REQ" in shell.execute("param show MIS_TKO*")
+
+
+def test_param_reset_and_reset_all(vehicle):
+    shell = Shell(vehicle)
+    shell.execute("param set BAT1_N_CELLS 6")
+    shell.execute("param set BAT_LOW_THR 0.2")
+    shell.execute("param set MPC_XY_P 1.1")
+    assert "not enough arguments" in shell.execute("param reset")
+    shell.execute("param reset BAT*")
+    assert vehicle.params.changed() == {"MPC_XY_P": 1.1}
+    shell.execute("param set BAT1_N_CELLS 6")
+    shell.execute("param reset_all MPC_XY_*")
+    assert vehicle.params.changed() == {"MPC_XY_P": 1.1}
+    shell.execute("param reset_all")
+    assert vehicle.params.changed() == {}
+
+
+def test_param_save_writes_the_vehicles_file_or_says_there_is_none(vehicle, tmp_path):
+    from sitl_emu.params.store import ParamStore, read_file
+
+    shell = Shell(vehicle)
+    assert shell.execute("param save").startswith("ERROR [param] Param save failed")
+    store = ParamStore(vehicle.params, tmp_path / "parameters.params")
+    shell.execute("param set BAT1_N_CELLS 6")
+    assert shell.execute("param save") == f"INFO  [param] saved to {store.path}\n" and not store.unsaved
+    assert read_file(store.path)[0][:2] == ("BAT1_N_CELLS", 6.0)
+    assert shell.execute(f"param save {tmp_path / 'export.params'}") == ""
+    assert read_file(tmp_path / "export.params") == [("BAT1_N_CELLS", 6.0, f"{tmp_path / 'export.params'}:3")]
 
 
 def test_param_set_prints_old_and_new_and_applies(vehicle):

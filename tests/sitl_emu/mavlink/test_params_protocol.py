@@ -13,7 +13,13 @@ from sitl_emu.mavlink.params_protocol import (
     MAV_PARAM_TYPE_INT32,
     MAV_PARAM_TYPE_REAL32,
     MAV_PARAM_TYPE_UINT32,
+    PARAM_ERROR_DOES_NOT_EXIST,
+    PARAM_ERROR_READ_ONLY,
+    PARAM_ERROR_TYPE_MISMATCH,
+    PARAM_ERROR_TYPE_UNSUPPORTED,
+    PARAM_ERROR_VALUE_OUT_OF_RANGE,
     PARAMS_PER_TICK,
+    UNUSED_INDEX,
     ParamProtocol,
     float_bits_to_int32,
     int32_to_float_bits,
@@ -76,13 +82,34 @@ def test_request_list_needs_exact_sysid(setup):
     assert _drain(proto, ctx) == []
 
 
-def test_hash_check_set_stops_the_stream(setup):
+def _error(ctx: MemoryContext) -> object:
+    """The one message sent since the last take, which must be a PARAM_ERROR to the client (255/190)."""
+    (err,) = ctx.take()
+    assert err.get_type() == "PARAM_ERROR" and (err.target_system, err.target_component) == (255, 190)
+    return err
+
+
+def test_hash_check_set_stops_the_stream_and_answers_read_only(setup):
     proto, ctx, client = setup
     proto.handle(client.msg("PARAM_REQUEST_LIST", 1, 1), ctx)
     proto.tick(ctx)
     ctx.take()
     proto.handle(_set(client, "_HASH_CHECK", 0.0, MAV_PARAM_TYPE_UINT32), ctx)
+    err = _error(ctx)  # PX4 main answers PARAM_ERROR READ_ONLY (px4-behaviour.md 10.4)
+    assert (err.param_id, err.param_index, err.error) == ("_HASH_CHECK", -1, PARAM_ERROR_READ_ONLY)
     assert _drain(proto, ctx) == []
+
+
+def test_hash_check_set_does_not_stop_the_stream_when_disabled(setup):
+    proto, ctx, client = setup
+    ctx.vehicle.params.set("MAV_HASH_CHK_EN", 0)
+    proto.tick(ctx)
+    ctx.take()
+    proto.handle(client.msg("PARAM_REQUEST_LIST", 1, 1), ctx)
+    proto.tick(ctx)
+    ctx.take()
+    proto.handle(_set(client, "_HASH_CHECK", 0.0, MAV_PARAM_TYPE_UINT32), ctx)
+    assert len(_drain(proto, ctx)) == len(ctx.vehicle.params) + 1 - PARAMS_PER_TICK
 
 
 def test_second_list_request_restarts_without_hash(setup):
@@ -124,11 +151,55 @@ def test_read_hash_check_by_name(setup):
     assert msg.param_id == "_HASH_CHECK" and msg.param_index == HASH_CHECK_INDEX
 
 
-def test_unknown_read_gets_no_reply(setup):
+def test_unknown_name_or_index_read_gets_param_error_does_not_exist(setup):
     proto, ctx, client = setup
     proto.handle(client.msg("PARAM_REQUEST_READ", 1, 1, b"NO_SUCH_PARAM", -1), ctx)
-    proto.handle(client.msg("PARAM_REQUEST_READ", 1, 1, b"", 30000), ctx)
-    assert ctx.take() == []
+    err = _error(ctx)
+    assert (err.param_id, err.param_index, err.error) == ("NO_SUCH_PARAM", -1, PARAM_ERROR_DOES_NOT_EXIST)
+    proto.handle(client.msg("PARAM_REQUEST_READ", 1, 1, b"", len(ctx.vehicle.params)), ctx)
+    err = _error(ctx)
+    assert (err.param_index, err.error) == (len(ctx.vehicle.params), PARAM_ERROR_DOES_NOT_EXIST)
+
+
+def test_any_negative_index_reads_by_name(setup):
+    proto, ctx, client = setup
+    proto.handle(client.msg("PARAM_REQUEST_READ", 1, 1, b"MAV_SYS_ID", -7), ctx)
+    (msg,) = ctx.take("PARAM_VALUE")
+    assert msg.param_id == "MAV_SYS_ID" and msg.param_index == ctx.vehicle.params.index_of("MAV_SYS_ID")
+
+
+def test_an_unused_parameter_is_read_and_set_by_name_only_and_never_listed(setup):
+    """PX4 finds every compiled-in parameter by name; one no module looked up answers with index -1 (65535)."""
+    proto, ctx, client = setup
+    registry = ctx.vehicle.params
+    count = len(registry)
+    proto.handle(client.msg("PARAM_REQUEST_READ", 1, 1, b"MIS_DIST_1WP", -1), ctx)
+    (msg,) = ctx.take("PARAM_VALUE")
+    assert (msg.param_index, msg.param_count, msg.param_value) == (UNUSED_INDEX, count, 10000.0)
+    proto.handle(_set(client, "MIS_DIST_1WP", 500.0, MAV_PARAM_TYPE_REAL32), ctx)
+    (echo,) = ctx.take("PARAM_VALUE")
+    assert (echo.param_index, echo.param_value) == (UNUSED_INDEX, 500.0)
+    proto.tick(ctx)
+    assert ctx.take() == []  # not re-sent on the links: PX4 re-sends only used parameters
+    proto.handle(client.msg("PARAM_REQUEST_LIST", 1, 1), ctx)
+    names = [m.param_id for m in _drain(proto, ctx)]
+    assert "MIS_DIST_1WP" not in names and len(names) == count + 1
+
+
+def test_mark_used_lists_a_parameter_in_name_order_and_counts_it(setup):
+    proto, ctx, client = setup
+    registry = ctx.vehicle.params
+    count = len(registry)
+    hash_before = px4_param_hash(registry)
+    registry.mark_used("MIS_DIST_1WP")
+    registry.mark_used("MIS_TKO_LAND_REQ")
+    assert len(registry) == count + 2 and px4_param_hash(registry) != hash_before
+    proto.handle(client.msg("PARAM_REQUEST_LIST", 1, 1), ctx)
+    values = _drain(proto, ctx)
+    names = [m.param_id for m in values[1:]]
+    assert names == sorted(names) and {"MIS_DIST_1WP", "MIS_TKO_LAND_REQ"} <= set(names)
+    assert all(m.param_count == count + 2 for m in values)
+    assert [m.param_index for m in values[1:]] == list(range(count + 2))
 
 
 def test_set_real_is_echoed_and_applied(setup):
@@ -186,29 +257,31 @@ def test_changes_from_the_shell_reach_the_links(setup):
 
 
 @pytest.mark.parametrize(
-    ("name", "value", "type_code"),
+    ("name", "value", "type_code", "code"),
     [
-        ("NO_SUCH_PARAM", 1.0, MAV_PARAM_TYPE_REAL32),
-        ("BAT_LOW_THR", int32_to_float_bits(1), MAV_PARAM_TYPE_INT32),  # wrong type for a REAL32 param
-        ("BAT1_N_CELLS", 3.0, MAV_PARAM_TYPE_REAL32),  # wrong type for an INT32 param
-        ("BAT1_N_CELLS", 3.0, 2),  # UINT8: PX4 has only INT32 and REAL32
+        ("NO_SUCH_PARAM", 1.0, MAV_PARAM_TYPE_REAL32, PARAM_ERROR_DOES_NOT_EXIST),
+        ("BAT_LOW_THR", int32_to_float_bits(1), MAV_PARAM_TYPE_INT32, PARAM_ERROR_TYPE_MISMATCH),
+        ("BAT1_N_CELLS", 3.0, MAV_PARAM_TYPE_REAL32, PARAM_ERROR_TYPE_MISMATCH),
+        ("BAT1_N_CELLS", 3.0, 2, PARAM_ERROR_TYPE_UNSUPPORTED),  # UINT8: PX4 has only INT32 and REAL32
     ],
 )
-def test_unknown_or_mistyped_set_gets_no_reply_and_changes_nothing(setup, name, value, type_code):
+def test_unknown_or_mistyped_set_gets_param_error_and_changes_nothing(setup, name, value, type_code, code):
     proto, ctx, client = setup
     before = ctx.vehicle.params.values()
     proto.handle(_set(client, name, value, type_code), ctx)
+    err = _error(ctx)
+    assert (err.param_id, err.param_index, err.error) == (name, -1, code)
     proto.tick(ctx)
     assert ctx.take() == []
     assert ctx.vehicle.params.values() == before
 
 
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf, 5.0, -1.0])
-def test_invalid_real_values_are_refused_and_the_old_value_echoed(setup, value):
+def test_invalid_real_values_are_refused_with_a_text_and_param_error(setup, value):
     proto, ctx, client = setup
     proto.handle(_set(client, "BAT_LOW_THR", value, MAV_PARAM_TYPE_REAL32), ctx)
-    (echo,) = ctx.take("PARAM_VALUE")
-    assert echo.param_value == pytest.approx(0.15)
+    err = _error(ctx)
+    assert (err.param_id, err.error) == ("BAT_LOW_THR", PARAM_ERROR_VALUE_OUT_OF_RANGE)
     assert ctx.vehicle.params.get("BAT_LOW_THR") == pytest.approx(0.15)
     (event,) = ctx.vehicle.events
     assert event.severity == Severity.CRITICAL and event.module == "param" and "BAT_LOW_THR" in event.text
@@ -217,9 +290,16 @@ def test_invalid_real_values_are_refused_and_the_old_value_echoed(setup, value):
 def test_out_of_range_int_is_refused(setup):
     proto, ctx, client = setup
     proto.handle(_set(client, "MAV_SYS_ID", int32_to_float_bits(300), MAV_PARAM_TYPE_INT32), ctx)
-    (echo,) = ctx.take("PARAM_VALUE")
-    assert float_bits_to_int32(echo.param_value) == 1
+    assert _error(ctx).error == PARAM_ERROR_VALUE_OUT_OF_RANGE
     assert ctx.vehicle.params.get("MAV_SYS_ID") == 1
+
+
+def test_a_parameter_without_a_range_of_its_own_takes_any_int32(setup):
+    proto, ctx, client = setup
+    for value in (-(2**31), 2**31 - 1):
+        proto.handle(_set(client, "ADSB_ICAO_ID", int32_to_float_bits(value), MAV_PARAM_TYPE_INT32), ctx)
+        (echo,) = ctx.take("PARAM_VALUE")
+        assert float_bits_to_int32(echo.param_value) == value == ctx.vehicle.params.get("ADSB_ICAO_ID")
 
 
 def test_hash_changes_with_values(setup):

@@ -1,0 +1,87 @@
+"""Which parameters exist: PX4's list (px4_params.csv) reconciled with the definitions the emulator uses by name.
+
+- px4_params.csv (package data, written by tools/px4_params_csv.py) is every parameter PX4 SITL (SIH quadrotor)
+  lists on a fresh boot: name, MAV_PARAM_TYPE and default, in PX4's order. These are the *used* parameters; their
+  order and count are PX4's, so PARAM_REQUEST_LIST returns PX4's indices.
+- The `defs_<domain>.py` modules define the parameters the emulator reads by name, with a range, a unit and a
+  description. A parameter in both keeps PX4's type and PX4's default unless EMULATOR_DEFAULTS lists it (a deliberate
+  difference, with its reason); a definition whose default is the same float32 as PX4's keeps its own decimal form, so
+  0.95 stays 0.95 (the derived controller settings do not change by a rounding).
+- A definition not in PX4's list is known but not used (not listed), as a parameter PX4 compiles in but no module
+  looks up: readable and settable by name, index -1. MIS_DIST_1WP and MIS_TKO_LAND_REQ are such until the first
+  mission upload marks them used (ParamRegistry.mark_used).
+- A parameter only in PX4's list has no range of its own: it is checked by type (an int32, or a finite float32).
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import importlib
+import io
+from functools import lru_cache
+from importlib import resources
+
+from sitl_emu.params.registry import FLT_MAX, INT32_MAX, INT32_MIN, ParamDef, ParamType, same_value
+
+DATA_FILE = "px4_params.csv"
+DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system")  # one defs_<domain>.py module each
+
+# PX4's @volatile parameters among the listed ones (the system changes them itself; _HASH_CHECK leaves them out):
+# src/modules/commander/commander_params.c COM_FLIGHT_UUID, src/modules/land_detector/land_detector_params.c
+# LND_FLIGHT_T_HI/LO. PX4 main may mark more (its hash of the recorded defaults, 0x88583ebe, is not reproduced by
+# leaving out these three), so our _HASH_CHECK value differs from PX4's for the same values; clients only compare it
+# with the hash of what they cached from the same vehicle, which stays consistent.
+VOLATILE = frozenset({"COM_FLIGHT_UUID", "LND_FLIGHT_T_HI", "LND_FLIGHT_T_LO"})
+
+# Defaults where the emulator deliberately differs from PX4 SITL, and why.
+EMULATOR_DEFAULTS: dict[str, str] = {
+    "SIH_LOC_H0": "488.0 m, the Gazebo/jMAVSim world elevation the project's home uses, not SIH's 489.4 m",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Catalog:
+    defs: tuple[ParamDef, ...]  # every known parameter
+    used: tuple[str, ...]  # the listed ones, in PX4's order
+    px4_defaults: dict[str, float]  # PX4's default of each listed parameter
+
+
+def emulator_definitions() -> list[ParamDef]:
+    """The `defs_*.py` definitions, in domain order."""
+    defs: list[ParamDef] = []
+    for domain in DOMAINS:
+        module = importlib.import_module(f"sitl_emu.params.defs_{domain}")
+        defs.extend(module.PARAMS)
+    return defs
+
+
+def read_px4_rows(text: str) -> list[tuple[str, ParamType, float]]:
+    """(name, type, default) from the data file's text: '#' comment lines, a header line, then one line each."""
+    lines = [line for line in text.splitlines() if line and not line.startswith("#")]
+    rows = []
+    for name, kind, default in csv.reader(io.StringIO("\n".join(lines[1:]))):
+        ptype = ParamType(kind)
+        rows.append((name, ptype, int(default) if ptype is ParamType.INT32 else float(default)))
+    return rows
+
+
+@lru_cache(maxsize=1)
+def px4_catalog() -> Catalog:
+    """PX4's list and the emulator's definitions reconciled (built once per process; the ParamDefs are immutable)."""
+    text = resources.files("sitl_emu.params").joinpath(DATA_FILE).read_text(encoding="ascii")
+    rows = read_px4_rows(text)
+    own = {d.name: d for d in emulator_definitions()}
+    defs = [_reconcile(own.pop(name, None), name, ptype, default) for name, ptype, default in rows]
+    return Catalog(tuple(defs) + tuple(own.values()), tuple(name for name, _, _ in rows),
+                   {name: default for name, _, default in rows})
+
+
+def _reconcile(own: ParamDef | None, name: str, ptype: ParamType, px4_default: float) -> ParamDef:
+    if own is None:
+        lo, hi = (INT32_MIN, INT32_MAX) if ptype is ParamType.INT32 else (-FLT_MAX, FLT_MAX)
+        return ParamDef(name, ptype, px4_default, lo, hi, volatile=name in VOLATILE)
+    if own.type is not ptype:
+        raise ValueError(f"{name} is {own.type.value} in defs_*.py but {ptype.value} in PX4's list")
+    keep_own = same_value(ptype, own.default, px4_default) or name in EMULATOR_DEFAULTS
+    return dataclasses.replace(own, default=own.default if keep_own else px4_default, volatile=name in VOLATILE)

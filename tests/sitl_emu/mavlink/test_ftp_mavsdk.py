@@ -1,0 +1,131 @@
+"""Conformance: MAVSDK's Ftp and LogFiles plugins (the native `mavsdk` >= 4 binding) against `sitl-emu serve`.
+
+The server runs in a scratch working directory, so its FTP root is that directory's fs/ (as PX4 SITL serves its
+own working directory). MAVSDK lists it, downloads with and without burst, uploads, compares by CRC32, makes and
+removes a directory, renames and removes a file, is refused a path out of the root, and its LogFiles plugin gets
+PX4's "no log files" answer at once instead of a timeout. Skipped only when MAVSDK cannot be loaded here.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from support import REPO_ROOT
+from support.ports import free_udp_ports
+
+SPEED = 4.0
+CALL_TIMEOUT_S = 20.0
+
+
+def _load_mavsdk() -> Any:
+    try:
+        import mavsdk.asyncio as mavsdk_asyncio
+    except Exception as err:  # no package, or its native library cannot be loaded here
+        pytest.skip(f"MAVSDK cannot start on this machine: {err}")
+    return mavsdk_asyncio
+
+
+@pytest.fixture()
+def served(tmp_path: Path):
+    """`sitl-emu serve` in tmp_path/work (FTP root work/fs, with a few files); yields (MAVSDK's port, the root)."""
+    work = tmp_path / "work"
+    root = work / "fs"
+    (root / "sub").mkdir(parents=True)
+    (root / "hello.txt").write_bytes(b"hello from the emulator\n")
+    (root / "big.bin").write_bytes(os.urandom(80_000))
+    (tmp_path / "outside.txt").write_bytes(b"secret")
+    client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
+    args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
+            "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
+            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO_ROOT), os.environ.get("PYTHONPATH", "")])}
+    log_path = tmp_path / "serve.log"
+    with log_path.open("w") as log_file:
+        proc = subprocess.Popen(args, cwd=work, env=env, stdout=log_file, stderr=subprocess.STDOUT,
+                                stdin=subprocess.DEVNULL)
+        try:
+            yield client_port, root
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(timeout=5)
+            print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-3000:])
+
+
+@pytest.mark.timeout(240)
+def test_mavsdk_ftp_and_log_files_work_as_against_px4(served, tmp_path):
+    mavsdk_asyncio = _load_mavsdk()
+    port, root = served
+    asyncio.run(asyncio.wait_for(_session(mavsdk_asyncio, port, root, tmp_path), timeout=200))
+    assert (tmp_path / "outside.txt").read_bytes() == b"secret"
+
+
+async def _call(awaitable: Any) -> Any:
+    return await asyncio.wait_for(awaitable, CALL_TIMEOUT_S)
+
+
+async def _session(mavsdk_asyncio: Any, port: int, root: Path, tmp_path: Path) -> None:
+    from mavsdk.asyncio.plugins.ftp import FtpAsync
+    from mavsdk.asyncio.plugins.log_files import LogFilesAsync
+
+    config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
+    async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
+        await _call(mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
+        system = await asyncio.wait_for(mavsdk.first_autopilot(timeout_s=20.0), 25.0)
+        assert system is not None, "MAVSDK found no autopilot"
+        await _check_log_files(LogFilesAsync(system))
+        await _check_ftp(FtpAsync(system), root, tmp_path)
+
+
+async def _check_log_files(log_files: Any) -> None:
+    from mavsdk.plugins.log_files import LogFilesError, LogFilesResult
+
+    started = time.monotonic()
+    with pytest.raises(LogFilesError) as no_logs:
+        await _call(log_files.get_entries())
+    assert no_logs.value.result == LogFilesResult.NO_LOGFILES
+    assert time.monotonic() - started < 5.0  # answered, not timed out
+
+
+async def _check_ftp(ftp: Any, root: Path, tmp_path: Path) -> None:
+    from mavsdk.plugins.ftp import FilesystemEntry, FtpError, FtpResult
+
+    listed = await _call(ftp.list_directory("/"))
+    kinds = {e.name: (e.entry_type, e.size_bytes) for e in listed.entries}
+    assert kinds == {"sub": (FilesystemEntry.EntryType.DIRECTORY, 0),
+                     "hello.txt": (FilesystemEntry.EntryType.FILE, 24),
+                     "big.bin": (FilesystemEntry.EntryType.FILE, 80_000)}
+    for use_burst in (True, False):
+        local = tmp_path / f"down_{use_burst}"
+        local.mkdir()
+        async for _ in ftp.download("/big.bin", str(local), use_burst):
+            pass
+        assert (local / "big.bin").read_bytes() == (root / "big.bin").read_bytes()
+    upload = tmp_path / "upload.txt"
+    upload.write_bytes(b"uploaded by MAVSDK " * 50)
+    async for _ in ftp.upload(str(upload), "/sub"):
+        pass
+    assert (root / "sub" / "upload.txt").read_bytes() == upload.read_bytes()
+    assert await _call(ftp.are_files_identical(str(upload), "/sub/upload.txt"))
+    await _call(ftp.create_directory("/made"))
+    assert (root / "made").is_dir()
+    await _call(ftp.remove_directory("/made"))
+    await _call(ftp.rename("/sub/upload.txt", "/renamed.txt"))
+    await _call(ftp.remove_file("/renamed.txt"))
+    assert sorted(p.name for p in root.iterdir()) == ["big.bin", "hello.txt", "sub"]
+    refused = tmp_path / "refused"
+    refused.mkdir()
+    with pytest.raises(FtpError) as escape:
+        async for _ in ftp.download("/../outside.txt", str(refused), False):
+            pass
+    assert escape.value.result == FtpResult.FILE_PROTECTED
