@@ -19,8 +19,9 @@ from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
+from sitl_emu.flight.stick_gestures import Gesture, GestureDetector, StickMotion
 from sitl_emu.params import ParamRegistry
-from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, MANUAL_MODES, MANUAL_THRUST_MODES, UI_NAMES, MavState, NavState, Severity
 from sitl_emu.types import NAN, HomePosition, ManualControlSetpoint, OffboardControlMode, Vec3
 
 # emit(severity, module, text, is_event, statustext)
@@ -44,6 +45,8 @@ class CommanderSettings:
     rc_loss_us: int  # COM_RC_LOSS_T
     rc_in_mode: int  # COM_RC_IN_MODE
     manual_loss: ManualLossSettings  # NAV_RCL_ACT, COM_RCL_EXCEPT, COM_FAIL_ACT_T
+    arm_gesture: bool  # MAN_ARM_GESTURE
+    override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> CommanderSettings:
@@ -59,6 +62,8 @@ class CommanderSettings:
             manual_loss=ManualLossSettings(rcl_act=int(p["NAV_RCL_ACT"]), rcl_except=int(p["COM_RCL_EXCEPT"]),
                                            fail_act_us=int(float(p["COM_FAIL_ACT_T"]) * 1e6),
                                            input_disabled=int(p["COM_RC_IN_MODE"]) == INPUT_DISABLED),
+            arm_gesture=int(p["MAN_ARM_GESTURE"]) == 1,
+            override_speed=float(p["MAN_OVERRIDE_SPD"]),
         )
 
 
@@ -116,6 +121,8 @@ class Commander:
         self._offboard = OffboardSignal()  # flight/offboard.py: what happens when the setpoints stop
         self.manual = ManualControlSignal()  # flight/manual_control.py: the MAVLink joystick as RC
         self._manual_lost_at_arming = True
+        self._gestures = GestureDetector()
+        self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
 
     @property
@@ -138,8 +145,42 @@ class Commander:
         self._offboard.refresh(now_us, mode)
 
     def manual_control_signal(self, now_us: int, setpoint: ManualControlSetpoint) -> bool:
-        """A MANUAL_CONTROL arrived (any mode); False if COM_RC_IN_MODE ignores MAVLink input."""
-        return self.manual.refresh(now_us, setpoint, self.settings.rc_in_mode)
+        """A MANUAL_CONTROL arrived (any mode); False if COM_RC_IN_MODE ignores MAVLink input. The sticks' gestures
+        and a pilot's takeover act at once (flight/stick_gestures.py)."""
+        regained = not self.manual_control_valid(now_us)
+        if not self.manual.refresh(now_us, setpoint, self.settings.rc_in_mode):
+            return False
+        if regained:  # manual_control resets its gesture and movement filters while the input is invalid
+            self._gestures.reset()
+            self._stick_motion.reset()
+        self._stick_gesture(now_us, setpoint)
+        if self._stick_motion.update(now_us, setpoint, self.settings.override_speed):
+            self._pilot_takeover()
+        return True
+
+    def _stick_gesture(self, now_us: int, setpoint: ManualControlSetpoint) -> None:
+        """MAN_ARM_GESTURE: arm with the preflight checks; disarm only on the ground or in a manual-thrust mode (in
+        the air it is refused without a word)."""
+        gesture = self._gestures.update(now_us, setpoint)
+        if gesture is None or not self.settings.arm_gesture:
+            return
+        if gesture is Gesture.ARM and not self.armed:
+            self.arm(now_us, external=True, run_checks=True, reason="stick gesture")
+        elif gesture is Gesture.DISARM and self.armed and self._may_disarm_by_sticks():
+            self.disarm("stick gesture", forced=True)
+
+    def _may_disarm_by_sticks(self) -> bool:
+        return self.landed or self.maybe_landed or self.nav_state in MANUAL_THRUST_MODES
+
+    def _pilot_takeover(self) -> None:
+        """Commander::manualControlCheck: sticks moved in an auto mode or OFFBOARD switch to Position (Altitude if
+        Position cannot run); during a failsafe action the switch ends it too."""
+        if not self.armed or not (self.nav_state in AUTO_MODES or self.nav_state is NavState.OFFBOARD):
+            return
+        if self._failsafe.manual_loss.hold_s(self.now_us) > 0:
+            return  # no stick takeover during the Hold before a failsafe action (framework.cpp)
+        if self.change_mode(NavState.POSCTL) or self.change_mode(NavState.ALTCTL):
+            self.say(Severity.INFO, "Pilot took over using sticks", statustext=not self.failsafe)
 
     def manual_control_valid(self, now_us: int) -> bool:
         return self.manual.valid(now_us, self.settings.rc_loss_us)
@@ -193,10 +234,13 @@ class Commander:
         self.say(Severity.CRITICAL, f"Switching to {UI_NAMES[nav_state]} is currently not available")
 
     # ---- arming -------------------------------------------------------------------------------------------------
-    def arm(self, now_us: int, *, external: bool, run_checks: bool) -> bool:
+    def arm(self, now_us: int, *, external: bool, run_checks: bool, reason: str | None = None) -> bool:
         """Commander::arm: checks for the current nav_state, then arm, set home, start the auto-disarm timers."""
         if self.armed:
             return True
+        if run_checks and not self._throttle_safe(now_us):
+            self.say(Severity.CRITICAL, "Arming denied: throttle not in safe position")
+            return False
         if run_checks:
             failure = arming.arming_failure(self.nav_state, self.check_inputs(now_us))
             if failure is not None:
@@ -213,8 +257,16 @@ class Commander:
         here = self._here()
         if self.settings.home_enabled and here is not None:
             self.home = here
-        self.say(Severity.INFO, f"Armed by {'external' if external else 'internal'} command")
+        self.say(Severity.INFO, f"Armed by {reason or ('external' if external else 'internal') + ' command'}")
         return True
+
+    def _throttle_safe(self, now_us: int) -> bool:
+        """Commander::arm's throttle check, in a manual mode with manual control present: at most 0.2 (of -1..1) where
+        the sticks command a climb rate, below -0.8 where the throttle is the thrust."""
+        if self.nav_state not in MANUAL_MODES or not self.manual_control_valid(now_us):
+            return True
+        throttle = self.manual.setpoint.throttle
+        return throttle < -0.8 if self.nav_state in MANUAL_THRUST_MODES else throttle <= 0.2
 
     def disarm(self, reason: str, *, forced: bool) -> bool:
         """Commander::disarm: refused in the air unless forced; the mode reverts to the sticky user mode."""

@@ -139,7 +139,7 @@ class Failsafe:
             rank, mode, disarm = (_DISARM_RANK, user, True) if fallback is None else (_RANK[fallback], fallback, False)
         if manual_loss is not None:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
-            if self.manual_loss.disarm and _DISARM_RANK > rank:
+            if self.manual_loss.disarm and rank < _DISARM_RANK:
                 rank, mode, disarm = _DISARM_RANK, user, True
             elif wanted is not None and _RANK[wanted] > rank:
                 rank, mode, disarm = _RANK[wanted], wanted, False
