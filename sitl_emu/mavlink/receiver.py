@@ -162,14 +162,15 @@ class Receiver:
 
 def manual_setpoint(x: int, y: int, z: int, r: int, buttons: int) -> ManualControlSetpoint:
     """MANUAL_CONTROL's x (forward), y (right), r (yaw) in -1000..1000 and z (throttle) in 0..1000 as PX4 reads them
-    into manual_control_setpoint: pitch x/1000, roll y/1000, yaw r/1000, throttle 2 z/1000 - 1 (so 500 is the centre).
-    Values beyond the range (the fields are int16) are clamped to it, so garbage never commands more than full stick."""
-    return ManualControlSetpoint(roll=_unit(y / 1000.0), pitch=_unit(x / 1000.0), yaw=_unit(r / 1000.0),
-                                 throttle=_unit(z / 500.0 - 1.0), buttons=int(buttons) & 0xFFFF)
+    into manual_control_setpoint: pitch x/1000, roll y/1000, yaw r/1000, throttle z/500 - 1 (500 is the centre).
+    A field outside its range counts as 0, as in PX4: the stick centred, and for z the throttle centred, not low."""
+    return ManualControlSetpoint(roll=_in_range(y, -1000, 1000) / 1000.0, pitch=_in_range(x, -1000, 1000) / 1000.0,
+                                 yaw=_in_range(r, -1000, 1000) / 1000.0,
+                                 throttle=_in_range(z, 0, 1000, 500) / 500.0 - 1.0, buttons=int(buttons) & 0xFFFF)
 
 
-def _unit(v: float) -> float:
-    return -1.0 if v < -1.0 else (1.0 if v > 1.0 else v)
+def _in_range(value: int, lo: int, hi: int, otherwise: int = 0) -> int:
+    return value if lo <= value <= hi else otherwise
 
 
 def _targets_us(msg: setpoints.SetpointMessage, ctx: EndpointContext) -> bool:

@@ -1,5 +1,5 @@
-"""MANUAL_CONTROL against the reference: the protocol cases of ../shared/reference/px4-manual/cases.json, replayed in the
-order the probe ran them on one freshly booted vehicle, over loopback UDP in lockstep simulated time.
+"""MANUAL_CONTROL against the reference: the protocol cases of ../shared/reference/px4-manual/cases.json, replayed in
+the order the probe ran them on one freshly booted vehicle, over loopback UDP in lockstep simulated time.
 
 The probe (a ground station, sysid 245 / compid 190, HEARTBEAT at 1 Hz) streamed MANUAL_CONTROL at 20 Hz to target 1
 on the API link; each case's COMMAND_ACK, STATUSTEXTs (text and severity) and the HEARTBEAT after it are compared.
