@@ -107,6 +107,24 @@ _DEFINITIONS: dict[str, tuple[int, tuple[Field, ...]]] = {
 SPECS: dict[str, MessageSpec] = {name: make_spec(msg_id, name, fields)
                                  for name, (msg_id, fields) in _DEFINITIONS.items()}
 MESSAGE_IDS: frozenset[int] = frozenset(spec.msg_id for spec in SPECS.values())
+NAMES: dict[int, str] = {spec.msg_id: name for name, spec in SPECS.items()}
+
+
+def fields_of(name: str) -> tuple[Field, ...]:
+    return _DEFINITIONS[name][1]
+
+
+def decode(msg_id: int, payload: bytes) -> dict[str, Any]:
+    """A received payload (MAVLink 2 may have cut its trailing zeros) as {field: value}, arrays as lists."""
+    name = NAMES[msg_id]
+    layout = struct.Struct("<" + "".join(_code(t, length) for _, t, length in wire_order(fields_of(name))))
+    values = list(layout.unpack(payload.ljust(layout.size, b"\0")[:layout.size]))
+    out: dict[str, Any] = {}
+    for fname, ftype, length in wire_order(fields_of(name)):
+        count = 1 if not length or ftype == "char" else length
+        taken, values = values[:count], values[count:]
+        out[fname] = taken if length and ftype != "char" else taken[0]
+    return out
 
 
 class ExtraEncoder:
