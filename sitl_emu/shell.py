@@ -165,6 +165,7 @@ class Shell:
         snap = self.vehicle.snapshot()
         lines = [
             "Armed" if snap.armed else "Disarmed",
+            "prearm safety: Off",  # Commander::print_status: SITL has no safety switch, so the safety is off
             f"navigation mode: {_nav_name(snap.nav_state)}",
             f"user intended navigation mode: {_nav_name(snap.user_intended_nav_state)}",
             f"in failsafe: {'yes' if snap.failsafe else 'no'}",

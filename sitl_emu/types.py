@@ -156,8 +156,13 @@ class VehicleSnapshot:
     attitude_setpoint_q_wxyz: Vec4 | None
     rates_setpoint_rad_s: Vec3
     thrust_setpoint: float  # collective, 0..1
-    motors: Vec4  # 0..1
+    motors: Vec4  # 0..1, the motors' state (SIH's first-order lag behind the commands)
     # battery
     battery_voltage_v: float = 16.2
     battery_remaining: float = 1.0  # 0..1
     extras: dict[str, float] = field(default_factory=dict)
+    # actuators: the mixer's commands this tick (PX4's actuator_motors), 0..1; SERVO_OUTPUT_RAW and the outputs
+    motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0)
+    # the kinds of the last offboard message since boot, fresh or not: PX4's commander derives OFFBOARD's control
+    # mode from the last offboard_control_mode it received (HEARTBEAT base_mode), whatever its age
+    offboard_control_last: OffboardControlMode | None = None

@@ -40,11 +40,12 @@ from sitl_emu.types import (
     OffboardControlMode,
     TrajectorySetpoint,
     Vec3,
+    Vec4,
     VehicleCommand,
     VehicleEvent,
     VehicleSnapshot,
 )
-from sitl_emu.vehicle_parts import ControlChain
+from sitl_emu.vehicle_parts import ControlChain, published_setpoints
 
 EVENT_HISTORY: Final = 1000
 # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks
@@ -81,6 +82,7 @@ class Vehicle:
         self._rng = np.random.default_rng(self._seed)
         self._state = RigidBodyState()
         self._estimate = self._state
+        self._motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the mixer's output of the last tick
         self._sih_version = -1
         self._sih = sih_config(self.params)
         self.commander = Commander(self.params, self._emit, self._ned_of, self._here)
@@ -113,7 +115,7 @@ class Vehicle:
         out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
-        motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
+        motors = self._motor_commands = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
         self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
         climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
@@ -222,17 +224,21 @@ class Vehicle:
         return self._snap
 
     def _make_snapshot(self) -> VehicleSnapshot:
-        c, s, ctrl, ref = self.commander, self._estimate, self.chain.control, self.ref
+        c, s, ref = self.commander, self._estimate, self.ref
         lat, lon, alt = ned_to_global(ref, s.pos_ned_m)
+        euler = euler_from_q(s.q_wxyz)
+        offboard_last = c.offboard_mode_last
+        local_sp, q_sp, rates_sp, thrust = published_setpoints(self.chain.control, c.nav_state, c.armed, offboard_last,
+                                                               euler[2])
         return VehicleSnapshot(
             time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
             user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe, landed_state=self.landed_state(),
             pre_flight_checks_pass=c.pre_flight_checks_pass(), position_valid=c.estimator_ready,
             takeoff_detected=c.have_taken_off, offboard_control=c.offboard_mode,
             pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s, acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz,
-            rates_frd_rad_s=s.rates_frd_rad_s, euler_rad=euler_from_q(s.q_wxyz), lat_deg=lat, lon_deg=lon,
+            rates_frd_rad_s=s.rates_frd_rad_s, euler_rad=euler, lat_deg=lat, lon_deg=lon,
             alt_amsl_m=alt, ref_lat_deg=ref.lat_deg, ref_lon_deg=ref.lon_deg, ref_alt_amsl_m=ref.alt_amsl_m,
-            home=c.home, local_setpoint=ctrl.local_setpoint, attitude_setpoint_q_wxyz=ctrl.attitude_setpoint_q_wxyz,
-            rates_setpoint_rad_s=ctrl.rates_setpoint_rad_s, thrust_setpoint=ctrl.thrust_setpoint,
-            motors=self._state.motors, extras={"system_status": float(c.system_status())},
+            home=c.home, local_setpoint=local_sp, attitude_setpoint_q_wxyz=q_sp, rates_setpoint_rad_s=rates_sp,
+            thrust_setpoint=thrust, motors=self._state.motors, extras={"system_status": float(c.system_status())},
+            motor_commands=self._motor_commands, offboard_control_last=offboard_last,
         )

@@ -20,9 +20,17 @@ from sitl_emu.geo import GeoRef
 from sitl_emu.params import ParamRegistry
 from sitl_emu.params.settings import cascade_settings
 from sitl_emu.physics import RigidBodyState
-from sitl_emu.types import TrajectorySetpoint, Vec4
+from sitl_emu.px4 import AUTO_MODES, NavState
+from sitl_emu.types import NAN3, OffboardControlMode, TrajectorySetpoint, Vec3, Vec4
 
 LAND_DETECTOR_PERIOD_US: Final = 20_000
+# Modes in which PX4's mc_pos_control runs on a multicopter (ModeUtil/control_mode.cpp: altitude, climb-rate, position,
+# velocity or acceleration control), armed or not. While it is not flying it publishes the idle setpoint.
+POSITION_CONTROLLED: Final = frozenset({NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
+                                        NavState.ALTITUDE_CRUISE, NavState.ORBIT, *AUTO_MODES})
+ZERO3: Final = (0.0, 0.0, 0.0)
+# (local setpoint, attitude setpoint, rate setpoint, collective thrust) as PX4's controllers publish them
+Setpoints = tuple[TrajectorySetpoint | None, Vec4 | None, Vec3, float]
 
 
 class ControlChain:
@@ -74,6 +82,30 @@ class ControlChain:
             in_descent_mode=climb_rate_controlled))
         self.ground_contact = state.ground_contact
         return state
+
+
+def published_setpoints(ctrl: MulticopterControl, nav_state: NavState, armed: bool,
+                        offboard_last: OffboardControlMode | None, yaw_rad: float) -> Setpoints:
+    """What the controllers publish (vehicle_local_position_setpoint, vehicle_attitude_setpoint, rates, thrust).
+
+    Armed: the cascade's own. Disarmed, the cascade rests, but PX4's mc_pos_control keeps running in every
+    position-controlled mode (MulticopterPositionControl.cpp): not yet taken off, it flies the idle setpoint (no
+    position or velocity, acceleration 0,0,+100, i.e. no thrust) and publishes it with the yaw setpoint at the current
+    heading and no yaw rate; its attitude setpoint is then level at that heading with zero thrust. So a ground station
+    sees POSITION_TARGET_LOCAL_NED and ATTITUDE_TARGET at rest, as from PX4.
+    """
+    if armed or not _position_controlled(nav_state, offboard_last):
+        return ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s, ctrl.thrust_setpoint
+    idle = TrajectorySetpoint(NAN3, NAN3, (0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad, 0.0)
+    half = 0.5 * yaw_rad
+    return idle, (math.cos(half), 0.0, 0.0, math.sin(half)), ZERO3, 0.0
+
+
+def _position_controlled(nav_state: NavState, offboard_last: OffboardControlMode | None) -> bool:
+    if nav_state is NavState.OFFBOARD:  # control_mode.cpp: position, velocity or acceleration setpoints
+        return offboard_last is not None and (offboard_last.position or offboard_last.velocity
+                                              or offboard_last.acceleration)
+    return nav_state in POSITION_CONTROLLED
 
 
 def descent_vz(sp: TrajectorySetpoint | None) -> float:

@@ -200,6 +200,11 @@ class Commander:
         """The last offboard signal kinds while the signal is fresh, else None."""
         return self._offboard.mode if self.offboard_fresh(self.now_us) else None
 
+    @property
+    def offboard_mode_last(self) -> OffboardControlMode | None:
+        """The kinds of the last offboard message since boot, however old (PX4's offboard_control_mode topic)."""
+        return self._offboard.mode
+
     # ---- checks -------------------------------------------------------------------------------------------------
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
         t = self.now_us if now_us is None else now_us

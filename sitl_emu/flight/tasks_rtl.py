@@ -9,12 +9,16 @@ RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RT
 from __future__ import annotations
 
 import math
+import struct
 from enum import Enum
+from typing import Final
 
 from sitl_emu.flight.tasks_core import NavInput, SetpointType, Task, Waypoint
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3
+
+_F32: Final = struct.Struct("<f")
 
 
 class RtlState(Enum):
@@ -29,6 +33,19 @@ class RtlState(Enum):
     IDLE = "idle"  # IDLE (on the ground)
 
 
+def rtl_start_text(return_alt_amsl_m: float, destination_alt_amsl_m: float) -> str:
+    """The text RtlDirect::on_activation logs (navigator/rtl_direct.cpp): both altitudes are floats (32 bit) in PX4,
+    rounded up, the second being the float difference; so 518.0000001 m, which is 518.0 as a float, says 518."""
+    rtl_alt = _f32(return_alt_amsl_m)
+    above = _f32(rtl_alt - _f32(destination_alt_amsl_m))
+    return f"RTL: start return at {math.ceil(rtl_alt):d} m ({math.ceil(above):d} m above destination)"
+
+
+def _f32(x: float) -> float:
+    """x rounded to the nearest 32-bit float, as PX4 holds it."""
+    return float(_F32.unpack(_F32.pack(x))[0]) if math.isfinite(x) else x
+
+
 class RtlTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         super().__init__(nav, params)
@@ -41,10 +58,8 @@ class RtlTask(Task):
             self._enter(RtlState.IDLE, nav)
         else:
             self._enter(RtlState.CLIMB if -nav.pos_ned_m[2] < self._rtl_up_m else RtlState.RETURN, nav)
-        home_up = -self._home[2]
-        amsl = nav.ref_alt_amsl_m + self._rtl_up_m
-        self._say(Severity.INFO, f"RTL: start return at {math.ceil(amsl):d} m "
-                                 f"({math.ceil(self._rtl_up_m - home_up):d} m above destination)")
+        self._say(Severity.INFO, rtl_start_text(nav.ref_alt_amsl_m + self._rtl_up_m,
+                                                nav.ref_alt_amsl_m - self._home[2]))
 
     @property
     def state(self) -> RtlState:

@@ -13,6 +13,7 @@ Tests implement LinkContext in memory (tests/handler_ctx.py); Endpoint implement
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Protocol
 
 if TYPE_CHECKING:
@@ -26,6 +27,38 @@ if TYPE_CHECKING:
 
     # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
     OutMessage: TypeAlias = MAVLink_message | Packed
+
+
+@dataclass(slots=True)
+class EndpointStats:
+    """One link's counters (PX4's telemetry_status): what LINK_NODE_STATUS reports, and the endpoint's own errors."""
+
+    rx_messages: int = 0
+    rx_bytes: int = 0
+    rx_parse_errors: int = 0
+    rx_own_echo: int = 0
+    handler_errors: int = 0
+    tx_messages: int = 0
+    tx_bytes: int = 0
+    tx_pack_errors: int = 0
+    tx_forwarded: int = 0
+    # the byte counts at the last rate sample (link_rates)
+    _rate_time_us: int = -1
+    _rate_tx_bytes: int = 0
+    _rate_rx_bytes: int = 0
+    _tx_rate: int = 0
+    _rx_rate: int = 0
+
+    def link_rates(self, now_us: int) -> tuple[int, int]:
+        """(tx, rx) bytes per second since the previous sample at least half a second ago (the first call: 0, 0)."""
+        dt_us = now_us - self._rate_time_us
+        if self._rate_time_us < 0 or dt_us < 0:
+            self._rate_time_us, self._rate_tx_bytes, self._rate_rx_bytes = now_us, self.tx_bytes, self.rx_bytes
+        elif dt_us >= 500_000:
+            self._tx_rate = (self.tx_bytes - self._rate_tx_bytes) * 1_000_000 // dt_us
+            self._rx_rate = (self.rx_bytes - self._rate_rx_bytes) * 1_000_000 // dt_us
+            self._rate_time_us, self._rate_tx_bytes, self._rate_rx_bytes = now_us, self.tx_bytes, self.rx_bytes
+        return self._tx_rate & 0xFFFFFFFF, self._rx_rate & 0xFFFFFFFF
 
 
 class LinkContext(Protocol):
@@ -68,6 +101,7 @@ class NodeView(Protocol):
 class EndpointContext(LinkContext, Protocol):
     encoder: Encoder  # fastpack.ENCODER: the same calls as ctx.mav, cheaper messages (telemetry streams)
     last_gcs_heartbeat_us: int | None  # the receiver sets it on a GCS heartbeat
+    stats: EndpointStats  # this link's counters (LINK_NODE_STATUS)
 
     @property
     def node(self) -> NodeView: ...

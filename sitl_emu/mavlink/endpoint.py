@@ -12,12 +12,11 @@ import logging
 import struct
 from collections import deque
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink.context import NodeView
+from sitl_emu.mavlink.context import EndpointStats, NodeView
 from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
@@ -71,16 +70,6 @@ class NodeServices(NodeView, Protocol):
     def broadcast(self, msg: OutMessage) -> None: ...
 
     def forward(self, msg: MAVLink_message, origin: Endpoint, target_system: int, target_component: int) -> None: ...
-
-
-@dataclass(slots=True)
-class EndpointStats:
-    rx_messages: int = 0
-    rx_parse_errors: int = 0
-    rx_own_echo: int = 0
-    handler_errors: int = 0
-    tx_pack_errors: int = 0
-    tx_forwarded: int = 0
 
 
 class _LinkWriter:
@@ -147,6 +136,9 @@ class Endpoint:
             return
         self.link.send(data)
         mav.seq = (mav.seq + 1) % 256
+        stats = self.stats
+        stats.tx_messages += 1
+        stats.tx_bytes += len(data)
 
     def broadcast(self, msg: OutMessage) -> None:
         self.node.broadcast(msg)
@@ -157,6 +149,7 @@ class Endpoint:
         self._now_us = now_us
         datagrams = self.link.receive(max_datagrams)
         for data in datagrams:
+            self.stats.rx_bytes += len(data)
             for msg in self._parse(data):
                 self.dispatch(msg)
         return len(datagrams)
@@ -197,8 +190,10 @@ class Endpoint:
 
     def pass_message(self, msg: MAVLink_message) -> None:
         """Send a received message on as it is (its own sysid, compid, sequence and checksum)."""
+        data = bytes(msg.get_msgbuf())
         self.stats.tx_forwarded += 1
-        self.link.send(bytes(msg.get_msgbuf()))
+        self.stats.tx_bytes += len(data)
+        self.link.send(data)
 
     def gcs_connected(self) -> bool:
         last = self.last_gcs_heartbeat_us

@@ -2,7 +2,10 @@
 
 Default sets from PX4's configure_streams_to_default() (src/modules/mavlink/mavlink_main.cpp, reference 1.5/1.6),
 restricted to messages whose data we have, plus the SITL GCS-link overrides of ROMFS/px4fmu_common/init.d-posix/
-px4-rc.mavlink (50 Hz position/attitude). HEARTBEAT is always 1 Hz and cannot be changed (mavlink_main.cpp ~l.2547).
+px4-rc.mavlink (50 Hz position/attitude). The GCS link's set and rates are those PX4 SIH measurably streams at rest
+(../shared/reference/px4-gcs-streams.json), but for CURRENT_EVENT_SEQUENCE (extra_messages.py says why).
+HEARTBEAT is always 1 Hz and cannot be changed (mavlink_main.cpp ~l.2547). MISSION_CURRENT is not a configured
+stream in PX4 but the mission manager's once-a-second report on every link; here it is one more 1 Hz stream.
 A stream whose builder returns None (no data, e.g. HOME_POSITION before home is set) sends nothing.
 """
 
@@ -14,6 +17,8 @@ from collections.abc import Callable, Sequence
 from heapq import heapify, heapreplace
 from typing import TYPE_CHECKING
 
+from sitl_emu.mavlink import telemetry_actuators as ta
+from sitl_emu.mavlink import telemetry_health as th
 from sitl_emu.mavlink import telemetry_msgs as tm
 from sitl_emu.mavlink import telemetry_sensors as ts
 from sitl_emu.mavlink.version import autopilot_version, protocol_version
@@ -35,29 +40,42 @@ class StreamMode(enum.Enum):
     NORMAL = "normal"
 
 
-# message id -> builder (streamable messages)
+# message id -> builder (streamable messages; REQUEST_MESSAGE answers every one of them)
 BUILDERS: dict[int, tm.Builder] = {
     0: tm.heartbeat,
-    1: tm.sys_status,
+    1: th.sys_status,
     2: tm.system_time,
     4: tm.ping,
+    8: th.link_node_status,
     24: tm.gps_raw_int,
+    29: ts.scaled_pressure,
     30: tm.attitude,
     31: tm.attitude_quaternion,
     32: tm.local_position_ned,
     33: tm.global_position_int,
+    36: ta.servo_output_raw,
+    42: th.mission_current,
     74: tm.vfr_hud,
     83: tm.attitude_target,
-    105: ts.highres_imu,
     85: tm.position_target_local_ned,
+    105: ts.highres_imu,
     111: tm.timesync,
-    29: ts.scaled_pressure,
+    132: ts.distance_sensor,
     141: tm.altitude,
     147: tm.battery_status,
+    230: th.estimator_status,
+    241: ts.vibration,
     242: tm.home_position,
     245: tm.extended_sys_state,
+    290: ta.esc_info,
+    291: ta.esc_status,
     331: tm.odometry,
+    380: th.time_estimate_to_target,
     436: tm.current_mode,
+    441: ts.gnss_integrity,
+    514: th.estimator_sensor_fusion_status,
+    12901: ts.open_drone_id_location,
+    12904: ts.open_drone_id_system,
 }
 # messages PX4 sends only on request (REQUEST_MESSAGE), not as periodic streams
 ON_REQUEST: dict[int, tm.Builder] = {
@@ -67,14 +85,19 @@ ON_REQUEST: dict[int, tm.Builder] = {
 
 # Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
 ONBOARD_RATES_HZ: dict[int, float] = {
-    111: 10, 32: 30, 30: 100, 141: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5, 245: 5, 33: 50, 24: 8,
-    242: 0.5, 85: 10, 1: 5, 2: 1, 74: 10, 105: 50, 29: 1, 4: 1,
+    111: 10, 32: 30, 30: 100, 141: 10, 132: 10, 290: 10, 291: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5,
+    230: 1, 514: 1, 245: 5, 33: 50, 441: 1, 24: 8, 242: 0.5, 12901: 1, 12904: 1, 4: 1, 85: 10, 36: 10, 1: 5, 2: 1,
+    380: 1, 74: 10, 241: 0.5, 8: 1, 105: 50, 29: 1, 42: 1,
 }
 # MAVLINK_MODE_NORMAL with the SITL GCS-link overrides (px4-rc.mavlink: 50 Hz for position/attitude streams)
 NORMAL_RATES_HZ: dict[int, float] = {
-    141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 245: 1, 33: 50, 24: 5, 242: 0.5, 32: 50, 85: 50, 1: 1,
-    74: 4, 29: 1, 4: 0.1,
+    141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 132: 0.5, 290: 1, 291: 1, 230: 0.5, 514: 0.5, 245: 1,
+    33: 50, 441: 1, 24: 5, 242: 0.5, 32: 50, 12901: 1, 12904: 1, 4: 0.1, 85: 50, 36: 50, 1: 1, 380: 1, 74: 4,
+    241: 0.1, 8: 1, 29: 1, 42: 1,
 }
+# A stream sends only when its source topic has news: a topic slower than the stream sets the pace. PX4's navigator
+# publishes rtl_time_estimate every 2 s, so TIME_ESTIMATE_TO_TARGET (1 Hz configured) goes out at 0.5 Hz.
+SOURCE_PERIOD_US: dict[int, int] = {380: 2_000_000}
 
 
 def _interval_us(hz: float) -> int:
@@ -191,7 +214,7 @@ class Streams:
     def _rebuild_schedule(self, now: int) -> None:
         """A stream without a kept due time is due now (new, re-configured, or after a restart)."""
         kept = self._next_us
-        self._schedule = [(kept.get(mid, now), order, mid, interval)
+        self._schedule = [(kept.get(mid, now), order, mid, max(interval, SOURCE_PERIOD_US.get(mid, 0)))
                           for order, (mid, interval) in enumerate(self._interval_us.items())]
         heapify(self._schedule)
         self._next_us = {}

@@ -28,37 +28,38 @@ MAV_AUTOPILOT_PX4 = 12
 MAV_FRAME_LOCAL_NED = 1
 MAV_FRAME_BODY_FRD = 12
 
-# MAV_SYS_STATUS_SENSOR bits (common.xml)
-S_GYRO, S_ACCEL, S_MAG, S_ABS_PRESSURE, S_GPS = 0x01, 0x02, 0x04, 0x08, 0x20
-S_ATTITUDE_STAB, S_XY_POSITION, S_MOTOR_OUTPUTS, S_RC = 0x800, 0x4000, 0x8000, 0x10000
-S_AHRS, S_BATTERY, S_PREARM_CHECK = 0x200000, 0x2000000, 0x10000000
-_PRESENT = (S_GYRO | S_ACCEL | S_MAG | S_ABS_PRESSURE | S_GPS | S_ATTITUDE_STAB | S_XY_POSITION | S_MOTOR_OUTPUTS
-            | S_AHRS | S_BATTERY)
-_POSITION_BITS = S_GPS | S_XY_POSITION | S_AHRS
-
 # Modes whose control mode has flag_control_manual_enabled and attitude (ModeUtil/control_mode.cpp).
 _MANUAL_STABILIZED = frozenset({NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
                                 NavState.ALTITUDE_CRUISE, NavState.STAB})
+# flag_control_auto_enabled: the AUTO.* modes and Descend. Follow Target and Orbit are neither auto nor manual
+# (control_mode.cpp: they accept stick adjustments), only attitude-stabilized.
+_AUTO_CONTROL = px4.AUTO_MODES - {NavState.AUTO_FOLLOW_TARGET}
+_STABILIZED_ONLY = frozenset({NavState.AUTO_FOLLOW_TARGET, NavState.ORBIT})
 
 # A stream: the message for this snapshot, or None when PX4 would have no data to send
 Builder = Callable[["EndpointContext", VehicleSnapshot], "OutMessage | None"]
 
 
 def base_mode(snap: VehicleSnapshot) -> int:
-    """HEARTBEAT.base_mode as streams/HEARTBEAT.hpp builds it from the control-mode flags (reference 2.2)."""
+    """HEARTBEAT.base_mode as streams/HEARTBEAT.hpp builds it from the control-mode flags (reference 2.2).
+
+    OFFBOARD's flags come from the last offboard_control_mode commander received, however old (it keeps the last
+    message): 17 once position, velocity, acceleration or attitude setpoints have been sent, 1 before any or with body
+    rates only; armed adds 128.
+    """
     nav = snap.nav_state
     flags = px4.MODE_FLAG_CUSTOM_MODE_ENABLED
     if nav in _MANUAL_STABILIZED:
         flags |= px4.MODE_FLAG_MANUAL_INPUT_ENABLED | px4.MODE_FLAG_STABILIZE_ENABLED
     elif nav == NavState.ACRO:
         flags |= px4.MODE_FLAG_MANUAL_INPUT_ENABLED
-    elif nav in px4.AUTO_MODES:
+    elif nav in _AUTO_CONTROL:
         flags |= px4.MODE_FLAG_AUTO_ENABLED | px4.MODE_FLAG_GUIDED_ENABLED | px4.MODE_FLAG_STABILIZE_ENABLED
     elif nav == NavState.OFFBOARD:
-        ocm = snap.offboard_control
+        ocm = snap.offboard_control_last
         if ocm is not None and (ocm.position or ocm.velocity or ocm.acceleration or ocm.attitude):
             flags |= px4.MODE_FLAG_STABILIZE_ENABLED
-    elif nav == NavState.ORBIT:
+    elif nav in _STABILIZED_ONLY:
         flags |= px4.MODE_FLAG_STABILIZE_ENABLED
     if snap.armed:
         flags |= px4.MODE_FLAG_SAFETY_ARMED
@@ -77,20 +78,6 @@ def system_status(snap: VehicleSnapshot) -> int:
 def heartbeat(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return ctx.encoder.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
                                     px4.custom_mode(snap.nav_state), system_status(snap), 3)
-
-
-def sys_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
-    """streams/SYS_STATUS.hpp; MAVSDK reads health from these bits (reference 9a.5)."""
-    health = _PRESENT | S_RC
-    if not snap.position_valid:
-        health &= ~_POSITION_BITS
-    if snap.pre_flight_checks_pass:
-        health |= S_PREARM_CHECK
-    enabled = _PRESENT | (_PRESENT & ~health)
-    voltage_mv = int(min(max(snap.battery_voltage_v * 1000.0, 0.0), UINT16_MAX - 1))
-    remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
-    return ctx.encoder.sys_status_encode(_PRESENT | S_PREARM_CHECK, enabled | S_PREARM_CHECK, health, 0, voltage_mv, -1,
-                                     remaining, 0, 0, 0, 0, 0, 0)
 
 
 def extended_sys_state(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:

@@ -82,6 +82,7 @@ def test_status_prints_px4_lines(vehicle):
     out = Shell(vehicle).execute("commander status")
     assert out.splitlines() == [
         "INFO  [commander] Armed",
+        "INFO  [commander] prearm safety: Off",
         "INFO  [commander] navigation mode: Return",
         "INFO  [commander] user intended navigation mode: Offboard",
         "INFO  [commander] in failsafe: yes",

@@ -21,7 +21,7 @@ from sitl_emu.flight.tasks import (
     make_rtl,
     make_takeoff,
 )
-from sitl_emu.flight.tasks_rtl import RtlState
+from sitl_emu.flight.tasks_rtl import RtlState, rtl_start_text
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import TrajectorySetpoint, Vec3
@@ -269,6 +269,16 @@ def test_rtl_near_home_uses_the_cone_altitude(params):
     task = make_rtl(pm.nav(), params)
     assert task.return_alt_up_m == pytest.approx(10.0)  # within NAV_ACC_RAD: twice the distance
     assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 498 m (10 m above destination)")]
+
+
+@pytest.mark.parametrize(("return_alt", "home_alt", "text"), [
+    (518.0000001, 488.0, "518 m (30 m above destination)"),  # 518.0 as a 32-bit float: no rounding up
+    (518.0001, 488.0, "519 m (31 m above destination)"),  # a float above 518 rounds up, as ceilf does
+    (491.87082, 489.4, "492 m (3 m above destination)"),  # SIH's home altitude, 2.47 m up
+    (30.00000001, 0.00000001, "30 m (30 m above destination)"),
+])
+def test_rtl_start_text_rounds_up_32_bit_floats_as_rtl_direct_cpp(return_alt, home_alt, text):
+    assert rtl_start_text(return_alt, home_alt) == f"RTL: start return at {text}"
 
 
 def test_rtl_above_return_altitude_does_not_climb(params):

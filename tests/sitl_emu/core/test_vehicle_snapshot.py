@@ -87,3 +87,35 @@ def test_georef_derived_values_do_not_change_its_identity():
     assert a == b and hash(a) == hash(b)
     assert repr(a) == "GeoRef(lat_deg=47.397742, lon_deg=8.545594, alt_amsl_m=488.0)"
     assert a.lat_rad == math.radians(47.397742) and a.cos_lat == math.cos(math.radians(47.397742))
+
+
+def test_controller_outputs_at_rest_are_what_px4_publishes_disarmed():
+    """Disarmed, mc_pos_control still runs in position-controlled modes and publishes its idle setpoint (no position or
+    velocity, acceleration (0, 0, 100), yaw at the heading); in Manual it does not run (nothing published)."""
+    v = Vehicle()
+    v.run_for(2.5)
+    s = v.snapshot()
+    assert s.nav_state == NavState.AUTO_LOITER and not s.armed
+    sp = s.local_setpoint
+    assert sp is not None and all(math.isnan(c) for c in (*sp.position_ned_m, *sp.velocity_ned_m_s))
+    assert sp.acceleration_ned_m_s2 == (0.0, 0.0, 100.0) and sp.yaw_rad == s.euler_rad[2] and sp.yawspeed_rad_s == 0.0
+    assert s.attitude_setpoint_q_wxyz == (1.0, 0.0, 0.0, 0.0) and s.thrust_setpoint == 0.0
+    assert s.motor_commands == (0.0, 0.0, 0.0, 0.0) and s.offboard_control_last is None
+    main_mode, sub = decode_custom_mode(custom_mode(NavState.MANUAL))
+    _command(v, 176, 1, main_mode, sub)
+    v.run_for(0.1)
+    s = v.snapshot()
+    assert s.nav_state == NavState.MANUAL and s.local_setpoint is None and s.attitude_setpoint_q_wxyz is None
+
+
+def test_motor_commands_are_the_mixers_and_the_last_offboard_kinds_stay():
+    v = Vehicle()
+    v.run_for(2.5)
+    v.offboard_input(OffboardControlMode(velocity=True), TrajectorySetpoint(velocity_ned_m_s=(0.0, 0.0, 0.0)))
+    _command(v, 400, 1.0)
+    _command(v, 22)
+    v.run_for(8.0)
+    s = v.snapshot()
+    assert s.armed and all(0.3 < u < 0.7 for u in s.motor_commands)
+    assert s.motor_commands != s.motors  # the state lags the commands (SIH_T_TAU)
+    assert s.offboard_control is None and s.offboard_control_last == OffboardControlMode(velocity=True)

@@ -1,7 +1,8 @@
 """The stream scheduler sends what PX4's per-stream rate scheduling sends, in the same order, whatever the history.
 
 The reference below is the plain algorithm (scan the stream table every pass; a stream is due when its time has come,
-its next time is one interval later, or one interval from now if it fell behind). Streams keeps a heap instead; the
+its next time is one interval later, or one interval from now if it fell behind; the interval is never shorter than
+its source topic's period). Streams keeps a heap instead; the
 two must agree message for message through rate changes, stopped and restarted streams and reboots.
 """
 
@@ -45,8 +46,8 @@ class _Reference:
             self.next_hb = _next(self.next_hb, HEARTBEAT_INTERVAL_US, now)
         for msg_id, interval in self.interval.items():
             due = self.next.get(msg_id, now)
-            if now >= due:
-                self.next[msg_id] = _next(due, interval, now)
+            if now >= due:  # a stream whose source topic is slower goes at the topic's pace
+                self.next[msg_id] = _next(due, max(interval, telemetry.SOURCE_PERIOD_US.get(msg_id, 0)), now)
                 out.append(msg_id)
         return out
 
