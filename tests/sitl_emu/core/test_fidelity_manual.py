@@ -11,6 +11,7 @@ Tolerances as the other fidelity tests (tens of per cent): the emulator has no e
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import statistics
@@ -141,10 +142,10 @@ def test_yaw_stick_rate_matches_px4(yaw_turn):
     ref, rows = PX4["p_yaw"], yaw_turn.rows
     yaws = [(t, yaw) for t, _, _, yaw, _ in rows]
     unwrapped, total = [], 0.0
-    for (_, a), (t, b) in zip(yaws, yaws[1:], strict=False):
+    for (_, a), (t, b) in itertools.pairwise(yaws):
         total += math.remainder(b - a, 2 * math.pi)
         unwrapped.append((t, math.degrees(total)))
-    rates = [(t1, (y1 - y0) / (t1 - t0)) for (t0, y0), (t1, y1) in zip(unwrapped, unwrapped[1:], strict=False)]
+    rates = [(t1, (y1 - y0) / (t1 - t0)) for (t0, y0), (t1, y1) in itertools.pairwise(unwrapped)]
     assert max(r for _, r in rates) == pytest.approx(ref["peak_yaw_rate_dps"], rel=0.1)
     at_release = max((t, y) for t, y in unwrapped if t <= 2.0)[1]
     assert at_release == pytest.approx(ref["yaw_change_at_release_deg"], rel=0.15)

@@ -118,11 +118,22 @@ def test_the_stream_starting_makes_the_manual_modes_ready(pilot):
         check(f"mode_with_manual.{name}", pilot.observe(lambda n=name: pilot.mode(n.rstrip("2"))))
 
 
+def _rc_bits(pilot: Pilot) -> tuple[bool, bool, bool]:
+    """SYS_STATUS's RC receiver bit (0x10000): (present, enabled, healthy)."""
+    m = pilot.client.of_type("SYS_STATUS")[-1]
+    rc = 0x10000
+    return (bool(m.onboard_control_sensors_present & rc), bool(m.onboard_control_sensors_enabled & rc),
+            bool(m.onboard_control_sensors_health & rc))
+
+
 def test_losing_and_regaining_the_stream_while_disarmed(pilot):
+    assert _rc_bits(pilot) == (True, True, True)  # the joystick is the RC (rcAndDataLinkCheck.cpp)
     pilot.sticks = None
     check("loss_disarmed", pilot.observe(lambda: None, window_s=3.0))
+    assert _rc_bits(pilot) == (False, True, False)  # "No manual control input": required, missing
     pilot.sticks = dict(CENTRE)
     check("resume_disarmed", pilot.observe(lambda: None))
+    assert _rc_bits(pilot) == (True, True, True)
 
 
 def test_arming_needs_the_throttle_low_only_where_it_is_the_thrust(pilot):
