@@ -119,7 +119,11 @@ class ManualAltitudeTask:
 
     period_us = TASK_PERIOD_US
     finished = False
-    setpoint_type = SetpointType.POSITION
+
+    @property
+    def setpoint_type(self) -> SetpointType:
+        """A position-controlled setpoint (not a navigator takeoff or land item)."""
+        return SetpointType.POSITION
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params, self._version = params, params.version
