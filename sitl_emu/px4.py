@@ -245,6 +245,14 @@ AUTO_MODES = frozenset(
 )
 
 
+# control_mode flag_control_manual_enabled modes, split by who controls the thrust (ModeUtil/control_mode.cpp):
+# the climb-rate modes (the sticks command a climb rate) and the manual-thrust ones (the throttle is the thrust)
+CLIMB_RATE_MANUAL_MODES = frozenset({NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
+                                     NavState.ALTITUDE_CRUISE})
+MANUAL_THRUST_MODES = frozenset({NavState.MANUAL, NavState.STAB, NavState.ACRO})
+MANUAL_MODES = CLIMB_RATE_MANUAL_MODES | MANUAL_THRUST_MODES
+
+
 def main_sub(nav_state: NavState) -> tuple[int, int]:
     return _NAV_TO_MAIN_SUB[nav_state]
 

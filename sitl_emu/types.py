@@ -54,6 +54,18 @@ class AttitudeSetpoint:
 
 
 @dataclass(frozen=True, slots=True)
+class ManualControlSetpoint:
+    """PX4's manual_control_setpoint from a MAVLink joystick (MANUAL_CONTROL): sticks in -1..1, throttle -1 (low)
+    .. 1 (high), 0 the centre; `buttons` the bitfield as sent."""
+
+    roll: float = 0.0
+    pitch: float = 0.0
+    yaw: float = 0.0
+    throttle: float = -1.0
+    buttons: int = 0
+
+
+@dataclass(frozen=True, slots=True)
 class VehicleCommand:
     """PX4's vehicle_command; `command` uses MAV_CMD numbering, as PX4 does internally."""
 
@@ -154,3 +166,4 @@ class VehicleSnapshot:
     # the kinds of the last offboard message since boot, fresh or not: PX4's commander derives OFFBOARD's control
     # mode from the last offboard_control_mode it received (HEARTBEAT base_mode), whatever its age
     offboard_control_last: OffboardControlMode | None = None
+    manual_control: bool = False  # a manual input (MAVLink joystick) is present: SYS_STATUS's RC receiver

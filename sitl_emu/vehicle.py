@@ -36,6 +36,7 @@ from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
     HomePosition,
+    ManualControlSetpoint,
     OffboardControlMode,
     TrajectorySetpoint,
     Vec3,
@@ -164,6 +165,13 @@ class Vehicle:
         self.commander.offboard_signal(self._time_us, mode)
         self.chain.executor.offboard(mode, trajectory, attitude)
 
+    def manual_control_input(self, setpoint: ManualControlSetpoint) -> None:
+        """A MAVLink joystick's sticks (MANUAL_CONTROL): the vehicle's manual input per COM_RC_IN_MODE, in any mode
+        (flight/manual_control.py)."""
+        self._snap = None
+        if self.commander.manual_control_signal(self._time_us, setpoint):
+            self.chain.executor.manual(setpoint)
+
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""
         self._emit(severity, module, text, is_event, True)
@@ -233,4 +241,5 @@ class Vehicle:
             home=c.home, local_setpoint=local_sp, attitude_setpoint_q_wxyz=q_sp, rates_setpoint_rad_s=rates_sp,
             thrust_setpoint=thrust, motors=self._state.motors, extras={"system_status": float(c.system_status())},
             motor_commands=self._motor_commands, offboard_control_last=offboard_last,
+            manual_control=c.manual_control_valid(self._time_us),
         )

@@ -16,11 +16,13 @@ from enum import Enum
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
+from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
+from sitl_emu.flight.stick_gestures import Gesture, GestureDetector, StickMotion
 from sitl_emu.params import ParamRegistry
-from sitl_emu.px4 import UI_NAMES, MavState, NavState, Severity
-from sitl_emu.types import NAN, HomePosition, OffboardControlMode, Vec3
+from sitl_emu.px4 import AUTO_MODES, MANUAL_MODES, MANUAL_THRUST_MODES, UI_NAMES, MavState, NavState, Severity
+from sitl_emu.types import NAN, HomePosition, ManualControlSetpoint, OffboardControlMode, Vec3
 
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
@@ -40,6 +42,11 @@ class CommanderSettings:
     preflight_disarm_us: int  # COM_SPOOLUP_TIME + COM_DISARM_PRFLT (COM_DISARM_PRFLT <= 0: off)
     home_enabled: bool  # COM_HOME_EN
     fallback: FallbackSettings  # COM_OBL_RC_ACT, NAV_RCL_ACT
+    rc_loss_us: int  # COM_RC_LOSS_T
+    rc_in_mode: int  # COM_RC_IN_MODE
+    manual_loss: ManualLossSettings  # NAV_RCL_ACT, COM_RCL_EXCEPT, COM_FAIL_ACT_T
+    arm_gesture: bool  # MAN_ARM_GESTURE
+    override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> CommanderSettings:
@@ -50,6 +57,13 @@ class CommanderSettings:
             preflight_disarm_us=int((float(p["COM_SPOOLUP_TIME"]) + prflt_s) * 1e6) if prflt_s > 0 else 0,
             home_enabled=bool(p["COM_HOME_EN"]),
             fallback=FallbackSettings(obl_rc_act=int(p["COM_OBL_RC_ACT"]), rcl_act=int(p["NAV_RCL_ACT"])),
+            rc_loss_us=int(float(p["COM_RC_LOSS_T"]) * 1e6),
+            rc_in_mode=int(p["COM_RC_IN_MODE"]),
+            manual_loss=ManualLossSettings(rcl_act=int(p["NAV_RCL_ACT"]), rcl_except=int(p["COM_RCL_EXCEPT"]),
+                                           fail_act_us=int(float(p["COM_FAIL_ACT_T"]) * 1e6),
+                                           input_disabled=int(p["COM_RC_IN_MODE"]) == INPUT_DISABLED),
+            arm_gesture=int(p["MAN_ARM_GESTURE"]) == 1,
+            override_speed=float(p["MAN_OVERRIDE_SPD"]),
         )
 
 
@@ -105,6 +119,10 @@ class Commander:
         self._armed_at_us = 0
         self._landed_since_us: int | None = None
         self._offboard = OffboardSignal()  # flight/offboard.py: what happens when the setpoints stop
+        self.manual = ManualControlSignal()  # flight/manual_control.py: the MAVLink joystick as RC
+        self._manual_lost_at_arming = True
+        self._gestures = GestureDetector()
+        self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
 
     @property
@@ -126,6 +144,54 @@ class Commander:
         """An offboard_control_mode arrived (any mode): refresh the COM_OF_LOSS_T watchdog."""
         self._offboard.refresh(now_us, mode)
 
+    def manual_control_signal(self, now_us: int, setpoint: ManualControlSetpoint) -> bool:
+        """A MANUAL_CONTROL arrived (any mode); False if COM_RC_IN_MODE ignores MAVLink input. The sticks' gestures
+        and a pilot's takeover act at once (flight/stick_gestures.py)."""
+        regained = not self.manual_control_valid(now_us)
+        if not self.manual.refresh(now_us, setpoint, self.settings.rc_in_mode):
+            return False
+        if regained:  # manual_control resets its gesture and movement filters while the input is invalid
+            self._gestures.reset()
+            self._stick_motion.reset()
+        self._stick_gesture(now_us, setpoint)
+        if self._stick_motion.update(now_us, setpoint, self.settings.override_speed):
+            self._pilot_takeover()
+        return True
+
+    def _stick_gesture(self, now_us: int, setpoint: ManualControlSetpoint) -> None:
+        """MAN_ARM_GESTURE: arm with the preflight checks; disarm only on the ground or in a manual-thrust mode (in
+        the air it is refused without a word)."""
+        gesture = self._gestures.update(now_us, setpoint)
+        if gesture is None or not self.settings.arm_gesture:
+            return
+        if gesture is Gesture.ARM and not self.armed:
+            self.arm(now_us, external=True, run_checks=True, reason="stick gesture")
+        elif gesture is Gesture.DISARM and self.armed and self._may_disarm_by_sticks():
+            self.disarm("stick gesture", forced=True)
+
+    def _may_disarm_by_sticks(self) -> bool:
+        return self.landed or self.maybe_landed or self.nav_state in MANUAL_THRUST_MODES
+
+    def _pilot_takeover(self) -> None:
+        """Commander::manualControlCheck: sticks moved in an auto mode or OFFBOARD switch to Position (Altitude if
+        Position cannot run); during a failsafe action the switch ends it too."""
+        if not self.armed or not (self.nav_state in AUTO_MODES or self.nav_state is NavState.OFFBOARD):
+            return
+        if self._failsafe.manual_loss.hold_s(self.now_us) > 0:
+            return  # no stick takeover during the Hold before a failsafe action (framework.cpp)
+        if self.change_mode(NavState.POSCTL) or self.change_mode(NavState.ALTCTL):
+            self.say(Severity.INFO, "Pilot took over using sticks", statustext=not self.failsafe)
+
+    def manual_control_valid(self, now_us: int) -> bool:
+        return self.manual.valid(now_us, self.settings.rc_loss_us)
+
+    def _manual_lost(self, inputs: arming.CheckInputs) -> bool:
+        """failsafe_flags.manual_control_signal_lost, not counting a vehicle armed without manual control
+        (failsafe.cpp _manual_control_lost_at_arming: ignored until the sticks first appear)."""
+        if inputs.manual_control:
+            self._manual_lost_at_arming = False
+        return not inputs.manual_control and not self._manual_lost_at_arming
+
     def offboard_fresh(self, now_us: int) -> bool:
         return self._offboard.fresh(now_us, self.settings.of_loss_us)
 
@@ -143,7 +209,7 @@ class Commander:
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
         t = self.now_us if now_us is None else now_us
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self.offboard_fresh(t))
+                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t))
 
     def can_run(self, nav_state: NavState) -> bool:
         return arming.can_run(nav_state, self.check_inputs())
@@ -173,10 +239,13 @@ class Commander:
         self.say(Severity.CRITICAL, f"Switching to {UI_NAMES[nav_state]} is currently not available")
 
     # ---- arming -------------------------------------------------------------------------------------------------
-    def arm(self, now_us: int, *, external: bool, run_checks: bool) -> bool:
+    def arm(self, now_us: int, *, external: bool, run_checks: bool, reason: str | None = None) -> bool:
         """Commander::arm: checks for the current nav_state, then arm, set home, start the auto-disarm timers."""
         if self.armed:
             return True
+        if run_checks and not self._throttle_safe(now_us):
+            self.say(Severity.CRITICAL, "Arming denied: throttle not in safe position")
+            return False
         if run_checks:
             failure = arming.arming_failure(self.nav_state, self.check_inputs(now_us))
             if failure is not None:
@@ -186,14 +255,23 @@ class Commander:
                 return False
         self.armed = True
         self.have_taken_off = False
+        self._manual_lost_at_arming = not self.manual_control_valid(now_us)
         self._armed_at_us = now_us
         self._landed_since_us = None
         self._failsafe.reset()
         here = self._here()
         if self.settings.home_enabled and here is not None:
             self.home = here
-        self.say(Severity.INFO, f"Armed by {'external' if external else 'internal'} command")
+        self.say(Severity.INFO, f"Armed by {reason or ('external' if external else 'internal') + ' command'}")
         return True
+
+    def _throttle_safe(self, now_us: int) -> bool:
+        """Commander::arm's throttle check, in a manual mode with manual control present: at most 0.2 (of -1..1) where
+        the sticks command a climb rate, below -0.8 where the throttle is the thrust."""
+        if self.nav_state not in MANUAL_MODES or not self.manual_control_valid(now_us):
+            return True
+        throttle = self.manual.setpoint.throttle
+        return throttle < -0.8 if self.nav_state in MANUAL_THRUST_MODES else throttle <= 0.2
 
     def disarm(self, reason: str, *, forced: bool) -> bool:
         """Commander::disarm: refused in the air unless forced; the mode reverts to the sticky user mode."""
@@ -218,20 +296,23 @@ class Commander:
         ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
                                    in_termination=self.nav_state is NavState.TERMINATION)
         if ok:
+            self._failsafe.reset()  # a user mode change ends the failsafe actions (OnModeChangeOrDisarm)
             self._apply_mode(self.now_us)
         return ok
 
     def _apply_mode(self, now_us: int) -> None:
         """The mode in force: the user's mode, or the failsafe's fallback while it cannot run; an armed vehicle never
         leaves termination."""
-        decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended,
-                                         inputs=self.check_inputs(now_us), settings=self.settings.fallback,
-                                         terminated=self.terminated)
+        inputs = self.check_inputs(now_us)
+        st = self.settings
+        decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
+                                         settings=st.fallback, terminated=self.terminated, now_us=now_us,
+                                         manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss)
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
         if decision.activated:
-            self.say(Severity.CRITICAL, "Failsafe activated")
+            self.say(Severity.CRITICAL, decision.text)
         if decision.disarm:
             self.disarm("failsafe", forced=True)
 

@@ -2,7 +2,8 @@
 
 After src/modules/commander/failsafe/failsafe.cpp (checkModeFallback, fromOffboardLossActParam,
 fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activated", clear conditions):
-- mode fallbacks act at once (no COM_FAIL_ACT_T hold);
+- mode fallbacks act at once (no COM_FAIL_ACT_T hold); the manual-control loss action holds first
+  (flight/manual_control.py);
 - OFFBOARD without a fresh signal -> COM_OBL_RC_ACT; a Position/Altitude/Stabilized fallback without manual control
   (the SITL norm) becomes NAV_RCL_ACT (default Return);
 - a fallback mode that cannot run degrades further: Position -> Altitude -> Stabilized -> NAV_RCL_ACT,
@@ -17,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from sitl_emu.flight.arming import CheckInputs, can_run
+from sitl_emu.flight.manual_control import ManualLossFailsafe, ManualLossSettings
 from sitl_emu.px4 import NavState
 
 
@@ -28,13 +30,16 @@ class Decision:
     nav_state: NavState
     failsafe: bool
     disarm: bool = False
-    activated: bool = False  # the failsafe started at this update: say "Failsafe activated"
+    activated: bool = False  # the action got worse at this update: tell the user `text`
+    text: str = ""
 
-    def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False) -> None:
+    def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False,
+                 text: str = "") -> None:
         self.nav_state = nav_state
         self.failsafe = failsafe
         self.disarm = disarm
         self.activated = activated
+        self.text = text
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
@@ -89,33 +94,64 @@ def resolve_fallback(user: NavState, s: FallbackSettings, inputs: CheckInputs) -
     return NavState.DESCEND
 
 
+# framework.cpp's order of actions, the worst wins: fallbacks to Position < Altitude < Stabilized < Hold < Return <
+# Land < Descend < Disarm < Terminate
+_RANK: dict[NavState, int] = {
+    NavState.POSCTL: 2, NavState.ALTCTL: 3, NavState.STAB: 4, NavState.AUTO_LOITER: 5, NavState.AUTO_RTL: 6,
+    NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
+}
+_DISARM_RANK = 9
+FAILSAFE_TEXT = "Failsafe activated"
+
+
 class Failsafe:
-    """Decides the nav_state in force from the user's intention and what can run."""
+    """Decides the nav_state in force from the user's intention, what can run, and the manual-control loss action.
+
+    Two kinds of failsafe, combined as framework.cpp does (the worst action wins):
+    - mode fallbacks: the user's mode cannot run (no offboard signal, no manual control...): at once;
+    - the manual-control loss action (flight/manual_control.py): after the COM_FAIL_ACT_T Hold.
+    The user is told when the action in force gets worse: "Failsafe activated" (or "... entering Hold for N seconds"
+    when the Hold before a delayed action begins)."""
 
     def __init__(self) -> None:
         self.active = False
+        self.manual_loss = ManualLossFailsafe()
+        self._rank = 0  # the action in force (0: none)
 
     def reset(self) -> None:
+        """Arming, disarming or a user mode change ends every failsafe action."""
         self.active = False
+        self._rank = 0
+        self.manual_loss.reset()
 
     def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
-               terminated: bool = False) -> Decision:
+               terminated: bool = False, now_us: int = 0, manual_lost: bool = False,
+               manual_loss: ManualLossSettings | None = None) -> Decision:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
-            self.active = False
+            self.reset()
             return Decision(user, False)
         if terminated:
-            return self._enter(NavState.TERMINATION)
-        if can_run(user, inputs):
-            self.active = False
+            return self._decide(NavState.TERMINATION, False, "")
+        rank, mode, disarm = 0, user, False
+        if not can_run(user, inputs):
+            fallback = resolve_fallback(user, settings, inputs)
+            rank, mode, disarm = (_DISARM_RANK, user, True) if fallback is None else (_RANK[fallback], fallback, False)
+        if manual_loss is not None:
+            wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
+            if self.manual_loss.disarm and rank < _DISARM_RANK:
+                rank, mode, disarm = _DISARM_RANK, user, True
+            elif wanted is not None and _RANK[wanted] > rank:
+                rank, mode, disarm = _RANK[wanted], wanted, False
+        if rank == 0:
+            self.active, self._rank = False, 0
             return Decision(user, False)
-        fallback = resolve_fallback(user, settings, inputs)
-        if fallback is None:
-            decision = self._enter(user)
-            return Decision(user, True, disarm=True, activated=decision.activated)
-        return self._enter(fallback)
+        hold_s = self.manual_loss.hold_s(now_us) if mode is NavState.AUTO_LOITER else 0
+        text = f"{FAILSAFE_TEXT}: entering Hold for {hold_s} seconds" if hold_s > 0 else FAILSAFE_TEXT
+        decision = self._decide(mode, disarm, text if rank > self._rank else "")
+        self._rank = rank
+        return decision
 
-    def _enter(self, nav_state: NavState) -> Decision:
-        activated = not self.active
+    def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
         self.active = True
-        return Decision(nav_state, True, activated=activated)
+        return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text)

@@ -1,4 +1,5 @@
-"""Messages the mavlink receiver itself handles: commands, modes, offboard setpoints, heartbeat, ping, timesync.
+"""Messages the mavlink receiver itself handles: commands, modes, offboard setpoints, manual control, heartbeat, ping,
+timesync.
 
 Sources: src/modules/mavlink/mavlink_receiver.cpp (handle_message_command_long/int/both ~l.493-930, set_mode ~l.1061,
 heartbeat, ping ~l.1912), mavlink_timesync.cpp; reference 1.8-1.10, 3.1, 3.4, 4.4, 4.7, 4.8.
@@ -19,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from sitl_emu.mavlink import setpoints
 from sitl_emu.mavlink.link_commands import ANY_COMPONENT, CommandHandler
 from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
-from sitl_emu.types import VehicleCommand
+from sitl_emu.types import ManualControlSetpoint, VehicleCommand
 
 if TYPE_CHECKING:
     from typing import TypeAlias
@@ -56,6 +57,7 @@ class Receiver:
             "SET_POSITION_TARGET_LOCAL_NED": self._local_ned,
             "SET_POSITION_TARGET_GLOBAL_INT": self._global_int,
             "SET_ATTITUDE_TARGET": self._attitude_target,
+            "MANUAL_CONTROL": self._manual_control,
             "PING": self._ping,
             "TIMESYNC": self._timesync,
         }
@@ -131,6 +133,15 @@ class Receiver:
         if _targets_us(msg, ctx):
             self._apply(setpoints.decode_attitude_target(msg), ctx)
 
+    # --- manual control (a MAVLink joystick) ---------------------------------------------------------------------
+    @staticmethod
+    def _manual_control(msg: dialect.MAVLink_manual_control_message, ctx: EndpointContext) -> None:
+        """handle_message_manual_control: for target 0 or our system; the vehicle decides whether it uses it
+        (COM_RC_IN_MODE)."""
+        if msg.target in (0, ctx.sysid):
+            ctx.vehicle.manual_control_input(manual_setpoint(msg.x, msg.y, msg.z, msg.r, msg.buttons))
+            ctx.node.invalidate_snapshot()
+
     def _apply(self, decoded: setpoints.Decoded, ctx: EndpointContext) -> None:
         if decoded.mode is None:
             self.setpoints_refused += 1
@@ -147,6 +158,19 @@ class Receiver:
             return
         self._last_error_us[text] = ctx.now_us
         ctx.vehicle.report(Severity.CRITICAL, "mavlink", text, is_event=True)
+
+
+def manual_setpoint(x: int, y: int, z: int, r: int, buttons: int) -> ManualControlSetpoint:
+    """MANUAL_CONTROL's x (forward), y (right), r (yaw) in -1000..1000 and z (throttle) in 0..1000 as PX4 reads them
+    into manual_control_setpoint: pitch x/1000, roll y/1000, yaw r/1000, throttle z/500 - 1 (500 is the centre).
+    A field outside its range counts as 0, as in PX4: the stick centred, and for z the throttle centred, not low."""
+    return ManualControlSetpoint(roll=_in_range(y, -1000, 1000) / 1000.0, pitch=_in_range(x, -1000, 1000) / 1000.0,
+                                 yaw=_in_range(r, -1000, 1000) / 1000.0,
+                                 throttle=_in_range(z, 0, 1000, 500) / 500.0 - 1.0, buttons=int(buttons) & 0xFFFF)
+
+
+def _in_range(value: int, lo: int, hi: int, otherwise: int = 0) -> int:
+    return value if lo <= value <= hi else otherwise
 
 
 def _targets_us(msg: setpoints.SetpointMessage, ctx: EndpointContext) -> bool:

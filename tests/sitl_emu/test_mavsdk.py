@@ -265,3 +265,62 @@ async def _return_and_land(telemetry: Any, action: Any, s: Session) -> None:
     home_dist = math.hypot(*(await _ned(telemetry))[:2])
     s.calls.append(("landed distance from home (m)", f"{home_dist:.2f}"))
     assert home_dist < 1.5
+
+
+@pytest.mark.timeout(300)
+def test_mavsdk_manual_control_flies_position_mode(server: int) -> None:
+    """MAVSDK's manual_control example: stream set_manual_control_input, take off, start_position_control, then fly
+    forward and back with the sticks; PX4 accepts and flies it (the reference's px4-manual cases)."""
+    mavsdk_asyncio = _load_mavsdk()
+    session = Session()
+    try:
+        asyncio.run(asyncio.wait_for(_fly_manual(mavsdk_asyncio, server, session), timeout=240))
+    finally:
+        print("\nMAVSDK calls and outcomes:\n" + session.table())
+
+
+async def _fly_manual(mavsdk_asyncio: Any, port: int, s: Session) -> None:
+    from mavsdk.asyncio.plugins.action import ActionAsync
+    from mavsdk.asyncio.plugins.manual_control import ManualControlAsync
+    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+    from mavsdk.plugins.telemetry import FlightMode
+
+    config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
+    async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
+        await s.call("Mavsdk.add_any_connection(udpin)", mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
+        system = await s.call("Mavsdk.first_autopilot", mavsdk.first_autopilot(timeout_s=20.0), timeout_s=25.0)
+        telemetry, action, manual = TelemetryAsync(system), ActionAsync(system), ManualControlAsync(system)
+        await s.wait_for("health_all_ok", telemetry.health_all_ok, bool, timeout_s=30)
+        sticks = [0.0, 0.0, 0.5, 0.0]  # x forward, y right, z throttle 0..1 (0.5 centre), r yaw
+
+        async def stream() -> None:  # the example sends at 10-20 Hz; COM_RC_LOSS_T is 0.5 s of simulated time
+            while True:
+                await manual.set_manual_control_input(*sticks)
+                await asyncio.sleep(0.05 / SPEED)
+
+        streamer = asyncio.create_task(stream())
+        try:
+            await asyncio.sleep(0.5)
+            await s.call("Action.arm", action.arm())
+            await s.call("Action.takeoff", action.takeoff())
+            await s.wait_for("in air above 2 m", telemetry.position, lambda p: p.relative_altitude_m > 2.0,
+                             timeout_s=30)
+            await s.call("ManualControl.start_position_control", manual.start_position_control())
+            await s.wait_for("flight mode POSCTL", telemetry.flight_mode, lambda m: m == FlightMode.POSCTL,
+                             timeout_s=5)
+            start = await _ned(telemetry)
+            sticks[0] = 0.6
+            await s.wait_for("5 m forward (north)", lambda: _ned(telemetry), lambda p: p[0] - start[0] > 5.0,
+                             timeout_s=30)
+            sticks[0] = -0.6
+            await s.wait_for("back past the start", lambda: _ned(telemetry), lambda p: p[0] < start[0],
+                             timeout_s=40)
+            sticks[0] = 0.0
+            await s.wait_for("stopped (position hold)", telemetry.velocity_ned,
+                             lambda v: math.hypot(v.north_m_s, v.east_m_s) < 0.2, timeout_s=30)
+            alt = (await telemetry.position()).relative_altitude_m
+            assert alt > 1.5, "the altitude was not held in Position mode"
+            await s.call("Action.land", action.land())
+            await s.wait_for("landed and disarmed", telemetry.armed, lambda armed: not armed, timeout_s=90)
+        finally:
+            streamer.cancel()
