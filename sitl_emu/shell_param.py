@@ -1,7 +1,8 @@
 """The pxh> `param` command (src/systemcmds/param/param.cpp, PX4 main): show, set, get, reset, reset_all, touch, save.
 
 Output formats follow param.cpp: `param show` prints "x + NAME [index,used index] : value" lines (x: used, +: changed
-from the default) and "N/M parameters used."; `param set` prints "curr: old -> new". `param get` is our addition
+from the default), the value followed by its unit where PX4's metadata gives one (our addition), and "N/M parameters
+used."; `param set` prints "curr: old -> new". `param get` is our addition
 (= `param show -q`). `param save` writes the vehicle's parameter file (sitl_emu/params/store.py) at once; PX4 saves
 after every change anyway, and so does `sitl-emu serve`.
 """
@@ -88,8 +89,9 @@ def _show(registry: ParamRegistry, args: list[str]) -> tuple[int, str]:
         used, changed = registry.is_used(d.name), not registry.is_default(d.name)
         shown = changed if flag == "-c" else used or flag == "-a"
         if shown and _matches(d.name, pattern):
+            unit = f" {d.unit}" if d.unit else ""
             lines.append(f"{'x' if used else ' '} {'+' if changed else ' '} {d.name} [{all_index},"
-                         f"{registry.index_of(d.name)}] : {format_value(registry, d.name)}\n")
+                         f"{registry.index_of(d.name)}] : {format_value(registry, d.name)}{unit}\n")
     lines.append(f"\n {len(registry)}/{sum(1 for _ in registry.known())} parameters used.\n")
     return 0, "".join(lines)
 

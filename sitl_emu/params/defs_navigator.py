@@ -11,14 +11,14 @@ from __future__ import annotations
 from sitl_emu.params.registry import ParamDef, integer, real
 
 _NAVIGATOR: list[ParamDef] = [
-    real("MIS_TAKEOFF_ALT", 2.5, 0.0, 10000.0, "m", "Default takeoff altitude above the takeoff point."),
-    real("NAV_ACC_RAD", 10.0, 0.05, 200.0, "m", "Default horizontal acceptance radius of waypoints."),
-    real("NAV_MC_ALT_RAD", 0.8, 0.05, 200.0, "m", "Altitude acceptance radius for multicopters."),
-    real("RTL_RETURN_ALT", 30.0, 0.0, 10000.0, "m", "Return altitude above the destination (multicopter default)."),
-    real("RTL_DESCEND_ALT", 10.0, 0.0, 10000.0, "m", "Loiter altitude above the destination before landing."),
-    real("RTL_LAND_DELAY", 0.0, -1.0, 300.0, "s", "Wait at RTL_DESCEND_ALT before landing; -1 loiters forever."),
-    real("RTL_MIN_DIST", 10.0, 0.5, 10000.0, "m", "Horizontal radius around the destination where the cone applies."),
-    integer("RTL_CONE_ANG", 45, 0, 90, "deg", "Half-angle of the return altitude cone (0: always RTL_RETURN_ALT)."),
+    real("MIS_TAKEOFF_ALT", 2.5, 0.0, 10000.0, "m"),
+    real("NAV_ACC_RAD", 10.0, 0.05, 200.0, "m"),
+    real("NAV_MC_ALT_RAD", 0.8, 0.05, 200.0, "m"),
+    real("RTL_RETURN_ALT", 30.0, 0.0, 10000.0, "m"),
+    real("RTL_DESCEND_ALT", 10.0, 0.0, 10000.0, "m"),
+    real("RTL_LAND_DELAY", 0.0, -1.0, 300.0, "s"),
+    real("RTL_MIN_DIST", 10.0, 0.5, 10000.0, "m"),
+    integer("RTL_CONE_ANG", 45, 0, 90, "deg"),
 ]
 
 # PX4's navigator looks these up only when a mission is uploaded, so PX4 lists them only from then on (catalog.py: not
@@ -31,11 +31,11 @@ _MISSION_CHECKS: list[ParamDef] = [
 ]
 
 _LAND_DETECTOR: list[ParamDef] = [
-    real("LNDMC_Z_VEL_MAX", 0.25, 0.0, 10.0, "m/s", "Maximum vertical speed to detect landing."),
-    real("LNDMC_XY_VEL_MAX", 1.5, 0.0, 10.0, "m/s", "Maximum horizontal speed to detect landing."),
-    real("LNDMC_ROT_MAX", 20.0, 0.0, 180.0, "deg/s", "Maximum roll/pitch rate to detect landing."),
+    real("LNDMC_Z_VEL_MAX", 0.25, 0.0, 10.0, "m/s"),
+    real("LNDMC_XY_VEL_MAX", 1.5, 0.0, 10.0, "m/s"),
+    real("LNDMC_ROT_MAX", 20.0, 0.0, 180.0, "deg/s"),
     real("LNDMC_TRIG_TIME", 1.0, 0.1, 10.0, "s", "Total time the landing conditions must hold (three stages)."),
-    real("LNDMC_ALT_GND", 2.0, -1.0, 10.0, "m", "Ground-effect height (below it in flight: ground effect)."),
+    real("LNDMC_ALT_GND", 2.0, -1.0, 10.0, "m"),
     real("LNDMC_ALT_MAX", -1.0, -1.0, 10000.0, "m", "Maximum altitude for multicopters (-1: no limit)."),
 ]
 

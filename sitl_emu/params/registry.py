@@ -234,7 +234,10 @@ def _checked(d: ParamDef, value: float) -> float:
             raise ParamError(f"Parameter {d.name} is an integer; {value} is not.")
         v = int(v)
         lo, hi = max(lo, INT32_MIN), min(hi, INT32_MAX)  # whatever the definition says, it is an int32
-    if not lo <= v <= hi:
+        inside = lo <= v <= hi
+    else:  # compared as float32, as the value travels: a client sending the bound 0.3 sends 0.30000001192...
+        inside = float32(max(lo, -FLT_MAX)) <= float32(v) <= float32(min(hi, FLT_MAX))
+    if not inside:
         raise ParamError(f"Parameter {d.name} must be within [{_fmt(lo)}, {_fmt(hi)}]; {value} is not.")
     return v
 

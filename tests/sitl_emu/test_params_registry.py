@@ -127,14 +127,14 @@ def test_mark_used_lists_in_name_order_and_refuses_unknown_names(reg):
         reg.mark_used("NO_SUCH_PARAM")
 
 
-def test_a_parameter_only_px4_defines_is_checked_by_type(reg):
-    assert reg.set("ADSB_ICAO_ID", 2**31 - 1) == 2**31 - 1
+def test_a_parameter_only_px4_defines_is_checked_by_type_where_px4_states_no_range(reg):
+    assert reg.set("ADSB_CALLSIGN_1", 2**31 - 1) == 2**31 - 1
     for value, words in ((2**31, "within"), (1.5, "integer"), (math.nan, "finite")):
         with pytest.raises(ParamError, match=words):
-            reg.set("ADSB_ICAO_ID", value)
-    assert reg.set("ASPD_SCALE_1", -3.0e38) == -3.0e38
+            reg.set("ADSB_CALLSIGN_1", value)
+    assert reg.set("CAL_ACC0_XOFF", -3.0e38) == -3.0e38
     with pytest.raises(ParamError, match="finite"):
-        reg.set("ASPD_SCALE_1", 1e39)  # beyond float32: PX4 would store infinity
+        reg.set("CAL_ACC0_XOFF", 1e39)  # beyond float32: PX4 would store infinity
 
 
 def test_a_real_set_to_the_same_float32_changes_nothing(reg):

@@ -25,7 +25,7 @@ def test_save_and_load_give_back_every_changed_value_bit_for_bit(tmp_path):
     store = ParamStore(reg, tmp_path / DEFAULT_FILE)
     reg.set("MPC_XY_P", 0.949999988079071 + 0.1)  # any double, as a REAL32 set over MAVLink gives
     reg.set("BAT1_N_CELLS", 6)
-    reg.set("ADSB_ICAO_ID", -(2**31))
+    reg.set("ADSB_CALLSIGN_1", -(2**31))
     reg.set("SENS_BOARD_X_OFF", 1.5e-7)
     assert store.unsaved and store.save() == str(store.path) and not store.unsaved
     assert [name for name, _, _ in read_file(store.path)] == sorted(reg.changed())

@@ -107,7 +107,7 @@ def test_param_show_format_and_pattern(vehicle):
     lines = out.splitlines()
     assert lines[0] == "Symbols: x = used, + = saved, * = unsaved"
     assert f"x   BAT_LOW_THR [{_table_index(vehicle, 'BAT_LOW_THR')},{vehicle.params.index_of('BAT_LOW_THR')}] : " \
-           "0.1500" in lines
+           "0.1500 norm" in lines  # the unit where PX4's metadata gives one
     assert all("BAT" in line for line in lines[1:-2])
     known = sum(1 for _ in vehicle.params.known())
     assert lines[-1] == f" {len(vehicle.params)}/{known} parameters used." == " 994/1002 parameters used."
@@ -116,6 +116,13 @@ def test_param_show_format_and_pattern(vehicle):
 def _table_index(vehicle, name: str) -> int:
     """The index among every known parameter (param.cpp's first number; the second is the used index)."""
     return [d.name for d in vehicle.params.known()].index(name)
+
+
+def test_param_show_gives_the_unit_where_known_and_get_only_the_value(vehicle):
+    shell = Shell(vehicle)
+    assert shell.execute("param show MPC_XY_CRUISE").splitlines()[1].endswith(" : 5.0000 m/s")
+    assert shell.execute("param show SIH_KDW").splitlines()[1].endswith(" : 0.0250 Nm/(rad/s)")
+    assert shell.execute("param get MPC_XY_CRUISE") == shell.execute("param show -q MPC_XY_CRUISE") == "5.0000\n"
 
 
 def test_param_show_exact_name_without_wildcard(vehicle):
@@ -127,7 +134,7 @@ def test_param_show_exact_name_without_wildcard(vehicle):
 def test_param_show_lists_unused_parameters_only_with_a(vehicle):
     shell = Shell(vehicle)
     assert "MIS_DIST_1WP" not in shell.execute("param show MIS_*")
-    assert f"    MIS_DIST_1WP [{_table_index(vehicle, 'MIS_DIST_1WP')},-1] : 10000.0000" in \
+    assert f"    MIS_DIST_1WP [{_table_index(vehicle, 'MIS_DIST_1WP')},-1] : 10000.0000 m" in \
         shell.execute("param show -a MIS_*").splitlines()
     assert shell.execute("param touch MIS_DIST_1WP NO_SUCH") == ""
     assert "x   MIS_DIST_1WP" in shell.execute("param show MIS_DIST_1WP")

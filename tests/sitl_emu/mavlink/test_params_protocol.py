@@ -294,12 +294,22 @@ def test_out_of_range_int_is_refused(setup):
     assert ctx.vehicle.params.get("MAV_SYS_ID") == 1
 
 
-def test_a_parameter_without_a_range_of_its_own_takes_any_int32(setup):
+def test_a_parameter_without_a_range_takes_any_int32(setup):
     proto, ctx, client = setup
-    for value in (-(2**31), 2**31 - 1):
-        proto.handle(_set(client, "ADSB_ICAO_ID", int32_to_float_bits(value), MAV_PARAM_TYPE_INT32), ctx)
+    for value in (-(2**31), 2**31 - 1):  # PX4's metadata states no range for ADSB_CALLSIGN_1
+        proto.handle(_set(client, "ADSB_CALLSIGN_1", int32_to_float_bits(value), MAV_PARAM_TYPE_INT32), ctx)
         (echo,) = ctx.take("PARAM_VALUE")
-        assert float_bits_to_int32(echo.param_value) == value == ctx.vehicle.params.get("ADSB_ICAO_ID")
+        assert float_bits_to_int32(echo.param_value) == value == ctx.vehicle.params.get("ADSB_CALLSIGN_1")
+
+
+def test_px4s_stated_range_is_kept_for_a_parameter_the_emulator_only_stores(setup):
+    """ADSB_ICAO_ID: [-1, 16777215] in PX4's metadata (px4_param_meta.csv); the emulator never reads it."""
+    proto, ctx, client = setup
+    proto.handle(_set(client, "ADSB_ICAO_ID", int32_to_float_bits(2**24), MAV_PARAM_TYPE_INT32), ctx)
+    assert _error(ctx).error == PARAM_ERROR_VALUE_OUT_OF_RANGE
+    proto.handle(_set(client, "ADSB_ICAO_ID", int32_to_float_bits(2**24 - 1), MAV_PARAM_TYPE_INT32), ctx)
+    (echo,) = ctx.take("PARAM_VALUE")
+    assert float_bits_to_int32(echo.param_value) == 2**24 - 1 == ctx.vehicle.params.get("ADSB_ICAO_ID")
 
 
 def test_hash_changes_with_values(setup):
