@@ -4,8 +4,9 @@ The story (PX4: mavlink_receiver.cpp handle_message_manual_control, src/modules/
 ManualControlSelector.cpp, commander's manual-control checks):
 1. Every MANUAL_CONTROL for our system becomes a `ManualControlSetpoint` (mavlink/receiver.py); `Vehicle.
    manual_control_input` hands it to `ManualControlSignal.refresh` below, whatever the mode.
-2. COM_RC_IN_MODE says which sources count: 1 (SITL's default, MAVLink only), 2 and 3 (RC and/or MAVLink) take it,
-   0 (RC only) and 4 (stick input disabled) ignore it.
+2. COM_RC_IN_MODE says which sources count: 1 (SITL's default, MAVLink only), 2 and 3 (RC and/or MAVLink) and 5-8
+   (RC and MAVLink by priority; the emulator has no RC, so MAVLink wins) take it, 0 (RC only) and 4 (stick input
+   disabled) ignore it.
 3. The input is valid while the last setpoint is younger than COM_RC_LOSS_T; manual modes (POSCTL, ALTCTL,
    STABILIZED...) need it to run (flight/arming.py Req.MANUAL), and the flight tasks read its sticks.
 4. The stream stops while armed (`ManualLossFailsafe` below): NAV_RCL_ACT (Return by default) after holding for
@@ -23,7 +24,7 @@ from sitl_emu.px4 import NavState
 from sitl_emu.types import ManualControlSetpoint
 
 # COM_RC_IN_MODE values whose input includes MAVLink MANUAL_CONTROL (commander_params.yaml / manual_control_params)
-_MAVLINK_SOURCES: Final = frozenset({1, 2, 3})
+_MAVLINK_SOURCES: Final = frozenset({1, 2, 3, 5, 6, 7, 8})
 INPUT_DISABLED: Final = 4  # COM_RC_IN_MODE 4: stick input disabled
 # manual_control's 200 ms timer notices a stream that stopped: the loss shows at the first timer run past
 # COM_RC_LOSS_T (ManualControl.cpp ScheduleDelayed(200_ms)), 0.6 s after the last sample with the default 0.5 s

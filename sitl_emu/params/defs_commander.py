@@ -23,6 +23,6 @@ PARAMS: list[ParamDef] = [
     integer("COM_RCL_EXCEPT", 0, 0, 31),
     integer("COM_ARM_WO_GPS", 1, 0, 2),
     integer("COM_HOME_EN", 1, 0, 1),
-    integer("COM_RC_IN_MODE", 1, 0, 4),
+    integer("COM_RC_IN_MODE", 1, 0, 8),  # 5-8: RC and MAVLink by priority
     integer("COM_LOW_BAT_ACT", 3, 0, 3),
 ]
