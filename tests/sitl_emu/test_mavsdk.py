@@ -1,7 +1,8 @@
 """Conformance: MAVSDK (the native `mavsdk` >= 4 binding, MAVSDK's C++ core) flies `sitl-emu serve` as it flies PX4.
 
 One test runs a whole session against a server started on free ports: connect, health, MAVLink shell, a mission
-upload, download and clear, parameters (REAL32 and INT32), arm, takeoff, offboard position / velocity NED / velocity body, hold, return and land.
+upload, download and clear, parameters (REAL32 and INT32), arm, takeoff, offboard position / velocity NED /
+velocity body, hold, return and land.
 Every MAVSDK call and its outcome is printed at the end (run with -s to see the table).
 
 MAVSDK's timeouts run on the wall clock (0.5 s command retries, 3 s heartbeat timeout), so the server runs only a few

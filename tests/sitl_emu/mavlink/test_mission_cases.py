@@ -155,3 +155,27 @@ def _out_of_sequence(probe: Probe, case: dict[str, Any]) -> None:
     assert abs(re_requests - case["_info"]["re_requests"]) <= 1  # PX4: 19 in 5 s (every 250 ms + its loop)
     assert t_text_s == pytest.approx(case["t_sync_timeout_text_s"], abs=0.15)
     assert probe.texts()[texts_start:] == list(zip(case["statustext"], case["statustext_severity"], strict=True))
+
+
+def test_two_links_upload_one_at_a_time_and_a_vanished_client_frees_the_vehicle() -> None:
+    """Over UDP on both links: the GCS link's MISSION_COUNT while the API link uploads gets MAV_MISSION_ERROR; the
+    API client then disappears mid-upload, PX4's 5 s timeout ends its transfer ("Mission sync timeout"), and the
+    GCS link's upload goes through; the partial upload was never stored."""
+    h = Harness(Vehicle(), handler_classes=[MissionProtocol])
+    try:
+        h.api.send(h.api.mav.mission_count_encode(1, 1, 3, 0))
+        assert h.run_until(lambda: bool(h.api.of_type("MISSION_REQUEST_INT")), 1.0)
+        h.gcs.send(h.gcs.mav.mission_count_encode(1, 1, 1, 0))
+        assert h.run_until(lambda: bool(h.gcs.of_type("MISSION_ACK")), 1.0)
+        assert h.gcs.of_type("MISSION_ACK")[-1].type == 1  # MAV_MISSION_ERROR: busy on another link
+        assert h.run_until(lambda: any(e.text == "Mission sync timeout" for e in h.vehicle.events_after(0)), 6.0)
+        assert len(h.api.of_type("MISSION_REQUEST_INT")) >= 15  # asked again every 250 ms meanwhile
+        assert h.vehicle.mission_store().count(0) == 0
+        h.gcs.send(h.gcs.mav.mission_count_encode(1, 1, 1, 0))
+        assert h.run_until(lambda: bool(h.gcs.of_type("MISSION_REQUEST_INT")), 1.0)
+        h.gcs.send(h.gcs.mav.mission_item_int_encode(1, 1, 0, 6, 16, 0, 1, 0, 0, 0, math.nan, 473977420, 85455940,
+                                                     5.0, 0))
+        assert h.run_until(lambda: len(h.gcs.of_type("MISSION_ACK")) == 2, 1.0)
+        assert h.gcs.of_type("MISSION_ACK")[-1].type == 0 and h.vehicle.mission_store().count(0) == 1
+    finally:
+        h.close()
