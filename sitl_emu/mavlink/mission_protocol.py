@@ -255,7 +255,7 @@ class MissionProtocol:
         if seq >= plan.count:  # the plan changed under the download
             self._refuse_request(ctx)
             return
-        current = self._type == PLAN_MISSION and seq == store.current_seq
+        current = seq == store.current_seq  # PX4 compares with the mission's current item for every plan type
         self._sent_us = ctx.now_us
         ctx.send(item_message(ctx.mav, self._partner, plan.items[seq], current, self._type, self._int_mode))
 

@@ -157,6 +157,25 @@ async def _check_missions(system: Any, s: Session) -> None:
         (i.seq, i.frame, i.command, i.x, i.y, i.z) for i in items]
     await s.call("MissionRaw.clear_mission", mission_raw.clear_mission())
     assert await s.call("MissionRaw.download_mission", mission_raw.download_mission()) in ([], None)
+    await _check_mission_plan(system, s)
+
+
+async def _check_mission_plan(system: Any, s: Session) -> None:
+    """MAVSDK's Mission plugin (the `mission` example): its items become waypoints plus DO_CHANGE_SPEED items."""
+    from mavsdk.asyncio.plugins.mission import MissionAsync
+    from mavsdk.plugins.mission import MissionItem, MissionPlan
+
+    mission = MissionAsync(system)
+    nan = float("nan")
+    points = [(47.398039, 8.545594, 10.0), (47.398036, 8.543587, 12.0)]
+    items = [MissionItem(lat, lon, alt, 5.0, True, nan, nan, MissionItem.CameraAction.NONE, nan, nan, nan, nan, nan,
+                         MissionItem.VehicleAction.NONE) for lat, lon, alt in points]
+    await s.call("Mission.upload_mission(2 waypoints at 5 m/s)", mission.upload_mission(MissionPlan(items)))
+    plan = await s.call("Mission.download_mission", mission.download_mission())
+    got = [(i.latitude_deg, i.longitude_deg, i.relative_altitude_m, i.speed_m_s) for i in plan.mission_items]
+    assert got == [(pytest.approx(lat), pytest.approx(lon), pytest.approx(alt), pytest.approx(5.0))
+                   for lat, lon, alt in points]
+    await s.call("Mission.clear_mission", mission.clear_mission())
 
 
 async def _echo(value: Any) -> Any:

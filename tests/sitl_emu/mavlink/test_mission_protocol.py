@@ -148,7 +148,7 @@ def test_fence_and_rally_plans_are_stored_apart(setup):
     assert upload(proto, ctx, client, fence, 1) == MAV_MISSION_ACCEPTED
     assert upload(proto, ctx, client, [item(client, 0, RALLY, mission_type=2)], 2) == MAV_MISSION_ACCEPTED
     assert [m.command for m in download(proto, ctx, client, 1)] == [FENCE_POLY_IN] * 3
-    assert [(m.command, m.mission_type) for m in download(proto, ctx, client, 2)] == [(RALLY, 2)]
+    assert [(m.command, m.mission_type, m.current) for m in download(proto, ctx, client, 2)] == [(RALLY, 2, 1)]
     assert download(proto, ctx, client, 0) == []
     proto.handle(client.msg("MISSION_CLEAR_ALL", 1, 1, 1), ctx)
     assert [m.type for m in ctx.take()] == [MAV_MISSION_ACCEPTED]
@@ -294,3 +294,18 @@ def test_readme_says_what_the_mission_protocol_does():
     readme = " ".join((REPO_ROOT / "README.md").read_text().split())
     assert "upload is refused at once" not in readme
     assert "plans upload, download and clear over PX4's mission protocol" in readme
+
+
+def test_busy_answers_while_a_transfer_runs(setup):
+    proto, ctx, client = setup
+    upload(proto, ctx, client, [item(client, 0), item(client, 1)])
+    proto.handle(client.msg("MISSION_REQUEST_LIST", 1, 1, 0), ctx)  # a download is running
+    proto.handle(client.msg("MISSION_REQUEST_LIST", 1, 1, 1), ctx)
+    proto.handle(client.msg("MISSION_COUNT", 1, 1, 1, 0), ctx)
+    proto.handle(client.msg("MISSION_CLEAR_ALL", 1, 1, 0), ctx)
+    proto.handle(client.msg("MISSION_SET_CURRENT", 1, 1, 1), ctx)
+    assert [m.get_type() for m in ctx.take()] == ["MISSION_COUNT", "MISSION_ACK"]
+    assert texts(ctx) == ["Mission download request ignored, already active", "WPM: IGN MISSION_COUNT: Busy",
+                          "WPM: IGN CLEAR CMD: Busy", "WPM: IGN WP CURR CMD: Busy"]
+    assert ctx.vehicle.events[0].severity == Severity.INFO
+    assert ctx.vehicle.mission_store().count(0) == 2 and ctx.vehicle.mission_store().current_seq == 0
