@@ -26,10 +26,10 @@ PLAN_RALLY = 2
 PLAN_ALL = 255  # MAV_MISSION_TYPE_ALL: MISSION_CLEAR_ALL of every plan
 PLAN_TYPES = (PLAN_MISSION, PLAN_FENCE, PLAN_RALLY)
 
-# How many items each plan holds (MavlinkMissionManager::MAX_COUNT from the dataman sizes in navigator/navigation.h
-# for a non-memory-constrained build, SITL: missions 2000, fence items 64, safe points 8). From memory of
-# navigation.h, not re-checked against PX4 main.
-MAX_ITEMS = {PLAN_MISSION: 2000, PLAN_FENCE: 64, PLAN_RALLY: 8}
+# How many items each plan holds (MavlinkMissionManager::MAX_COUNT from dataman.h: the mission's
+# CONFIG_NUM_MISSION_ITMES_SUPPORTED, 10000 in the px4_sitl board configuration as a third party reports it (Kconfig's
+# default is 500; not re-checked against the board file); DM_KEY_FENCE_POINTS_MAX 64, DM_KEY_SAFE_POINTS_MAX 32).
+MAX_ITEMS = {PLAN_MISSION: 10_000, PLAN_FENCE: 64, PLAN_RALLY: 32}
 
 # MISSION_STATE (common.xml), what MISSION_CURRENT reports for the stored mission
 MISSION_STATE_NO_MISSION = 1

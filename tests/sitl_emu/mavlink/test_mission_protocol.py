@@ -309,3 +309,19 @@ def test_busy_answers_while_a_transfer_runs(setup):
                           "WPM: IGN CLEAR CMD: Busy", "WPM: IGN WP CURR CMD: Busy"]
     assert ctx.vehicle.events[0].severity == Severity.INFO
     assert ctx.vehicle.mission_store().count(0) == 2 and ctx.vehicle.mission_store().current_seq == 0
+
+
+def test_the_largest_mission_is_stored_and_one_more_item_is_no_space(setup):
+    proto, ctx, client = setup
+    limit = MAX_ITEMS[0]
+    proto.handle(client.msg("MISSION_COUNT", 1, 1, limit + 1, 0), ctx)
+    assert [m.type for m in ctx.take()] == [MAV_MISSION_NO_SPACE]
+    wp = item(client, 0)
+    proto.handle(client.msg("MISSION_COUNT", 1, 1, limit, 0), ctx)
+    for seq in range(limit):
+        (request,) = ctx.take()
+        assert request.seq == seq
+        wp.seq = seq
+        proto.handle(wp, ctx)
+    assert [m.type for m in ctx.take()] == [MAV_MISSION_ACCEPTED]
+    assert ctx.vehicle.mission_store().count(0) == limit == 10_000
