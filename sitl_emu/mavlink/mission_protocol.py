@@ -15,6 +15,8 @@ One MissionProtocol per link, a state machine IDLE / GETLIST (receiving an uploa
 - MISSION_CLEAR_ALL (one plan type or MAV_MISSION_TYPE_ALL), MISSION_SET_CURRENT (index inside the mission).
 - One upload at a time on the whole vehicle (PX4's static _transfer_in_progress): a MISSION_COUNT on another link
   meanwhile gets MAV_MISSION_ERROR. A client other than the transfer partner gets PX4's "partner id mismatch".
+MISSION_REQUEST_PARTIAL_LIST / MISSION_WRITE_PARTIAL_LIST are not handled by PX4 (handle_message has no case for
+them), so they are ignored here too; an abandoned or broken transfer is the "partial" case PX4 knows (the timeout).
 Not on the wire: the opaque_id of MISSION_COUNT / MISSION_ACK and MISSION_CURRENT's plan ids, because pymavlink's
 dialects (2.4.x, development included) lack those extension fields; the store keeps a CRC32 per plan for them.
 """
