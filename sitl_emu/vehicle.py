@@ -25,6 +25,7 @@ import numpy as np
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
 from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.commands import handle_command
+from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.tasks_core import NavInput, SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry, default_registry
@@ -91,6 +92,7 @@ class Vehicle:
         self._task_finished = False
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
+        self._missions = MissionStore()  # in memory only: a reboot empties it (flight/mission_store.py)
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -175,6 +177,10 @@ class Vehicle:
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""
         self._emit(severity, module, text, is_event, True)
+
+    def mission_store(self) -> MissionStore:
+        """The stored mission, geofence and rally plans (the mission protocol writes them, the navigator reads)."""
+        return self._missions
 
     def reboot(self) -> None:
         """Back to the boot state now: time 0, disarmed in Hold, parameters kept (event seq keeps counting)."""

@@ -1,121 +1,328 @@
-"""The mission protocol for a vehicle that holds no plan (src/modules/mavlink/mavlink_mission.cpp; reference 9c.4).
+"""The mission protocol for mission, geofence and rally plans, as src/modules/mavlink/mavlink_mission.cpp runs it.
 
-sitl_emu does not fly missions yet, so every plan (mission, geofence, rally) is empty:
-- MISSION_REQUEST_LIST -> MISSION_COUNT 0 with the requested mission_type echoed, so QGC's connect sequence completes
-  (QGC downloads types 0, 1 and 2; the GCS closes the transfer with MISSION_ACK).
-- MISSION_COUNT 0 (clear by upload) and MISSION_CLEAR_ALL -> MISSION_ACK ACCEPTED, as PX4.
-- MISSION_COUNT > 0 -> refused at once with MISSION_ACK MAV_MISSION_UNSUPPORTED and a report saying so, never left
-  hanging (PX4 would request the items; a client then sees its upload fail cleanly instead of a timeout).
-- MISSION_ITEM(_INT) outside a transfer -> MISSION_ACK MAV_MISSION_ERROR (PX4: "IGN MISSION_ITEM: No transfer").
-- MISSION_REQUEST(_INT) outside a transfer is silently ignored, as PX4 does.
-The opaque_id extension field (0 for an empty plan) is not in pymavlink's dialects, so it goes out as 0 anyway.
+One MissionProtocol per link, a state machine IDLE / GETLIST (receiving an upload) / SENDLIST (sending a download):
+- Upload: MISSION_COUNT n -> MISSION_REQUEST_INT 0 (MISSION_REQUEST when the client speaks the legacy float
+  messages) -> MISSION_ITEM_INT 0 -> ... -> MISSION_ACK ACCEPTED. An item out of sequence is dropped; the
+  request is repeated every 250 ms (MAVLINK_MISSION_RETRY_TIMEOUT_DEFAULT) until 5 s pass without a message from
+  the client (MAVLINK_MISSION_PROTOCOL_TIMEOUT_DEFAULT): then "Mission sync timeout" (PX4 main's wording, the
+  reference's `bad.out_of_sequence`) and the partial upload is dropped, the stored plan untouched. A refused item
+  (mission_items.parse_item) ends the transfer with its MAV_MISSION_RESULT and "IGN MISSION_ITEM: Invalid item".
+  The plan is stored only when the last item arrives (mission_store.py: never half-written). MISSION_COUNT 0
+  clears the plan; more than the plan holds -> MAV_MISSION_NO_SPACE.
+- Download: MISSION_REQUEST_LIST -> MISSION_COUNT (repeated every 250 ms until the first request, as PX4 main does
+  since PR 26872) -> MISSION_REQUEST_INT i -> MISSION_ITEM_INT i (`current` set on the mission's current item) ->
+  the client's MISSION_ACK. A download never acknowledged also ends with "Mission sync timeout" after 5 s.
+- MISSION_CLEAR_ALL (one plan type or MAV_MISSION_TYPE_ALL), MISSION_SET_CURRENT (index inside the mission).
+- One upload at a time on the whole vehicle (PX4's static _transfer_in_progress): a MISSION_COUNT on another link
+  meanwhile gets MAV_MISSION_ERROR. A client other than the transfer partner gets PX4's "partner id mismatch".
+MISSION_REQUEST_PARTIAL_LIST / MISSION_WRITE_PARTIAL_LIST are not handled by PX4 (handle_message has no case for
+them), so they are ignored here too; an abandoned or broken transfer is the "partial" case PX4 knows (the timeout).
+Not on the wire: the opaque_id of MISSION_COUNT / MISSION_ACK and MISSION_CURRENT's plan ids, because pymavlink's
+dialects (2.4.x, development included) lack those extension fields; the store keeps a CRC32 per plan for them.
 """
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar, cast
+from typing import TYPE_CHECKING, Any, ClassVar
 
+from sitl_emu.flight.mission_store import (
+    MAX_ITEMS,
+    PLAN_ALL,
+    PLAN_MISSION,
+    PLAN_TYPES,
+    MissionItem,
+    MissionStore,
+    plan_id,
+)
+from sitl_emu.mavlink.mission_items import (
+    MAV_MISSION_ACCEPTED,
+    MAV_MISSION_ERROR,
+    MAV_MISSION_INVALID,
+    MAV_MISSION_NO_SPACE,
+    MAV_MISSION_OPERATION_CANCELLED,
+    MAV_MISSION_UNSUPPORTED,
+    item_message,
+    mission_current_fields,
+    parse_item,
+    plan_check,
+)
 from sitl_emu.px4 import Severity
 
 if TYPE_CHECKING:
-    from typing import TypeAlias
-
-    from pymavlink.dialects.v20 import development as dialect
     from pymavlink.dialects.v20.development import MAVLink_message
 
     from sitl_emu.mavlink.context import LinkContext
 
-    _Item: TypeAlias = dialect.MAVLink_mission_item_message | dialect.MAVLink_mission_item_int_message
-    # every message of MissionProtocol.MESSAGES: all carry a target and a mission_type
-    _MissionMessage: TypeAlias = (
-        dialect.MAVLink_mission_request_list_message | dialect.MAVLink_mission_count_message
-        | dialect.MAVLink_mission_clear_all_message | _Item | dialect.MAVLink_mission_request_message
-        | dialect.MAVLink_mission_request_int_message | dialect.MAVLink_mission_ack_message)
-
 log = logging.getLogger(__name__)
 
 MAV_COMP_ID_MISSIONPLANNER = 190
-
-# MAV_MISSION_RESULT (common.xml)
-MAV_MISSION_ACCEPTED = 0
-MAV_MISSION_ERROR = 1
-MAV_MISSION_UNSUPPORTED = 3
-
-# MAV_MISSION_TYPE (common.xml); PX4 stores these three.
-MISSION_TYPE_MISSION = 0
-MISSION_TYPE_FENCE = 1
-MISSION_TYPE_RALLY = 2
-_PLAN_NAMES = {
-    MISSION_TYPE_MISSION: ("Mission upload", "missions"),
-    MISSION_TYPE_FENCE: ("Geofence upload", "geofences"),
-    MISSION_TYPE_RALLY: ("Rally point upload", "rally points"),
-}
+RETRY_US = 250_000  # MAVLINK_MISSION_RETRY_TIMEOUT_DEFAULT
+TIMEOUT_US = 5_000_000  # MAVLINK_MISSION_PROTOCOL_TIMEOUT_DEFAULT
+IDLE, GETLIST, SENDLIST = "idle", "getlist", "sendlist"
 
 
 class MissionProtocol:
-    """One instance per link. Stateless: every plan is empty."""
+    """One instance per link; the plans and the upload lock live in the vehicle's MissionStore."""
 
     MESSAGES: ClassVar[tuple[str, ...]] = (
         "MISSION_REQUEST_LIST", "MISSION_COUNT", "MISSION_CLEAR_ALL", "MISSION_ITEM", "MISSION_ITEM_INT",
-        "MISSION_REQUEST", "MISSION_REQUEST_INT", "MISSION_ACK",
+        "MISSION_REQUEST", "MISSION_REQUEST_INT", "MISSION_ACK", "MISSION_SET_CURRENT",
     )
-    TICKS: ClassVar[bool] = False  # tick() never sends: the endpoint need not call it
 
     def __init__(self) -> None:
-        # message type -> its handler, which takes that type's message class (the one place a message is narrowed)
+        self._state = IDLE
+        self._type = PLAN_MISSION
+        self._partner = (0, 0)  # PX4 starts with partner 0/0: a stray item before any transfer is a "mismatch"
+        self._seq = 0  # the next item to receive, or the next request expected
+        self._count = 0
+        self._int_mode = True
+        self._items: list[MissionItem] = []
+        self._marked_current = -1
+        self._sent_us = 0
+        self._recv_us = 0
         self._handlers: dict[str, Callable[[Any, LinkContext], None]] = {
-            "MISSION_REQUEST_LIST": self._on_request_list,
-            "MISSION_COUNT": self._on_count,
-            "MISSION_CLEAR_ALL": self._on_clear_all,
-            "MISSION_ITEM": self._on_item,
-            "MISSION_ITEM_INT": self._on_item,
+            "MISSION_REQUEST_LIST": self._on_request_list, "MISSION_COUNT": self._on_count,
+            "MISSION_CLEAR_ALL": self._on_clear_all, "MISSION_ITEM": self._on_item,
+            "MISSION_ITEM_INT": self._on_item, "MISSION_REQUEST": self._on_request,
+            "MISSION_REQUEST_INT": self._on_request, "MISSION_ACK": self._on_ack,
+            "MISSION_SET_CURRENT": self._on_set_current,
         }
 
     def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None:
-        if not _addressed_to_us(cast("_MissionMessage", msg), ctx):  # the endpoint sends only MESSAGES
+        if not _addressed_to_us(msg, ctx):
             return
-        handler = self._handlers.get(msg.get_type())
-        if handler is not None:
-            handler(msg, ctx)
-        # MISSION_REQUEST(_INT) with no transfer running, and the GCS's closing MISSION_ACK: nothing to do.
+        kind = msg.get_type()
+        if kind in ("MISSION_ITEM", "MISSION_ITEM_INT", "MISSION_REQUEST", "MISSION_REQUEST_INT"):
+            self._int_mode = kind.endswith("_INT")  # PX4 follows the client's choice of message
+        self._handlers[kind](msg, ctx)
 
     def tick(self, ctx: LinkContext) -> None:
-        """Nothing to stream: an empty plan is answered in one message."""
-
-    @staticmethod
-    def _on_request_list(msg: dialect.MAVLink_mission_request_list_message, ctx: LinkContext) -> None:
-        if msg.mission_type not in _PLAN_NAMES:
-            _ack(msg, ctx, MAV_MISSION_UNSUPPORTED)
+        """Retries and the protocol timeout (MavlinkMissionManager::send)."""
+        if self._state == IDLE:
             return
-        ctx.send(ctx.mav.mission_count_encode(msg.get_srcSystem(), msg.get_srcComponent(), 0, msg.mission_type))
+        now = ctx.now_us
+        if now - self._sent_us > RETRY_US and self._state == GETLIST:
+            self._request(ctx, self._seq)
+        elif now - self._sent_us > RETRY_US and self._state == SENDLIST and self._seq == 0:
+            self._send_count(ctx, self._count)
+        elif now - self._recv_us > TIMEOUT_US:
+            _say(ctx, "Mission sync timeout")
+            self._end(ctx)
 
-    @staticmethod
-    def _on_count(msg: dialect.MAVLink_mission_count_message, ctx: LinkContext) -> None:
-        if msg.count == 0:  # uploading an empty plan clears it: accepted
-            _ack(msg, ctx, MAV_MISSION_ACCEPTED)
+    # ---- upload ---------------------------------------------------------------------------------------------------
+    def _on_count(self, msg: Any, ctx: LinkContext) -> None:
+        sender = _sender(msg)
+        if self._state == GETLIST:
+            self._count_while_receiving(msg, ctx, sender)
             return
-        what, plural = _PLAN_NAMES.get(msg.mission_type, ("Upload", "this plan type"))
-        ctx.vehicle.report(Severity.CRITICAL, "mavlink", f"{what} refused: {plural} are not supported yet",
-                           is_event=False)
-        _ack(msg, ctx, MAV_MISSION_UNSUPPORTED)
+        if self._state == SENDLIST:
+            _say(ctx, "WPM: IGN MISSION_COUNT: Busy")
+            self._ack(ctx, MAV_MISSION_ERROR, sender, msg.mission_type)
+            return
+        store = _store(ctx)
+        if not store.try_lock(self):  # another link is uploading
+            self._ack(ctx, MAV_MISSION_ERROR, sender, msg.mission_type)
+            return
+        self._recv_us, self._partner, self._type = ctx.now_us, sender, msg.mission_type
+        result = self._start_upload(msg.count, store)
+        if result is not None:
+            store.unlock(self)
+            self._ack(ctx, result)
+            return
+        self._request(ctx, 0)
 
-    @staticmethod
-    def _on_clear_all(msg: dialect.MAVLink_mission_clear_all_message, ctx: LinkContext) -> None:
-        _ack(msg, ctx, MAV_MISSION_ACCEPTED)
+    def _start_upload(self, count: int, store: MissionStore) -> int | None:
+        """GETLIST for `count` items; or the answer at once (too many, an empty plan stored, an unknown type)."""
+        if count > MAX_ITEMS.get(self._type, 0):
+            return MAV_MISSION_NO_SPACE
+        if self._type not in PLAN_TYPES:
+            return MAV_MISSION_INVALID
+        if count == 0:
+            store.clear(self._type)
+            return MAV_MISSION_ACCEPTED
+        self._state, self._seq, self._count = GETLIST, 0, count
+        self._items, self._marked_current = [], -1
+        return None
 
-    @staticmethod
-    def _on_item(msg: _Item, ctx: LinkContext) -> None:
-        ctx.vehicle.report(Severity.CRITICAL, "mavlink", "IGN MISSION_ITEM: No transfer")
-        _ack(msg, ctx, MAV_MISSION_ERROR)
+    def _count_while_receiving(self, msg: Any, ctx: LinkContext, sender: tuple[int, int]) -> None:
+        self._recv_us = ctx.now_us
+        if sender != self._partner:
+            self._ack(ctx, MAV_MISSION_ERROR, sender, msg.mission_type)
+        elif self._seq == 0:  # our first request was lost: ask again
+            self._request(ctx, 0)
+        else:
+            _say(ctx, "WPM: REJ. CMD: Busy")
+            self._ack(ctx, MAV_MISSION_ERROR)
+
+    def _on_item(self, msg: Any, ctx: LinkContext) -> None:
+        if _sender(msg) != self._partner:
+            _say(ctx, "REJ. MIS ITEM: partner id mismatch")
+        elif msg.mission_type != self._type:
+            self._ack(ctx, MAV_MISSION_ERROR)
+        elif self._state == IDLE:
+            self._item_while_idle(msg, ctx)
+        elif self._state == SENDLIST:
+            _say(ctx, "IGN MISSION_ITEM: Busy")
+            self._ack(ctx, MAV_MISSION_ERROR)
+        else:
+            self._recv_us = ctx.now_us
+            if msg.seq == self._seq:  # an item out of sequence is dropped: the retry asks for the right one
+                self._take_item(msg, ctx)
+
+    def _item_while_idle(self, msg: Any, ctx: LinkContext) -> None:
+        if self._seq == msg.seq + 1 and self._count == self._seq:
+            self._ack(ctx, MAV_MISSION_ACCEPTED)  # the last item again: the client missed our final ACK
+        else:
+            _say(ctx, "IGN MISSION_ITEM: No transfer")
+            self._ack(ctx, MAV_MISSION_ERROR)
+
+    def _take_item(self, msg: Any, ctx: LinkContext) -> None:
+        result, item = parse_item(msg, self._int_mode)
+        if item is None:
+            _say(ctx, "IGN MISSION_ITEM: Invalid item")
+            self._ack(ctx, result)
+            self._end(ctx)
+            return
+        if not plan_check(self._type, item):
+            self._ack(ctx, MAV_MISSION_ERROR)
+            self._end(ctx)
+            return
+        self._items.append(item)
+        if msg.current:
+            self._marked_current = msg.seq
+        self._seq = msg.seq + 1
+        if self._seq < self._count:
+            self._request(ctx, self._seq)
+            return
+        self._store_upload(ctx)
+        self._state = IDLE
+        self._ack(ctx, MAV_MISSION_ACCEPTED)
+        _store(ctx).unlock(self)
+
+    def _store_upload(self, ctx: LinkContext) -> None:
+        store = _store(ctx)
+        items = tuple(self._items)
+        if self._type == PLAN_MISSION:
+            # PX4's navigator looks these up (its feasibility checks) once a mission exists: listed from now on
+            ctx.vehicle.params.mark_used("MIS_DIST_1WP")
+            ctx.vehicle.params.mark_used("MIS_TKO_LAND_REQ")
+        if plan_id(items) != store.plan(self._type).opaque_id or store.count(self._type) == 0:
+            store.replace(self._type, items, self._marked_current)  # PX4 updates only a changed plan
+
+    def _request(self, ctx: LinkContext, seq: int) -> None:
+        self._sent_us = ctx.now_us
+        if self._int_mode:
+            ctx.send(ctx.mav.mission_request_int_encode(*self._partner, seq, self._type))
+        else:
+            ctx.send(ctx.mav.mission_request_encode(*self._partner, seq, self._type))
+
+    # ---- download -------------------------------------------------------------------------------------------------
+    def _on_request_list(self, msg: Any, ctx: LinkContext) -> None:
+        sender = _sender(msg)
+        if self._state == SENDLIST and self._seq == self._count:
+            self._state = IDLE  # everything was sent: a new request may start even without the client's ACK
+        same = self._state == SENDLIST and self._type == msg.mission_type and sender == self._partner
+        if self._state != IDLE and not same:
+            _say(ctx, "Mission download request ignored, already active", Severity.INFO)
+            return
+        self._state, self._type, self._partner = SENDLIST, msg.mission_type, sender
+        self._recv_us, self._seq = ctx.now_us, 0
+        self._count = _store(ctx).count(self._type) if self._type in PLAN_TYPES else 0
+        self._send_count(ctx, self._count)
+
+    def _send_count(self, ctx: LinkContext, count: int) -> None:
+        self._sent_us = ctx.now_us
+        ctx.send(ctx.mav.mission_count_encode(*self._partner, count, self._type))
+
+    def _on_request(self, msg: Any, ctx: LinkContext) -> None:
+        if _sender(msg) != self._partner:
+            _say(ctx, "WPM: REJ. CMD: partner id mismatch")
+        elif self._state == GETLIST:
+            _say(ctx, "WPM: REJ. CMD: Busy")
+        elif self._state == SENDLIST and msg.mission_type == self._type:
+            self._recv_us = ctx.now_us
+            if msg.seq == self._seq and self._seq < self._count:
+                self._seq += 1
+            elif msg.seq != self._seq - 1:  # neither the next item nor the last one again
+                self._refuse_request(ctx)
+                return
+            self._send_item(ctx, msg.seq)
+        # IDLE: silently ignored, as PX4 does ("some OSDs have buggy mission protocol implementations")
+
+    def _send_item(self, ctx: LinkContext, seq: int) -> None:
+        store = _store(ctx)
+        plan = store.plan(self._type)
+        if seq >= plan.count:  # the plan changed under the download
+            self._refuse_request(ctx)
+            return
+        current = seq == store.current_seq  # PX4 compares with the mission's current item for every plan type
+        self._sent_us = ctx.now_us
+        ctx.send(item_message(ctx.mav, self._partner, plan.items[seq], current, self._type, self._int_mode))
+
+    def _refuse_request(self, ctx: LinkContext) -> None:
+        self._state = IDLE
+        self._ack(ctx, MAV_MISSION_ERROR)
+        _say(ctx, "WPM: REJ. CMD: Req. WP was unexpected")
+
+    def _on_ack(self, msg: Any, ctx: LinkContext) -> None:
+        if _sender(msg) != self._partner:
+            _say(ctx, "REJ. WP CMD: partner id mismatch")
+        elif self._state == SENDLIST and msg.mission_type == self._type:
+            self._state = IDLE  # the download is over, whatever the client says
+        elif self._state == GETLIST and msg.type == MAV_MISSION_UNSUPPORTED:
+            self._int_mode = not self._int_mode  # the client cannot send this flavour: ask for the other
+            self._request(ctx, self._seq)
+        elif self._state == GETLIST and msg.type == MAV_MISSION_OPERATION_CANCELLED:
+            self._end(ctx)
+
+    # ---- clear, set current -----------------------------------------------------------------------------------------
+    def _on_clear_all(self, msg: Any, ctx: LinkContext) -> None:
+        if self._state != IDLE:
+            _say(ctx, "WPM: IGN CLEAR CMD: Busy")
+            return
+        if msg.mission_type in PLAN_TYPES or msg.mission_type == PLAN_ALL:
+            _store(ctx).clear(msg.mission_type)
+        self._ack(ctx, MAV_MISSION_ACCEPTED, _sender(msg), msg.mission_type)
+
+    def _on_set_current(self, msg: Any, ctx: LinkContext) -> None:
+        if self._state != IDLE:
+            _say(ctx, "WPM: IGN WP CURR CMD: Busy")
+            return
+        store = _store(ctx)
+        if not store.set_current(msg.seq):
+            _say(ctx, "WPM: WP CURR CMD: Not in list")
+            return
+        # the navigator's mission_result changes: every link reports the new current item at once
+        fields = mission_current_fields(store, ctx.vehicle.snapshot().nav_state)
+        ctx.broadcast(ctx.mav.mission_current_encode(*fields))
+
+    # ---- helpers ----------------------------------------------------------------------------------------------------
+    def _end(self, ctx: LinkContext) -> None:
+        self._state = IDLE
+        _store(ctx).unlock(self)
+
+    def _ack(self, ctx: LinkContext, result: int, target: tuple[int, int] | None = None,
+             mission_type: int | None = None) -> None:
+        to = self._partner if target is None else target
+        kind = self._type if mission_type is None else mission_type
+        ctx.send(ctx.mav.mission_ack_encode(*to, result, kind))
 
 
-def _addressed_to_us(msg: _MissionMessage, ctx: LinkContext) -> bool:
+def _store(ctx: LinkContext) -> MissionStore:
+    return ctx.vehicle.mission_store()
+
+
+def _sender(msg: Any) -> tuple[int, int]:
+    return msg.get_srcSystem(), msg.get_srcComponent()
+
+
+def _say(ctx: LinkContext, text: str, severity: Severity = Severity.CRITICAL) -> None:
+    """PX4's send_statustext_critical/_info: a tab-terminated STATUSTEXT (it is also an event) on every link."""
+    ctx.vehicle.report(severity, "mavlink", text)
+
+
+def _addressed_to_us(msg: Any, ctx: LinkContext) -> bool:
     """CHECK_SYSID_COMPID_MISSION: own sysid exactly; own compid, the mission planner's (190) or 0."""
     return msg.target_system == ctx.sysid and msg.target_component in (ctx.compid, MAV_COMP_ID_MISSIONPLANNER, 0)
-
-
-def _ack(msg: _MissionMessage, ctx: LinkContext, result: int) -> None:
-    mission_type = getattr(msg, "mission_type", MISSION_TYPE_MISSION)
-    ctx.send(ctx.mav.mission_ack_encode(msg.get_srcSystem(), msg.get_srcComponent(), result, mission_type))

@@ -11,6 +11,7 @@ import math
 from typing import TYPE_CHECKING, Final
 
 from sitl_emu.mavlink.extra_messages import EXTRA
+from sitl_emu.mavlink.mission_items import mission_current_fields
 from sitl_emu.mavlink.telemetry_msgs import UINT16_MAX
 from sitl_emu.types import VehicleSnapshot
 
@@ -107,10 +108,11 @@ def estimator_sensor_fusion_status(ctx: EndpointContext, snap: VehicleSnapshot) 
 
 
 def mission_current(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
-    """mavlink_mission.cpp send_mission_current, about once a second on every link: with no mission, item 0 of
-    total UINT16_MAX; state and mode unset (0); the plan ids (CRC32 of each plan, 0 when empty) are extension fields
-    pymavlink lacks, zero on the wire anyway."""
-    return ctx.encoder.mission_current_encode(0, UINT16_MAX, 0, 0)
+    """mavlink_mission.cpp send_mission_current, about once a second on every link: the stored mission's current item
+    and count (total UINT16_MAX with none), its state (NO_MISSION, or NOT_STARTED while stored and not flown) and
+    whether the vehicle is in a mode that flies it (mission_items.mission_current_fields). The plan ids (a CRC32 per
+    plan) are extension fields pymavlink lacks, so they are not on the wire."""
+    return ctx.encoder.mission_current_encode(*mission_current_fields(ctx.vehicle.mission_store(), snap.nav_state))
 
 
 # RTL time estimate (navigator's RtlTimeEstimator) with PX4's multicopter defaults: return altitude RTL_RETURN_ALT

@@ -1,7 +1,8 @@
 """Conformance: MAVSDK (the native `mavsdk` >= 4 binding, MAVSDK's C++ core) flies `sitl-emu serve` as it flies PX4.
 
-One test runs a whole session against a server started on free ports: connect, health, MAVLink shell, parameters
-(REAL32 and INT32), arm, takeoff, offboard position / velocity NED / velocity body, hold, return and land.
+One test runs a whole session against a server started on free ports: connect, health, MAVLink shell, a mission
+upload, download and clear, parameters (REAL32 and INT32), arm, takeoff, offboard position / velocity NED /
+velocity body, hold, return and land.
 Every MAVSDK call and its outcome is printed at the end (run with -s to see the table).
 
 MAVSDK's timeouts run on the wall clock (0.5 s command retries, 3 s heartbeat timeout), so the server runs only a few
@@ -137,22 +138,44 @@ async def _check_shell(system: Any, s: Session) -> None:
 
 
 async def _check_missions(system: Any, s: Session) -> None:
-    """No plan is stored: downloads are empty, an upload is refused at once (not left to time out)."""
+    """An empty download, then a mission uploaded, downloaded back item for item, and cleared (PX4's protocol)."""
     from mavsdk.asyncio.plugins.mission_raw import MissionRawAsync
-    from mavsdk.plugins.mission_raw import MissionItem, MissionRawError, MissionRawResult
+    from mavsdk.plugins.mission_raw import MissionItem
 
     mission_raw = MissionRawAsync(system)
     assert await s.call("MissionRaw.download_mission", mission_raw.download_mission()) in ([], None)
-    item = MissionItem(seq=0, frame=6, command=16, current=1, autocontinue=1, x=473977420, y=85455940, z=10.0,
-                       mission_type=0)
-    started = time.monotonic()
-    with pytest.raises(MissionRawError) as refused:
-        await asyncio.wait_for(mission_raw.upload_mission([item]), CALL_TIMEOUT_S)
-    elapsed_s = time.monotonic() - started
-    s.calls.append(("MissionRaw.upload_mission(1 waypoint)", f"refused as expected: {refused.value.result.name} "
-                    f"after {elapsed_s:.2f} s"))
-    assert refused.value.result == MissionRawResult.UNSUPPORTED
-    assert elapsed_s < 3.0
+    nan = float("nan")
+    items = [MissionItem(seq=0, frame=6, command=22, current=1, autocontinue=1, param1=0.0, param2=0.0, param3=0.0,
+                         param4=nan, x=473977420, y=85455940, z=5.0, mission_type=0),
+             MissionItem(seq=1, frame=6, command=16, current=0, autocontinue=1, param1=0.0, param2=0.0, param3=0.0,
+                         param4=nan, x=473978500, y=85455940, z=5.0, mission_type=0),
+             MissionItem(seq=2, frame=2, command=20, current=0, autocontinue=1, param1=0.0, param2=0.0, param3=0.0,
+                         param4=0.0, x=0, y=0, z=0.0, mission_type=0)]
+    await s.call("MissionRaw.upload_mission(takeoff, waypoint, RTL)", mission_raw.upload_mission(items))
+    got = await s.call("MissionRaw.download_mission", mission_raw.download_mission())
+    assert [(i.seq, i.frame, i.command, i.x, i.y, i.z) for i in got] == [
+        (i.seq, i.frame, i.command, i.x, i.y, i.z) for i in items]
+    await s.call("MissionRaw.clear_mission", mission_raw.clear_mission())
+    assert await s.call("MissionRaw.download_mission", mission_raw.download_mission()) in ([], None)
+    await _check_mission_plan(system, s)
+
+
+async def _check_mission_plan(system: Any, s: Session) -> None:
+    """MAVSDK's Mission plugin (the `mission` example): its items become waypoints plus DO_CHANGE_SPEED items."""
+    from mavsdk.asyncio.plugins.mission import MissionAsync
+    from mavsdk.plugins.mission import MissionItem, MissionPlan
+
+    mission = MissionAsync(system)
+    nan = float("nan")
+    points = [(47.398039, 8.545594, 10.0), (47.398036, 8.543587, 12.0)]
+    items = [MissionItem(lat, lon, alt, 5.0, True, nan, nan, MissionItem.CameraAction.NONE, nan, nan, nan, nan, nan,
+                         MissionItem.VehicleAction.NONE) for lat, lon, alt in points]
+    await s.call("Mission.upload_mission(2 waypoints at 5 m/s)", mission.upload_mission(MissionPlan(items)))
+    plan = await s.call("Mission.download_mission", mission.download_mission())
+    got = [(i.latitude_deg, i.longitude_deg, i.relative_altitude_m, i.speed_m_s) for i in plan.mission_items]
+    assert got == [(pytest.approx(lat), pytest.approx(lon), pytest.approx(alt), pytest.approx(5.0))
+                   for lat, lon, alt in points]
+    await s.call("Mission.clear_mission", mission.clear_mission())
 
 
 async def _echo(value: Any) -> Any:

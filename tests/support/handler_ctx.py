@@ -12,6 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.px4 import LandedState, MavResult, NavState, Severity
 from sitl_emu.types import CommandAck, VehicleCommand, VehicleEvent, VehicleSnapshot
@@ -114,6 +115,10 @@ class FakeVehicle:
         self.on_command: Callable[[VehicleCommand], None] | None = None
         self.snap = make_snapshot()
         self._events: list[VehicleEvent] = []
+        self._missions = MissionStore()
+
+    def mission_store(self) -> MissionStore:
+        return self._missions
 
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         self.commands.append(cmd)
