@@ -41,7 +41,7 @@ def test_top_level_keys_work_without_a_fly_table(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("options", "fragment"), [
     ({"rate": 5.0}, "--rate 5 is out of range: use 10 to 200 Hz (PX4 leaves OFFBOARD after 1 s"),
     ({"on_exit": "crash"}, "--on-exit crash is not a choice here: use one of land, hold, rtl."),
-    ({"control": "rate"}, "--control rate is not a choice here: use one of velocity, step."),
+    ({"control": "rate"}, "--control rate is not a choice here: use one of velocity, step, position, altitude."),
     ({"min_alt": 5.0, "max_alt": 4.0}, "--min-alt 5 must be below --max-alt (4 m)"),
     ({"alt": 20.0}, "--alt 20 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),
     ({"max_alt": 2.0}, "the default --alt 3 is out of range: use 0.5 to 2 m"),
