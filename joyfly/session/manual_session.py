@@ -24,6 +24,7 @@ or Land the sticks still stream: moving them hands control back as PX4 does (its
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 from joyfly.link.vehicle_link import (
     MAIN_ALTCTL,
@@ -38,7 +39,14 @@ from joyfly.session.core import Note, Phase, SessionSettings, StickSource
 from joyfly.session.loop import SessionLoop
 from joyfly.session.retry import Retry
 from joyfly.sticks.manual import CENTRED, ManualInput, interlock, to_manual
-from joyfly.sticks.manual_fence import PX4, ManualModel, limit_manual
+from joyfly.sticks.manual_fence import (
+    PX4,
+    ManualModel,
+    SetpointEstimate,
+    advance_estimate,
+    limit_tracked,
+    restart_estimate,
+)
 from joyfly.types import Clock
 
 # --control -> (PX4 main mode, its name, in words)
@@ -70,6 +78,7 @@ class ManualSession(SessionLoop):
         self._latched = True  # the throttle interlock (sticks/manual.py)
         self._joy_hold = False  # holding in AUTO.LOITER for a lost joystick
         self._from_air = False  # ENTERING a flying vehicle (not arming one on the ground)
+        self._est = SetpointEstimate()  # PX4's POSCTL velocity setpoint, estimated from what was sent
 
     def in_control(self, st: VehicleState) -> bool:
         return st.last_heartbeat_s is not None and main_mode(st.custom_mode) in STICK_MODES
@@ -113,13 +122,18 @@ class ManualSession(SessionLoop):
 
     def _sticks_to_send(self) -> ManualInput:
         """The pilot's sticks (interlocked, fenced) while armed in a pilot phase, else centred."""
-        st = self.link.state
+        st, now = self.link.state, self.clock.now()
+        mode = main_mode(st.custom_mode)
+        # PX4 runs its POSCTL setpoint only in POSCTL, and restarts it from the vehicle's velocity until takeoff
+        est = self._est if mode == MAIN_POSCTL and st.landed_state != 1 else restart_estimate(st.vel_ned_m_s, now)
         if (not st.armed or self.phase not in PILOT_PHASES or self._joy_hold or self._joy.lost
                 or self.cmd.deadman_ok is False or st.pos_ned_m is None):
+            self._est = replace(advance_estimate(est, now, st.vel_ned_m_s, self.model), stick_ne=(0.0, 0.0))
             return CENTRED
         inp, self._latched = interlock(to_manual(self.cmd), self._latched)
-        altitude = main_mode(st.custom_mode) == MAIN_ALTCTL
-        return limit_manual(inp, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, self.fence, altitude, self.model)
+        out, self._est = limit_tracked(inp, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, self.fence,
+                                       mode == MAIN_ALTCTL, est, now, self.model)
+        return out
 
     # --- taking control ----------------------------------------------------------------------------------------
 

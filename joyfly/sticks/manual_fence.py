@@ -17,14 +17,19 @@ PX4's (defaults of PX4 main, 2026; src/lib/sticks/Sticks.cpp, flight_mode_manage
 
 The rule (`allowed_speed`): towards a side, the vehicle may move at most as fast as it can still stop before that side
 less a `buffer_m`, planning a deceleration of `brake_acc_m_s2` = MPC_ACC_HOR / 2 (1.5 m/s^2) after a reaction time
-of `reaction_s` (0.7 s: the stream period, PX4's loops, the telemetry's age and the jerk-limited start of braking).
-That is conservative against real PX4: released at 6 m/s in POSCTL, it stops within 10.5 m (the reference trace
-p_fwd), where this rule plans for 16 m. The stick component towards the side is then set so the vehicle's measured
-speed tracks that allowance (gain `track_gain_1_s`): it falls to 0 at the buffer and turns into a brake (a push
-inwards) when the vehicle is faster than allowed; it never pushes further out than the pilot does. In POSCTL a
-fully released stick is left alone (PX4's own brake and position lock are stronger); in ALTCTL, where nothing else
-stops a drifting vehicle, the brake applies whatever the pilot does. Vertically, the throttle's climb (descent) is
-limited to the allowance above (below) the vehicle, down to the centred throttle, which holds the altitude.
+of `reaction_s` (1.2 s: the stream period, PX4's loops, the telemetry's age, the jerk-limited start of braking and
+the vehicle lagging its velocity setpoint). That is conservative against real PX4: released at 6 m/s in POSCTL, it
+stops within 10.5 m (the reference trace p_fwd), where this rule plans for 19 m; a model of PX4's stick dynamics
+with the vehicle lagging twice as much as PX4 did still stops inside (tests/joyfly/test_manual_fence.py).
+The stick component towards the side is then set so the vehicle's speed tracks that allowance (gain
+`track_gain_1_s`): it falls to 0 at the buffer and turns into a brake (a push inwards) when the vehicle is faster
+than allowed; it never pushes further out than the pilot does. The speed is the larger
+of the measured one and, in POSCTL, PX4's own velocity setpoint as joyfly estimates it from the sticks it sent
+(`SetpointEstimate`): that setpoint runs well ahead of the vehicle while it accelerates, and a rule on the measured
+speed alone lets it overshoot. In POSCTL a fully released stick is left alone (PX4's own brake and position lock are
+stronger); in ALTCTL, where nothing else stops a drifting vehicle, the brake applies whatever the pilot does.
+Vertically, the throttle's climb (descent) is limited to the allowance above (below) the vehicle, down to the
+centred throttle, which holds the altitude.
 """
 
 from __future__ import annotations
@@ -46,15 +51,16 @@ class ManualModel:
 
     vel_manual_m_s: float = 10.0  # MPC_VEL_MANUAL
     acc_hor_m_s2: float = 3.0  # MPC_ACC_HOR
+    jerk_max_m_s3: float = 8.0  # MPC_JERK_MAX
     tilt_max_deg: float = 35.0  # MPC_MAN_TILT_MAX
     z_vel_up_m_s: float = 3.0  # MPC_Z_VEL_MAX_UP
     z_vel_down_m_s: float = 1.5  # MPC_Z_VEL_MAX_DN
     deadzone: float = 0.1  # MAN_DEADZONE
     expo: float = 0.6  # the Sticks library's fixed expo (MPC_XY_MAN_EXPO / MPC_Z_MAN_EXPO's old default)
     brake_acc_m_s2: float = 1.5  # planned deceleration: MPC_ACC_HOR / 2
-    reaction_s: float = 0.7
+    reaction_s: float = 1.2
     buffer_m: float = 0.5  # where the vehicle stops, inside the fence
-    track_gain_1_s: float = 2.0  # how fast the stick pulls the speed to the allowance
+    track_gain_1_s: float = 3.0  # how fast the stick pulls the speed to the allowance
     return_gain_1_s: float = 1.0  # inside the buffer: back out of it at this many m/s per metre
 
     @property
@@ -119,13 +125,14 @@ def allowed_speed(room_m: float, m: ManualModel = PX4) -> float:
     return a * (-t + math.sqrt(t * t + 2.0 * room / a))
 
 
-def _limit_axis(u: float, pos: float, vel: float, centre: float, half_width: float, acc: float, drag: float,
-                m: ManualModel) -> float:
-    """One world axis of the (shaped) stick, limited against both sides of the fence."""
+def _limit_axis(u: float, pos: float, vel: tuple[float, float], centre: float, half_width: float, acc: float,
+                drag: float, m: ManualModel) -> float:
+    """One world axis of the (shaped) stick, limited against both sides of the fence; `vel` = (measured, PX4's
+    setpoint) velocity along the axis."""
     for side in (1.0, -1.0):
         room = (centre + side * half_width - pos) * side
-        v_out = vel * side
-        cap = (m.track_gain_1_s * (allowed_speed(room, m) - v_out) + drag * v_out) / acc
+        v_out = max(vel[0] * side, vel[1] * side)
+        cap = (m.track_gain_1_s * (allowed_speed(room, m) - v_out) + drag * vel[1] * side) / acc
         if u * side > cap:
             u = cap * side
     return max(-1.0, min(1.0, u))
@@ -137,19 +144,31 @@ def _rotate(f: float, r: float, yaw: float) -> tuple[float, float]:
     return c * f - s * r, s * f + c * r
 
 
+def _unit_limited(f: float, r: float) -> tuple[float, float]:
+    norm = math.hypot(f, r)
+    return (f / norm, r / norm) if norm > 1.0 else (f, r)
+
+
+def shaped_world(inp: ManualInput, yaw: float, m: ManualModel = PX4) -> tuple[float, float]:
+    """The right stick as PX4's POSCTL acts on it: shaped, limited to the unit circle, rotated into north/east."""
+    return _rotate(*_unit_limited(px4_shape(inp.x / 1000, m), px4_shape(inp.y / 1000, m)), yaw)
+
+
 def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence: Fence, altitude_mode: bool,
-                     m: ManualModel = PX4) -> tuple[float, float]:
-    """The right stick (x forward, y right, -1..1) limited by the fence's sides; unchanged when nothing binds."""
+                     m: ManualModel = PX4, vel_sp_ne: tuple[float, float] | None = None) -> tuple[float, float]:
+    """The right stick (x forward, y right, -1..1) limited by the fence's sides; unchanged when nothing binds.
+    `vel_sp_ne`: PX4's POSCTL velocity setpoint as estimated (`SetpointEstimate`), else the measured velocity."""
     if not fence.enabled:
         return x, y
     shape: Callable[[float], float] = (lambda s: s) if altitude_mode else (lambda s: px4_shape(s, m))
-    north, east = _rotate(shape(x), shape(y), yaw)
+    north, east = _rotate(*_unit_limited(shape(x), shape(y)), yaw)  # PX4 limits the stick to the unit circle
     if not altitude_mode and abs(north) < STICK_EPS and abs(east) < STICK_EPS:
         return x, y  # POSCTL brakes harder and locks the position by itself when the stick is released
     acc, drag = (m.tilt_acc_m_s2, 0.0) if altitude_mode else (m.pos_acc_m_s2, m.pos_drag_1_s)
     hx, hy, _ = fence.home_ned_m
-    n2 = _limit_axis(north, pos[0], vel[0], hx, fence.half_width_m, acc, drag, m)
-    e2 = _limit_axis(east, pos[1], vel[1], hy, fence.half_width_m, acc, drag, m)
+    sp = vel_sp_ne if vel_sp_ne is not None and not altitude_mode else (vel[0], vel[1])
+    n2 = _limit_axis(north, pos[0], (vel[0], sp[0]), hx, fence.half_width_m, acc, drag, m)
+    e2 = _limit_axis(east, pos[1], (vel[1], sp[1]), hy, fence.half_width_m, acc, drag, m)
     if abs(n2 - north) < STICK_EPS and abs(e2 - east) < STICK_EPS:
         return x, y
     f, r = _rotate(n2, e2, -yaw)
@@ -175,10 +194,77 @@ def limit_throttle(throttle: float, alt_m: float, climb_m_s: float, fence: Fence
 
 
 def limit_manual(inp: ManualInput, pos: Vec3, vel: Vec3, yaw: float, fence: Fence, altitude_mode: bool,
-                 m: ManualModel = PX4) -> ManualInput:
-    """The MANUAL_CONTROL sticks limited by the fence (horizontal sides, altitude band); yaw passes unchanged."""
-    x, y = limit_horizontal(inp.x / 1000, inp.y / 1000, pos, vel, yaw, fence, altitude_mode, m)
+                 m: ManualModel = PX4, vel_sp_ne: tuple[float, float] | None = None) -> ManualInput:
+    """The MANUAL_CONTROL sticks limited by the fence (horizontal sides, altitude band); yaw passes unchanged.
+    `vel_sp_ne`: PX4's POSCTL velocity setpoint as estimated (`SetpointEstimate`), if known."""
+    x, y = limit_horizontal(inp.x / 1000, inp.y / 1000, pos, vel, yaw, fence, altitude_mode, m, vel_sp_ne)
     throttle = limit_throttle(inp.throttle, fence.alt_m(pos), -vel[2], fence, m)
     out = replace(inp, x=round(x * 1000) if x != inp.x / 1000 else inp.x,
                   y=round(y * 1000) if y != inp.y / 1000 else inp.y)
     return replace(out, z=from_throttle(throttle)) if throttle != inp.throttle else out
+
+
+# --- PX4's POSCTL velocity setpoint, estimated from the sticks sent -------------------------------------------------
+
+ESTIMATE_STEP_S = 0.02  # PX4's flight tasks run at 50 Hz
+ESTIMATE_STALE_S = 0.5  # a gap this long (no stream) and the estimate starts again from the measured velocity
+
+
+@dataclass(frozen=True, slots=True)
+class SetpointEstimate:
+    """PX4's POSCTL horizontal velocity setpoint (north, east) as joyfly estimates it: StickAccelerationXY (spec
+    above) run on the stick joyfly sent last (`stick_ne`, shaped and rotated: `shaped_world`), with its jerk limit
+    (MPC_JERK_MAX) per axis and without its tilt limit. `time_s` None: nothing to go on yet."""
+
+    vel_ne: tuple[float, float] = (0.0, 0.0)
+    boost: float = 1.0
+    stick_ne: tuple[float, float] = (0.0, 0.0)
+    time_s: float | None = None
+    acc_ne: tuple[float, float] = (0.0, 0.0)
+
+
+def restart_estimate(vel: Vec3, now_s: float) -> SetpointEstimate:
+    """PX4 starts the setpoint from the vehicle's velocity (FlightTaskManualAcceleration::activate, and every cycle
+    on the ground before the takeoff ramp)."""
+    return SetpointEstimate((vel[0], vel[1]), 1.0, (0.0, 0.0), now_s)
+
+
+def advance_estimate(est: SetpointEstimate, now_s: float, vel: Vec3, m: ManualModel = PX4) -> SetpointEstimate:
+    """The estimate at `now_s`, the last stick held since `est.time_s`."""
+    if est.time_s is None or not 0.0 <= now_s - est.time_s <= ESTIMATE_STALE_S:
+        return restart_estimate(vel, now_s)
+    v, a, boost, elapsed = list(est.vel_ne), list(est.acc_ne), est.boost, now_s - est.time_s
+    released = est.stick_ne[0] ** 2 + est.stick_ne[1] ** 2 < 1.19e-7
+    while elapsed > 1e-9:
+        dt = min(ESTIMATE_STEP_S, elapsed)
+        elapsed -= dt
+        boost += dt / (0.8 + dt) * ((max(2.0, math.sqrt(m.vel_manual_m_s)) if released else 1.0) - boost)
+        drag = _drag(v[0], v[1], boost, m)
+        if released and v[0] ** 2 + v[1] ** 2 < (drag[0] ** 2 + drag[1] ** 2) * dt * dt:
+            v, drag = [0.0, 0.0], (0.0, 0.0)
+        for i in (0, 1):
+            wanted = m.pos_acc_m_s2 * est.stick_ne[i] - drag[i]
+            a[i] += min(max(wanted - a[i], -m.jerk_max_m_s3 * dt), m.jerk_max_m_s3 * dt)
+            v[i] += a[i] * dt
+    return SetpointEstimate((v[0], v[1]), boost, est.stick_ne, now_s, (a[0], a[1]))
+
+
+def _drag(vn: float, ve: float, boost: float, m: ManualModel) -> tuple[float, float]:
+    """StickAccelerationXY's drag: linear, boosted and square-root shaped below 1 m/s once the stick is released."""
+    speed = math.hypot(vn, ve)
+    if speed == 0.0:
+        return 0.0, 0.0
+    c = m.pos_drag_1_s * boost
+    brake = min(max(boost - 1.0, 0.0), 1.0)
+    boosted = (math.sqrt(speed) if speed < 1.0 else speed) / speed
+    scale = c * (brake * boosted + (1.0 - brake))
+    return scale * vn, scale * ve
+
+
+def limit_tracked(inp: ManualInput, pos: Vec3, vel: Vec3, yaw: float, fence: Fence, altitude_mode: bool,
+                  est: SetpointEstimate, now_s: float, m: ManualModel = PX4) -> tuple[ManualInput, SetpointEstimate]:
+    """`limit_manual` with PX4's POSCTL velocity setpoint estimated along the way: pass the estimate the previous call
+    returned (SetpointEstimate() at first, or restart_estimate() when PX4 restarts its setpoint)."""
+    est = restart_estimate(vel, now_s) if altitude_mode else advance_estimate(est, now_s, vel, m)
+    out = limit_manual(inp, pos, vel, yaw, fence, altitude_mode, m, None if altitude_mode else est.vel_ne)
+    return out, replace(est, stick_ne=(0.0, 0.0) if altitude_mode else shaped_world(out, yaw, m))
