@@ -166,3 +166,4 @@ class VehicleSnapshot:
     # the kinds of the last offboard message since boot, fresh or not: PX4's commander derives OFFBOARD's control
     # mode from the last offboard_control_mode it received (HEARTBEAT base_mode), whatever its age
     offboard_control_last: OffboardControlMode | None = None
+    manual_control: bool = False  # a manual input (MAVLink joystick) is present: SYS_STATUS's RC receiver

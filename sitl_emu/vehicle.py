@@ -241,4 +241,5 @@ class Vehicle:
             home=c.home, local_setpoint=local_sp, attitude_setpoint_q_wxyz=q_sp, rates_setpoint_rad_s=rates_sp,
             thrust_setpoint=thrust, motors=self._state.motors, extras={"system_status": float(c.system_status())},
             motor_commands=self._motor_commands, offboard_control_last=offboard_last,
+            manual_control=c.manual_control_valid(self._time_us),
         )

@@ -51,9 +51,11 @@ class ControlChain:
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
         """What the navigator task sees (tasks_core.NavInput)."""
         home = c.home
+        local = self.control.local_setpoint
         return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, yaw_from_q(est.q_wxyz),
                         home.pos_ned_m if home else (0.0, 0.0, 0.0), home.yaw_rad if home else 0.0, c.landed, c.armed,
-                        self.control.takeoff.state, ref.alt_amsl_m)
+                        self.control.takeoff.state, ref.alt_amsl_m,
+                        local.velocity_ned_m_s if local is not None else NAN3)
 
     def control_update(self, est: RigidBodyState, out: ExecutorOutput, armed: bool, landed: bool, now_us: int,
                        dt_s: float) -> Vec4:

@@ -179,8 +179,9 @@ class Commander:
             return
         if self._failsafe.manual_loss.hold_s(self.now_us) > 0:
             return  # no stick takeover during the Hold before a failsafe action (framework.cpp)
+        in_failsafe = self.failsafe  # taking over from a failsafe action is told as an event only
         if self.change_mode(NavState.POSCTL) or self.change_mode(NavState.ALTCTL):
-            self.say(Severity.INFO, "Pilot took over using sticks", statustext=not self.failsafe)
+            self.say(Severity.INFO, "Pilot took over using sticks", statustext=not in_failsafe)
 
     def manual_control_valid(self, now_us: int) -> bool:
         return self.manual.valid(now_us, self.settings.rc_loss_us)

@@ -7,7 +7,9 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 - Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
   loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
 - OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
-- manual and termination modes have no setpoint (the controller idles or the motors stop).
+- POSCTL and ALTCTL run the manual flight tasks (flight/tasks_manual.py) on the latest sticks; STABILIZED and
+  MANUAL turn the sticks into an attitude and thrust every tick (flight/stabilized.py); termination has no
+  setpoint (the motors stop).
 """
 
 from __future__ import annotations
@@ -15,22 +17,23 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Final
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.manual_control import CENTRED
+from sitl_emu.flight.stabilized import StabilizedMode
 from sitl_emu.flight.tasks import SetpointType
+from sitl_emu.flight.tasks_manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import AttitudeSetpoint, ManualControlSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
-# flight_mode_manager runs the task on each estimator update; sitl_emu runs it with the position controller (125 Hz)
-TASK_PERIOD_US: Final = 8000
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
-                         NavState.AUTO_RTL})
+                         NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL})
+_STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
+FlightTask = tasks.Task | ManualAltitudeTask
 
 
 @dataclass(slots=True)
@@ -63,14 +66,15 @@ class ModeExecutor:
 
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
-        self.task: tasks.Task | None = None
+        self.task: FlightTask | None = None
+        self._stabilized: StabilizedMode | None = None  # STABILIZED / MANUAL, while in force
         self._task_mode: NavState | None = None  # the mode self.task flies; None exactly when no task runs
         self._pending_takeoff: NavCommand | None = None  # NAV_TAKEOFF parameters, used when the takeoff starts
         self._offboard_kind: OffboardControlMode | None = None
         self._offboard_traj: TrajectorySetpoint | None = None
         self._offboard_att: AttitudeSetpoint | None = None
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
-        self._held: ExecutorOutput | None = None  # the task's last output, reused until TASK_PERIOD_US has passed
+        self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
         self.sticks: ManualControlSetpoint = CENTRED  # the last manual input (flight/manual_control.py)
 
@@ -90,6 +94,9 @@ class ModeExecutor:
                commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
+        if nav_state in _STICK_ATTITUDE_MODES:
+            return self._stick_attitude(armed, nav_fn, dt_s)
+        self._stabilized = None
         if nav_state is NavState.OFFBOARD:
             if self._offboard_out is None:
                 self._offboard_out = self._offboard_output()
@@ -98,15 +105,28 @@ class ModeExecutor:
             return _NO_SETPOINT
         return self._run_task(self.task, now_us, nav_fn, dt_s, new_task)
 
-    def _run_task(self, task: tasks.Task, now_us: int, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
+    def _stick_attitude(self, armed: bool, nav_fn: Callable[[], tasks.NavInput], dt_s: float) -> ExecutorOutput:
+        """STABILIZED / MANUAL: the sticks' attitude and thrust, every tick (mc_att_control)."""
+        if not armed:
+            self._stabilized = None
+            return _NO_SETPOINT
+        nav = nav_fn()
+        if self._stabilized is None:
+            self._stabilized = StabilizedMode(nav, self.params)
+        self._stabilized.sticks = self.sticks
+        return ExecutorOutput(None, self._stabilized.update(nav, dt_s), SetpointType.NONE, False, ())
+
+    def _run_task(self, task: FlightTask, now_us: int, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
                   new_task: bool) -> ExecutorOutput:
-        """The task's setpoint, computed every TASK_PERIOD_US (the last one is held in between)."""
+        """The task's setpoint, computed every task.period_us (the last one is held in between)."""
         held = self._held
         dt = dt_s
         if held is not None and not new_task:
-            if now_us - self._last_us < TASK_PERIOD_US:
+            if now_us - self._last_us < task.period_us:
                 return held
             dt = (now_us - self._last_us) * 1e-6
+        if isinstance(task, ManualAltitudeTask):
+            task.sticks = self.sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
         self._last_us = now_us
@@ -163,6 +183,10 @@ class ModeExecutor:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
             self.task = tasks.make_rtl(nav, self.params)
+        elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
+            self.task = ManualPositionTask(nav, self.params)
+        elif nav_state is NavState.ALTCTL:
+            self.task = ManualAltitudeTask(nav, self.params)
         else:
             self.task = tasks.make_land(nav, self.params)
 

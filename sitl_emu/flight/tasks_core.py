@@ -67,10 +67,11 @@ class NavInput:
     armed: bool
     takeoff_state: TakeoffState = TakeoffState.FLIGHT
     ref_alt_amsl_m: float = 488.0
+    vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD  # the position controller's last velocity setpoint (NaN: none)
 
     def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
                  home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: TakeoffState = TakeoffState.FLIGHT,
-                 ref_alt_amsl_m: float = 488.0) -> None:
+                 ref_alt_amsl_m: float = 488.0, vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD) -> None:
         self.time_us = time_us
         self.pos_ned_m = pos_ned_m
         self.vel_ned_m_s = vel_ned_m_s
@@ -81,6 +82,7 @@ class NavInput:
         self.armed = armed
         self.takeoff_state = takeoff_state
         self.ref_alt_amsl_m = ref_alt_amsl_m
+        self.vel_sp_ned_m_s = vel_sp_ned_m_s
 
 
 @dataclass(frozen=True, slots=True)
@@ -268,6 +270,10 @@ class AutoCore:
 
 class Task:
     """One activation of an auto mode. Subclasses implement `_waypoint(nav)`."""
+
+    # flight_mode_manager runs the task on each estimator update; sitl_emu runs the auto tasks with the position
+    # controller (125 Hz), the manual ones at FlightModeManager's 50 Hz (tasks_manual.py)
+    period_us = 8000
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params = params

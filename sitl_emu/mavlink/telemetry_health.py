@@ -42,19 +42,21 @@ def sensor_bits(snap: VehicleSnapshot) -> tuple[int, int, int]:
     """(present, enabled, health) of SYS_STATUS, as PX4 SIH reports them (at rest and ready: 0x0300c02f,
     0x0301c02f, 0x1320c83f).
 
-    Remote control is always unhealthy: no RC and no MAVLink joystick, so modeCheck.cpp reports "No manual control
-    input" for the manual modes (remote_control component). PREARM_CHECK is set when arming is possible in the mode
-    in force (health_report.can_arm_mode_flags), which stays true armed (the mode-prevents-arming check is skipped
-    while armed) and through a Return failsafe; arming checks that fail clear it.
+    Remote control (a MAVLink joystick here) is present and healthy while manual control is valid; without it
+    rcAndDataLinkCheck.cpp reports "No manual control input" on the remote_control component: unhealthy, enabled.
+    PREARM_CHECK is set when arming is possible in the mode in force (health_report.can_arm_mode_flags), which stays
+    true armed (the mode-prevents-arming check is skipped while armed) and through a Return failsafe; arming checks
+    that fail clear it.
     """
-    faults = S_RC
+    present = PRESENT_SIH | (S_RC if snap.manual_control else 0)
+    faults = 0 if snap.manual_control else S_RC
     if not snap.position_valid:
         faults |= _ESTIMATOR_BITS
     health = REPORTED & ~faults
     if snap.pre_flight_checks_pass:
         health |= S_PREARM_CHECK
-    enabled = PRESENT_SIH | (REPORTED & ~health)
-    return PRESENT_SIH, enabled, health
+    enabled = present | (REPORTED & ~health)
+    return present, enabled, health
 
 
 def sys_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:

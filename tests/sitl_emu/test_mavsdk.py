@@ -12,55 +12,26 @@ from __future__ import annotations
 
 import asyncio
 import math
-import os
-import subprocess
-import sys
 import time
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
-from support import REPO_ROOT
-from support.ports import free_udp_ports
+from support.serve_process import load_mavsdk, serve
 
-REPO = REPO_ROOT
 SPEED = 4.0  # simulated seconds per wall second
 CALL_TIMEOUT_S = 15.0  # no single MAVSDK call may hang the test
 
 
 
 
-def _load_mavsdk() -> Any:
-    try:
-        import mavsdk.asyncio as mavsdk_asyncio
-    except Exception as err:  # no package, or its native library cannot be loaded here
-        pytest.skip(f"MAVSDK cannot start on this machine: {err}")
-    return mavsdk_asyncio
-
-
 @pytest.fixture()
 def server(tmp_path: Path):
-    """`sitl-emu serve` on free ports; yields the UDP port MAVSDK must listen on (the API link's remote)."""
-    client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
-    args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
-            "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
-            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
-    log_path = tmp_path / "serve.log"
-    with log_path.open("w") as log_file:
-        # in tmp_path: the parameters it sets are saved there (parameters.params), not in the repository
-        proc = subprocess.Popen(args, cwd=tmp_path, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                env={**os.environ, "PYTHONPATH": str(REPO)})
-        try:
-            yield client_port
-        finally:
-            proc.terminate()
-            try:
-                proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(timeout=5)
-            print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-3000:])
+    """`sitl-emu serve` on free ports, in tmp_path (the parameters it sets are saved there, not in the repository);
+    yields the UDP port MAVSDK must listen on (the API link's remote)."""
+    with serve(tmp_path, tmp_path / "serve.log", SPEED) as client_port:
+        yield client_port
 
 
 class Session:
@@ -107,7 +78,7 @@ def _dist(a: tuple[float, float, float], b: tuple[float, float, float]) -> float
 
 @pytest.mark.timeout(420)
 def test_mavsdk_flies_the_emulator(server: int) -> None:
-    mavsdk_asyncio = _load_mavsdk()
+    mavsdk_asyncio = load_mavsdk()
     session = Session()
     try:
         asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, server, session), timeout=360))
@@ -123,12 +94,9 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
 
     config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
     async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
-        await s.call("Mavsdk.add_any_connection(udpin)", mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
-        system = await s.call("Mavsdk.first_autopilot", mavsdk.first_autopilot(timeout_s=20.0), timeout_s=25.0)
-        assert system is not None, "MAVSDK found no autopilot"
+        system = await _connect(mavsdk, port, s)
         assert (await s.call("System.autopilot_type", system.autopilot_type())).name == "PX4"
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
-        await s.wait_for("health_all_ok", telemetry.health_all_ok, bool, timeout_s=30)
         await s.call("Telemetry.health", telemetry.health())
         await _check_shell(system, s)
         await _check_missions(system, s)
@@ -136,6 +104,17 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
         await _take_off(telemetry, action, s)
         await _offboard(telemetry, OffboardAsync(system), s)
         await _return_and_land(telemetry, action, s)
+
+
+async def _connect(mavsdk: Any, port: int, s: Session) -> Any:
+    """The autopilot on udpin PORT, once its health is all good."""
+    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+
+    await s.call("Mavsdk.add_any_connection(udpin)", mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
+    system = await s.call("Mavsdk.first_autopilot", mavsdk.first_autopilot(timeout_s=20.0), timeout_s=25.0)
+    assert system is not None, "MAVSDK found no autopilot"
+    await s.wait_for("health_all_ok", TelemetryAsync(system).health_all_ok, bool, timeout_s=30)
+    return system
 
 
 async def _check_shell(system: Any, s: Session) -> None:
@@ -265,3 +244,60 @@ async def _return_and_land(telemetry: Any, action: Any, s: Session) -> None:
     home_dist = math.hypot(*(await _ned(telemetry))[:2])
     s.calls.append(("landed distance from home (m)", f"{home_dist:.2f}"))
     assert home_dist < 1.5
+
+
+@pytest.mark.timeout(300)
+def test_mavsdk_manual_control_flies_position_mode(server: int) -> None:
+    """MAVSDK's manual_control example: stream set_manual_control_input, take off, start_position_control, then fly
+    forward and back with the sticks; PX4 accepts and flies it (the reference's px4-manual cases)."""
+    mavsdk_asyncio = load_mavsdk()
+    session = Session()
+    try:
+        asyncio.run(asyncio.wait_for(_fly_manual(mavsdk_asyncio, server, session), timeout=240))
+    finally:
+        print("\nMAVSDK calls and outcomes:\n" + session.table())
+
+
+async def _fly_manual(mavsdk_asyncio: Any, port: int, s: Session) -> None:
+    from mavsdk.asyncio.plugins.action import ActionAsync
+    from mavsdk.asyncio.plugins.manual_control import ManualControlAsync
+    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+    from mavsdk.plugins.telemetry import FlightMode
+
+    config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
+    async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
+        system = await _connect(mavsdk, port, s)
+        telemetry, action, manual = TelemetryAsync(system), ActionAsync(system), ManualControlAsync(system)
+        sticks = [0.0, 0.0, 0.5, 0.0]  # x forward, y right, z throttle 0..1 (0.5 centre), r yaw
+
+        async def stream() -> None:  # the example sends at 10-20 Hz; COM_RC_LOSS_T is 0.5 s of simulated time
+            while True:
+                await manual.set_manual_control_input(*sticks)
+                await asyncio.sleep(0.05 / SPEED)
+
+        streamer = asyncio.create_task(stream())
+        try:
+            await asyncio.sleep(0.5)
+            await s.call("Action.arm", action.arm())
+            await s.call("Action.takeoff", action.takeoff())
+            await s.wait_for("in air above 2 m", telemetry.position, lambda p: p.relative_altitude_m > 2.0,
+                             timeout_s=30)
+            await s.call("ManualControl.start_position_control", manual.start_position_control())
+            await s.wait_for("flight mode POSCTL", telemetry.flight_mode, lambda m: m == FlightMode.POSCTL,
+                             timeout_s=5)
+            start = await _ned(telemetry)
+            sticks[0] = 0.6
+            await s.wait_for("5 m forward (north)", lambda: _ned(telemetry), lambda p: p[0] - start[0] > 5.0,
+                             timeout_s=30)
+            sticks[0] = -0.6
+            await s.wait_for("back past the start", lambda: _ned(telemetry), lambda p: p[0] < start[0],
+                             timeout_s=40)
+            sticks[0] = 0.0
+            await s.wait_for("stopped (position hold)", telemetry.velocity_ned,
+                             lambda v: math.hypot(v.north_m_s, v.east_m_s) < 0.2, timeout_s=30)
+            alt = (await telemetry.position()).relative_altitude_m
+            assert alt > 1.5, "the altitude was not held in Position mode"
+            await s.call("Action.land", action.land())
+            await s.wait_for("landed and disarmed", telemetry.armed, lambda armed: not armed, timeout_s=90)
+        finally:
+            streamer.cancel()

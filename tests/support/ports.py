@@ -20,3 +20,13 @@ def free_udp_ports(n: int) -> list[int]:
 
 def free_udp_port() -> int:
     return free_udp_ports(1)[0]
+
+
+def pending_datagrams(sock: socket.socket) -> list[bytes]:
+    """Every datagram waiting on a non-blocking socket."""
+    out = []
+    while True:
+        try:
+            out.append(sock.recv(65535))
+        except BlockingIOError:
+            return out

@@ -10,26 +10,15 @@ from __future__ import annotations
 
 import asyncio
 import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import pytest
-from support import REPO_ROOT
-from support.ports import free_udp_ports
+from support.serve_process import load_mavsdk, serve
 
 SPEED = 4.0
 CALL_TIMEOUT_S = 20.0
-
-
-def _load_mavsdk() -> Any:
-    try:
-        import mavsdk.asyncio as mavsdk_asyncio
-    except Exception as err:  # no package, or its native library cannot be loaded here
-        pytest.skip(f"MAVSDK cannot start on this machine: {err}")
-    return mavsdk_asyncio
 
 
 @pytest.fixture()
@@ -41,30 +30,13 @@ def served(tmp_path: Path):
     (root / "hello.txt").write_bytes(b"hello from the emulator\n")
     (root / "big.bin").write_bytes(os.urandom(80_000))
     (tmp_path / "outside.txt").write_bytes(b"secret")
-    client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
-    args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
-            "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
-            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO_ROOT), os.environ.get("PYTHONPATH", "")])}
-    log_path = tmp_path / "serve.log"
-    with log_path.open("w") as log_file:
-        proc = subprocess.Popen(args, cwd=work, env=env, stdout=log_file, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL)
-        try:
-            yield client_port, root
-        finally:
-            proc.terminate()
-            try:
-                proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(timeout=5)
-            print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-3000:])
+    with serve(work, tmp_path / "serve.log", SPEED) as client_port:
+        yield client_port, root
 
 
 @pytest.mark.timeout(240)
 def test_mavsdk_ftp_and_log_files_work_as_against_px4(served, tmp_path):
-    mavsdk_asyncio = _load_mavsdk()
+    mavsdk_asyncio = load_mavsdk()
     port, root = served
     asyncio.run(asyncio.wait_for(_session(mavsdk_asyncio, port, root, tmp_path), timeout=200))
     assert (tmp_path / "outside.txt").read_bytes() == b"secret"

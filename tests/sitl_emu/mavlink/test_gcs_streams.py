@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import socket
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import development as dialect
 from support.fakes import HOME, Harness
+from support.ports import pending_datagrams
 
 from sitl_emu.mavlink import extra_messages
 from sitl_emu.px4 import MavCmd
@@ -58,7 +58,7 @@ class Tap:
                 every_step()
             h.node.step_io(h.vehicle.time_us)
             for name, client in (("api", h.api), ("gcs", h.gcs)):
-                self.raw[name] += _datagrams(client.sock)
+                self.raw[name] += pending_datagrams(client.sock)
 
     def clear(self) -> None:
         self.raw = {"api": [], "gcs": []}
@@ -86,15 +86,6 @@ class Tap:
 
     def close(self) -> None:
         self.h.close()
-
-
-def _datagrams(sock: socket.socket) -> list[bytes]:
-    out = []
-    while True:
-        try:
-            out.append(sock.recv(65535))
-        except BlockingIOError:
-            return out
 
 
 def _msg_id(frame: bytes) -> int:

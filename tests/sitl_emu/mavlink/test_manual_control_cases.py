@@ -8,6 +8,7 @@ on the API link; each case's COMMAND_ACK, STATUSTEXTs (text and severity) and th
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -117,11 +118,22 @@ def test_the_stream_starting_makes_the_manual_modes_ready(pilot):
         check(f"mode_with_manual.{name}", pilot.observe(lambda n=name: pilot.mode(n.rstrip("2"))))
 
 
+def _rc_bits(pilot: Pilot) -> tuple[bool, bool, bool]:
+    """SYS_STATUS's RC receiver bit (0x10000): (present, enabled, healthy)."""
+    m = pilot.client.of_type("SYS_STATUS")[-1]
+    rc = 0x10000
+    return (bool(m.onboard_control_sensors_present & rc), bool(m.onboard_control_sensors_enabled & rc),
+            bool(m.onboard_control_sensors_health & rc))
+
+
 def test_losing_and_regaining_the_stream_while_disarmed(pilot):
+    assert _rc_bits(pilot) == (True, True, True)  # the joystick is the RC (rcAndDataLinkCheck.cpp)
     pilot.sticks = None
     check("loss_disarmed", pilot.observe(lambda: None, window_s=3.0))
+    assert _rc_bits(pilot) == (False, True, False)  # "No manual control input": required, missing
     pilot.sticks = dict(CENTRE)
     check("resume_disarmed", pilot.observe(lambda: None))
+    assert _rc_bits(pilot) == (True, True, True)
 
 
 def test_arming_needs_the_throttle_low_only_where_it_is_the_thrust(pilot):
@@ -143,3 +155,49 @@ def test_the_stick_gestures_arm_and_disarm(pilot):
     pilot.sticks = {"z": 0}
     pilot.run(0.5)
     check("arm.posctl_throttle_low", pilot.observe(lambda: pilot.command(MavCmd.COMPONENT_ARM_DISARM, 1)))
+
+
+def _numbers_as_hash(texts: list[str]) -> list[str]:
+    return [re.sub(r"\d+", "#", t) for t in texts]
+
+
+def test_modes_in_the_air_offboard_and_the_stick_loss_failsafe(pilot):
+    assert pilot.h.vehicle.snapshot().armed  # armed in Position mode by the previous case
+    pilot.sticks = {"z": 1000}
+    pilot.run(14.0)  # the throttle takes off and climbs to about 30 m, where the probe's vehicle was
+    pilot.sticks = {"x": 1000}  # and flies forward, as the probe's p_fwd trace did: about 23 m from home
+    pilot.run(4.0)
+    pilot.sticks = dict(CENTRE)
+    pilot.run(8.0)
+    assert -pilot.h.vehicle.snapshot().pos_ned_m[2] > 25.0
+    check("mode_in_air.ALTCTL", pilot.observe(lambda: pilot.mode("ALTCTL")))
+    check("mode_in_air.POSCTL", pilot.observe(lambda: pilot.mode("POSCTL")))
+    target = pilot.h.vehicle.snapshot().pos_ned_m
+    setpoints = pilot.h.vehicle  # offboard setpoints go with every pilot tick from here on
+    tick = pilot._tick
+
+    def with_setpoints() -> None:
+        tick()
+        if setpoints.time_us % 50_000 == 0:
+            c = pilot.client
+            c.send(c.mav.set_position_target_local_ned_encode(0, 1, 1, 1, 2552, *target, 0, 0, 0, 0, 0, 0, 0, 0))
+
+    pilot._tick = with_setpoints  # type: ignore[method-assign]
+    pilot.run(1.0)
+    check("offboard.set_mode", pilot.observe(lambda: pilot.mode("OFFBOARD")))
+    pilot.sticks = None  # the sticks stop, the setpoints go on (COM_RCL_EXCEPT 0: the loss counts in OFFBOARD)
+    got = pilot.observe(lambda: None, window_s=7.0)
+    want = CASES["offboard.stick_loss"]
+    assert _numbers_as_hash(got["statustext"]) == _numbers_as_hash(want["statustext"]), got["statustext"]
+    assert got["statustext_severity"] == want["statustext_severity"]
+    assert got["heartbeat"] == want["heartbeat"]
+    pilot.sticks = dict(CENTRE)
+    check("offboard.stick_resume", pilot.observe(lambda: None, window_s=2.0))  # still returning: sticks centred
+    check("offboard.back_to_posctl", pilot.observe(lambda: pilot.mode("POSCTL")))
+    pilot._tick = tick  # type: ignore[method-assign]
+    pilot.sticks = None
+    pilot.run(7.0)  # lost again in Position mode: Hold, then Return
+    pilot.sticks = dict(CENTRE)
+    pilot.run(1.0)
+    check("rc_resume.set_posctl", pilot.observe(lambda: pilot.mode("POSCTL")))
+    check("land.nav_land", pilot.observe(lambda: pilot.command(MavCmd.NAV_LAND)))

@@ -11,13 +11,13 @@ from __future__ import annotations
 import itertools
 import math
 import random
-import socket
 from typing import Any
 
 import pytest
 from pymavlink.dialects.v20 import development as dialect
 from support.fakes import HOME, Harness
 from support.handler_ctx import make_snapshot
+from support.ports import pending_datagrams
 
 from sitl_emu.mavlink import extra_messages, fastpack
 from sitl_emu.mavlink.telemetry import BUILDERS, ON_REQUEST
@@ -193,15 +193,6 @@ def test_every_telemetry_builder_sends_what_pymavlink_would(snaps):
 
 
 # --- end to end -----------------------------------------------------------------------------------------------------
-def _datagrams(sock: socket.socket) -> list[bytes]:
-    out = []
-    while True:
-        try:
-            out.append(sock.recv(65535))
-        except BlockingIOError:
-            return out
-
-
 def _repacked(datagram: bytes) -> bytes:
     """The datagram as pymavlink packs the message it parses to (PROTOCOL_VERSION decoded by hand)."""
     seq, sysid, compid = datagram[4], datagram[5], datagram[6]
@@ -236,8 +227,8 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
 
         def io() -> None:
             h.node.step_io(h.vehicle.time_us)
-            raw["api"] += _datagrams(h.api.sock)
-            raw["gcs"] += _datagrams(h.gcs.sock)
+            raw["api"] += pending_datagrams(h.api.sock)
+            raw["gcs"] += pending_datagrams(h.gcs.sock)
 
         def run(seconds: float) -> None:
             for _ in range(round(seconds * 250)):
