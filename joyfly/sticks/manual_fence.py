@@ -43,6 +43,7 @@ from joyfly.sticks.setpoints import Fence, Vec3
 
 G = 9.80665
 STICK_EPS = 1e-6
+SNAP = 0.03  # a limited stick component this small (0.18 m/s^2 in POSCTL) is sent as 0: PX4 brakes, holds
 
 
 @dataclass(frozen=True, slots=True)
@@ -171,6 +172,7 @@ def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence
     e2 = _limit_axis(east, pos[1], (vel[1], sp[1]), hy, fence.half_width_m, acc, drag, m)
     if abs(n2 - north) < STICK_EPS and abs(e2 - east) < STICK_EPS:
         return x, y
+    n2, e2 = (0.0 if abs(n2) < SNAP else n2), (0.0 if abs(e2) < SNAP else e2)  # PX4 then brakes and locks
     f, r = _rotate(n2, e2, -yaw)
     unshape: Callable[[float], float] = (lambda e: e) if altitude_mode else (lambda e: px4_unshape(e, m))
     return unshape(f), unshape(r)
