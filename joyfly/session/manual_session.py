@@ -103,7 +103,7 @@ class ManualSession(SessionLoop):
         return self.phase not in (Phase.CONNECTING, Phase.DONE, Phase.FAILED) and self._linkw.ok
 
     def _send_now_possible(self) -> bool:
-        return self._dirty and self.phase in PILOT_PHASES and self._streaming_allowed()
+        return False  # a steady stream, as QGC's: a stick change goes out with the next tick (at most 40 ms later)
 
     def _send_on_change(self) -> None:
         self._stream()
