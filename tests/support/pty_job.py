@@ -125,7 +125,8 @@ def _shell(control_fd: int, pid_fd: int, mode: str, readline: str, serve_args: l
         signal.signal(signal.SIGTTIN, signal.SIG_DFL)
         start = ["-m", "sitl_emu"] if readline == "readline" else ["-c", _WITHOUT_READLINE]
         os.execv(sys.executable, [sys.executable, *start, "serve", *serve_args])
-    os.setpgid(pid, pid)
+    with contextlib.suppress(PermissionError):  # EACCES: the job already exec'd (it set its own group first)
+        os.setpgid(pid, pid)
     if mode == "fg":
         os.tcsetpgrp(0, pid)
     os.write(pid_fd, f"{pid}\n".encode())

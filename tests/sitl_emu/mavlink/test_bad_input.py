@@ -8,14 +8,11 @@ from __future__ import annotations
 
 import math
 import random
-import threading
-import time
 
 import pytest
 from support.fakes import Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.runtime.runner import RealTimeRunner
 from sitl_emu.vehicle import Vehicle
 
 NAN, INF = math.nan, math.inf
@@ -129,45 +126,38 @@ def test_out_of_range_enums_are_refused_quietly(h):
     _still_serving(h)
 
 
-def test_setpoint_flood_of_10000_per_second_keeps_physics_on_time_and_the_peer_served():
-    """Real time in a background runner; a flood thread sends 10,000 SET_POSITION_TARGET_LOCAL_NED a second."""
+def test_setpoint_flood_of_10000_per_second_never_stalls_the_step_and_the_peer_is_served():
+    """10,000 SET_POSITION_TARGET_LOCAL_NED a second (40 per 4 ms tick) in lockstep: every tick still runs, each
+    step_io reads at most its budget (the rest waits in the socket), setpoints are handled, commands answered.
+    (How much CPU a flood costs at real time is a speed figure: bench/, not a timed test.)"""
     h = Harness(Vehicle(), handler_classes=None)
-    runner = RealTimeRunner([h.node], speed=1.0)
-    thread = threading.Thread(target=runner.run, daemon=True)
     frame = _frame(h, h.api.mav.set_position_target_local_ned_encode(0, 1, 1, 1, 2552, 0, 0, -3, 0, 0, 0, 0, 0, 0, 0,
                                                                      0))
-    stop = threading.Event()
     sent = {"n": 0}
+    reads: list[int] = []
+    step_io = h.node.step_io
+
+    def counted_step_io(now_us: int, readable: int = 3) -> int:
+        reads.append(step_io(now_us, readable))
+        return reads[-1]
+
+    h.node.step_io = counted_step_io  # type: ignore[method-assign]
 
     def flood() -> None:
-        t0 = time.monotonic()
-        while not stop.is_set():
-            due = int((time.monotonic() - t0) * 10_000)
-            while sent["n"] < due:
-                h.api.send_raw(frame)
-                sent["n"] += 1
-            time.sleep(0.001)
+        for _ in range(40):
+            h.api.send_raw(frame)
+        sent["n"] += 40
 
-    flooder = threading.Thread(target=flood, daemon=True)
     try:
-        thread.start()
-        flooder.start()
-        wall0, sim0 = time.monotonic(), h.vehicle.time_us
-        time.sleep(0.5)
+        h.run(0.5, flood)
         h.gcs.command_long(MavCmd.REQUEST_MESSAGE, 148)
-        time.sleep(2.0)
-        wall, sim = time.monotonic() - wall0, (h.vehicle.time_us - sim0) / 1e6
+        h.run(2.0, flood)
+        h.gcs.drain()
+        assert h.vehicle.time_us == 2_500_000  # not one tick lost
+        assert max(reads) <= 2 * h.node.io_budget
+        assert h.node.api.receiver.setpoints_accepted > 0.5 * sent["n"]
+        assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(MavCmd.REQUEST_MESSAGE, 0)]
+        assert len(h.gcs.of_type("HEARTBEAT")) >= 2
+        assert h.vehicle.snapshot().offboard_control is not None
     finally:
-        stop.set()
-        flooder.join()
-        runner.stop()
-        thread.join(timeout=5)
-        h.node.close()
-    h.gcs.drain()
-    accepted = h.node.api.receiver.setpoints_accepted
-    assert sent["n"] > 15_000
-    assert sim > 0.9 * wall, f"physics fell behind: {sim:.2f} s simulated in {wall:.2f} s"
-    assert accepted > 0.5 * sent["n"], "most setpoints are handled, the rest dropped by the socket"
-    assert [(a.command, a.result) for a in h.gcs.of_type("COMMAND_ACK")] == [(MavCmd.REQUEST_MESSAGE, 0)]
-    assert len(h.gcs.of_type("HEARTBEAT")) >= 2
-    assert h.vehicle.snapshot().offboard_control is not None
+        h.close()
