@@ -23,6 +23,7 @@ or Land the sticks still stream: moving them hands control back as PX4 does (its
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -31,6 +32,7 @@ from joyfly.link.vehicle_link import (
     MAIN_AUTO,
     MAIN_POSCTL,
     SUB_AUTO_LOITER,
+    CommandHandle,
     VehicleLink,
     VehicleState,
     main_mode,
@@ -58,6 +60,10 @@ MANUAL_CONTROLS = tuple(MANUAL_MODES)
 STICK_MODES = (MAIN_POSCTL, MAIN_ALTCTL)  # where joyfly's sticks fly the vehicle (PX4 may fall back to ALTCTL)
 RATE_HZ = 25.0  # QGroundControl's joystick rate while the sticks move (its Axis Frequency default)
 FRESH_HEARTBEAT_S = 0.1  # a HEARTBEAT this long after a mode command shows its effect (PX4 ACKs after switching)
+# Centred sticks this long before joyfly's own switch to an auto mode (the exit, a lost joystick): PX4's stick
+# movement filter (ManualControl.cpp MovingDiff, tau 0.05 s) forgets the sticks' last moves, so it does not take the
+# vehicle straight back to Position mode ("Pilot took over using sticks")
+STEADY_S = 0.3
 PILOT_PHASES = (Phase.FLYING, Phase.PAUSED, Phase.LANDING)  # the pilot's sticks go out; elsewhere centred ones
 _PHASE_TEXT = {Phase.PRESTREAM: "streaming MANUAL_CONTROL", Phase.ENTERING: "entering {mode}",
                Phase.ARMING: "arming in {mode}", Phase.FLYING: "flying in {mode}"}
@@ -77,6 +83,7 @@ class ManualSession(SessionLoop):
         self.manual_count = 0  # MANUAL_CONTROL messages sent
         self._latched = True  # the throttle interlock (sticks/manual.py)
         self._joy_hold = False  # holding in AUTO.LOITER for a lost joystick
+        self._hold_sent = False  # ... and the Hold was asked for
         self._from_air = False  # ENTERING a flying vehicle (not arming one on the ground)
         self._est = SetpointEstimate()  # PX4's POSCTL velocity setpoint, estimated from what was sent
 
@@ -126,20 +133,22 @@ class ManualSession(SessionLoop):
         mode = main_mode(st.custom_mode)
         # PX4 runs its POSCTL setpoint only in POSCTL, and restarts it from the vehicle's velocity until takeoff
         est = self._est if mode == MAIN_POSCTL and st.landed_state != 1 else restart_estimate(st.vel_ned_m_s, now)
+        pilot, self._latched = interlock(to_manual(self.cmd), self._latched)  # it follows the stick in every phase
         if (not st.armed or self.phase not in PILOT_PHASES or self._joy_hold or self._joy.lost
                 or self.cmd.deadman_ok is False or st.pos_ned_m is None):
             self._est = replace(advance_estimate(est, now, st.vel_ned_m_s, self.model), stick_ne=(0.0, 0.0))
             return CENTRED
-        inp, self._latched = interlock(to_manual(self.cmd), self._latched)
-        out, self._est = limit_tracked(inp, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, self.fence,
-                                       mode == MAIN_ALTCTL, est, now, self.model)
+        # landing by itself, the vehicle may go below --min-alt: a held throttle must not turn into a moving one
+        fence = replace(self.fence, min_alt_m=-math.inf) if self.phase is Phase.LANDING else self.fence
+        out, self._est = limit_tracked(pilot, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, fence, mode == MAIN_ALTCTL,
+                                       est, now, self.model)
         return out
 
     # --- taking control ----------------------------------------------------------------------------------------
 
     def _start_control(self, why: str) -> None:
         st = self.link.state
-        self._joy_hold = False
+        self._joy_hold, self._latched = False, True
         self._from_air = st.armed and not st.on_ground
         if self._from_air:
             self._note("info", f"{why}: switching to {self.mode_words} ({self.mode_name}).")
@@ -152,14 +161,19 @@ class ManualSession(SessionLoop):
         self._set_phase(Phase.PRESTREAM)
 
     def _take_over(self) -> None:
+        self._latched = True
         self._now_flying(f"The vehicle is already flying in {self.link.state.mode}: taking over with the sticks "
-                         "(the throttle acts once it has been at the centre).", latch=True)
+                         "(the throttle acts once it has been at the centre).")
 
-    def _now_flying(self, text: str, latch: bool) -> None:
+    def _now_flying(self, text: str) -> None:
         self._note("info", text)
-        self._latched = self._latched or latch
         self._joy_hold = False
         self._set_phase(Phase.FLYING)
+
+    def _arm(self) -> CommandHandle:
+        """ARM, the throttle interlock closed: it opens once the stick is at or below the centre (_sticks_to_send)."""
+        self._latched = True
+        return self.link.arm()
 
     def _fresh(self, st: VehicleState) -> bool:
         """A HEARTBEAT that came after this phase began (so after the command that started it took effect)."""
@@ -176,7 +190,7 @@ class ManualSession(SessionLoop):
         st = self.link.state
         if main_mode(st.custom_mode) == self.main_mode and self._fresh(st):
             if st.armed:
-                self._now_flying(f"{self.mode_words} ({self.mode_name}): you have control.", latch=True)
+                self._now_flying(f"{self.mode_words} ({self.mode_name}): you have control.")
             elif self._from_air:
                 self._note("warn", f"The vehicle disarmed before {self.mode_name} was entered.")
                 self._set_phase(Phase.GROUNDED)
@@ -192,15 +206,19 @@ class ManualSession(SessionLoop):
     def _arming(self, now: float) -> None:
         if self.link.state.armed:  # from the HEARTBEAT: until then the sticks stay centred
             self._now_flying(f"Armed in {self.mode_words}: push the throttle up to take off (PX4 disarms again if it "
-                             "has not taken off within about 10 s).", latch=True)
+                             "has not taken off within about 10 s).")
             return
         if self._retry is None:
             self._retry = Retry("Arming", self.s.arm_attempts, now)
-        outcome = self._retry.update(now, self.link, self.link.arm, lambda: self.link.state.armed)
+        outcome = self._retry.update(now, self.link, self._arm, lambda: self.link.state.armed)
         self._report_retry(outcome)
 
     def _flying(self, now: float) -> None:
         st = self.link.state
+        lost_s = self._joy.lost_since
+        if self._joy_hold and not self._hold_sent and lost_s is not None and now - lost_s >= STEADY_S:
+            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self._hold_sent = True
         if not st.armed:
             self._note("warn", "The vehicle disarmed: press ARM or TAKEOFF to fly again.")
             self._set_phase(Phase.GROUNDED)
@@ -215,7 +233,7 @@ class ManualSession(SessionLoop):
         st = self.link.state
         if st.armed and self.in_control(st) and self._fresh(st):
             self._now_flying(f"The vehicle is in {st.mode} again (the sticks took over, or another ground "
-                             "station): you have control.", latch=False)
+                             "station): you have control.")
         else:
             super()._paused(now)
 
@@ -223,17 +241,17 @@ class ManualSession(SessionLoop):
         st = self.link.state
         if st.armed and self.in_control(st) and self._fresh(st):
             self._now_flying(f"The vehicle is in {st.mode} again (the sticks took over): you have control.",
-                             latch=False)
+                             )
         else:
             super()._landing(now)
 
     # --- the watchdogs' steps ----------------------------------------------------------------------------------
 
     def _hold_for_joystick(self) -> None:
+        """Hold (AUTO.LOITER), asked for once the centred sticks have been steady for STEADY_S (_flying)."""
         self._note("warn", f"Joystick lost: Hold (AUTO.LOITER) with centred sticks; landing in "
                            f"{self.s.joy_timeout_s:g} s unless it comes back.")
-        self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
-        self._joy_hold = True
+        self._joy_hold, self._hold_sent = True, False
 
     def _joystick_back(self) -> None:
         was_holding, self._joy_hold = self._joy_hold, False
@@ -256,6 +274,8 @@ class ManualSession(SessionLoop):
         return self.link.state.armed or (handle is not None and (handle.accepted or not handle.done))
 
     def _exiting(self, now: float) -> None:
+        if self._exit is None and now - self._phase_s < STEADY_S:
+            return  # centred sticks first (_sticks_to_send), then the exit command
         super()._exiting(now)
         if self.phase is Phase.DONE and self.s.on_exit == "hold" and self.link.state.armed:
             self._note("warn", "joyfly stops sending MANUAL_CONTROL now: PX4 takes that for a lost RC and, after "

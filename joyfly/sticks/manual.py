@@ -14,9 +14,10 @@ PX4 applies its own deadzone (MAN_DEADZONE) and expo on top of these values, as 
 
 The throttle interlock (`interlock`): PX4 arms in POSCTL/ALTCTL only with the throttle at or below 0.2 (z <= 600,
 Commander::arm), and a throttle above the centre at arming would take off at once. joyfly sends centred sticks
-(z = 500, the throttle QGC sends with its "centred throttle" option) until the vehicle is armed, and after arming (or
-after switching a flying vehicle to the manual mode) it keeps the throttle at the centre until the stick has been at
-or below the centre once: a throttle held up during arming never launches the vehicle.
+(z = 500, the throttle QGC sends with its "centred throttle" option) until the vehicle is armed; it closes the
+interlock when it sends the ARM (or takes control of a flying vehicle), and from then on the throttle it sends stays
+at the centre until the stick has been at or below the centre once: a throttle held up during arming never launches
+the vehicle, and one pushed once the vehicle is armed flies at once.
 """
 
 from __future__ import annotations

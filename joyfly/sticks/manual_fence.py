@@ -43,7 +43,7 @@ from joyfly.sticks.setpoints import Fence, Vec3
 
 G = 9.80665
 STICK_EPS = 1e-6
-SNAP = 0.03  # a limited stick component this small (0.18 m/s^2 in POSCTL) is sent as 0: PX4 brakes, holds
+SNAP = 0.05  # a limited stick component this small (0.3 m/s^2 in POSCTL) is sent as 0: PX4 brakes, holds
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,7 +62,7 @@ class ManualModel:
     reaction_s: float = 1.2
     buffer_m: float = 0.5  # where the vehicle stops, inside the fence
     track_gain_1_s: float = 3.0  # how fast the stick pulls the speed to the allowance
-    return_gain_1_s: float = 1.0  # inside the buffer: back out of it at this many m/s per metre
+    return_gain_1_s: float = 1.0  # past the fence: back in at this many m/s per metre
 
     @property
     def pos_acc_m_s2(self) -> float:
@@ -117,11 +117,14 @@ def stop_distance(speed_m_s: float, m: ManualModel = PX4) -> float:
 
 
 def allowed_speed(room_m: float, m: ManualModel = PX4) -> float:
-    """The fastest the vehicle may move towards a side `room_m` away (it then stops `buffer_m` short of it);
-    negative inside the buffer: move back out of it."""
+    """The fastest the vehicle may move towards a side `room_m` away (it then stops `buffer_m` short of it); 0 in
+    the buffer (no pull back: a stick held still there lets PX4 lock the position, and never looks like a pilot
+    moving the sticks); negative past the side: move back in."""
+    if room_m < 0.0:
+        return room_m * m.return_gain_1_s
     room = room_m - m.buffer_m
     if room <= 0.0:
-        return room * m.return_gain_1_s
+        return 0.0
     a, t = m.brake_acc_m_s2, m.reaction_s
     return a * (-t + math.sqrt(t * t + 2.0 * room / a))
 
@@ -173,7 +176,7 @@ def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence
     if abs(n2 - north) < STICK_EPS and abs(e2 - east) < STICK_EPS:
         return x, y
     n2, e2 = (0.0 if abs(n2) < SNAP else n2), (0.0 if abs(e2) < SNAP else e2)  # PX4 then brakes and locks
-    f, r = _rotate(n2, e2, -yaw)
+    f, r = (0.0 if abs(v) < SNAP else v for v in _rotate(n2, e2, -yaw))  # no residue becomes PX4's deadzone edge
     unshape: Callable[[float], float] = (lambda e: e) if altitude_mode else (lambda e: px4_unshape(e, m))
     return unshape(f), unshape(r)
 

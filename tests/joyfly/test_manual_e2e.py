@@ -60,6 +60,7 @@ class GroundStation:
     armed: bool = False
     custom_mode: int = 0
     _stop: threading.Event = field(default_factory=threading.Event)
+    log: Callable[[], str] = lambda: ""  # joyfly's output so far, for failure messages
 
     def __post_init__(self) -> None:
         self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{self.port}", source_system=245)
@@ -89,7 +90,7 @@ class GroundStation:
     def wait_for(self, what: str, done: Callable[[], bool], sim_s: float) -> None:
         give_up = time.monotonic() + sim_s / SPEED * 3 + 5
         while not done():
-            assert time.monotonic() < give_up, f"never saw: {what}"
+            assert time.monotonic() < give_up, f"never saw: {what}\n{self.log()}"
             time.sleep(0.02)
 
     def wait(self, sim_s: float) -> None:
@@ -142,6 +143,7 @@ def _start(tmp_path: Path) -> Pair:
                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     out: list[str] = []
     threading.Thread(target=lambda: out.extend(iter(joy.stdout.readline, "")), daemon=True).start()  # type: ignore[union-attr]
+    gcs.log = lambda: "".join(out)
     fd = _open_writer(fifo, 20.0)
     for index in range(7):
         os.write(fd, pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, index, 0))
@@ -193,6 +195,6 @@ def test_position_mode_with_a_fifo_joystick_from_arming_to_ctrl_c(pair: Pair) ->
     assert pair.joy.wait(60.0) == 0, log()
     time.sleep(0.2)
     text = log()
-    assert "Exiting: land" in text and "Landed and disarmed" in text and "Traceback" not in text
+    assert "Exiting: land" in text and "Landed and disarmed" in text and "Traceback" not in text, text
     assert "time in POSCTL" in text and re.search(r"vehicle at the end    \S+, disarmed", text), text
     assert not gcs.armed

@@ -55,8 +55,8 @@ def test_the_allowance_stops_the_vehicle_at_the_buffer() -> None:
     for room in (0.6, 1.0, 3.0, 10.0, 50.0):
         v = allowed_speed(room)
         assert v > 0 and stop_distance(v) == pytest.approx(room - PX4.buffer_m)
-    assert allowed_speed(PX4.buffer_m) == 0.0
-    assert allowed_speed(0.0) < 0.0  # inside the buffer: back out
+    assert allowed_speed(PX4.buffer_m) == 0.0 and allowed_speed(0.2) == 0.0  # in the buffer: stay
+    assert allowed_speed(-0.3) == pytest.approx(-0.3)  # past the side: back in
     assert stop_distance(6.0) > 10.5  # more than real PX4 needs from 6 m/s in POSCTL (reference p_fwd)
 
 
@@ -166,3 +166,12 @@ def test_the_estimate_restarts_from_the_measured_velocity_after_a_gap() -> None:
     assert advance_estimate(SetpointEstimate(), 3.0, (0.2, 0.0, 0.0)).vel_ne == (0.2, 0.0)
     on = advance_estimate(SetpointEstimate((0.0, 0.0), 1.0, (1.0, 0.0), 0.0), 0.4, (0.0, 0.0, 0.0))
     assert on.vel_ne[0] == pytest.approx(0.5 * 8.0 * 0.4 ** 2, rel=0.1)  # the jerk limit: 8 m/s^3 from rest
+
+
+@pytest.mark.parametrize("noise", [-0.08, -0.04, 0.0, 0.04, 0.08])
+def test_at_rest_in_the_buffer_a_held_outward_stick_goes_out_as_a_steady_zero(noise: float) -> None:
+    """No jitter from the velocity's noise: PX4 would take a changing stick for a pilot moving it (its takeover of
+    an auto mode) and a zero lets it lock the position."""
+    for yaw in (0.0, 0.02, -0.02):  # nose north: the push is all eastwards
+        out = limit_manual(ManualInput(y=1000), (0.0, 4.6, -3.0), (noise / 2, noise, 0.0), yaw, FENCE, False)
+        assert (out.x, out.y) == (0, 0)

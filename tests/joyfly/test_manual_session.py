@@ -142,6 +142,24 @@ def test_a_throttle_held_up_while_arming_does_not_take_off_until_centred() -> No
     assert world.vehicle.pos[2] < -2.0  # once centred, the throttle flies
 
 
+class UpOnceArmed(TimedSticks):
+    """A quick pilot: the throttle goes up the moment the vehicle is armed, before joyfly's 1 Hz HEARTBEAT says so."""
+
+    def __init__(self, clock: SimClock, vehicle: ManualFakeVehicle) -> None:
+        super().__init__(clock, [])
+        self.vehicle = vehicle
+
+    def poll(self, timeout_s: float) -> StickCommand:
+        return UP if self.vehicle.armed else CENTRE
+
+
+def test_a_throttle_pushed_as_soon_as_the_vehicle_arms_takes_off() -> None:
+    world = make_world()
+    world.session.sticks = UpOnceArmed(world.clock, world.vehicle)
+    world.run_until(8.0)
+    assert world.vehicle.pos[2] < -1.0, world.notes()  # the interlock opened with the stick centred at arming
+
+
 def test_the_arming_refusal_is_reported_with_the_vehicles_reason() -> None:
     world = make_world()
     world.vehicle.refuse_arm_reason = "Arming denied: Resolve system health failures first"
@@ -159,11 +177,12 @@ def test_the_fence_and_max_alt_stop_full_sticks() -> None:
 
 
 def test_joystick_lost_holds_in_loiter_then_lands_with_centred_sticks() -> None:
-    world = airborne([(9.0, StickCommand(up=0.0, forward=1.0)), (9.5, StickCommand(connected=False))],
-                     joy_timeout_s=4.0)
+    world = airborne([*sweeping(9.0, 9.5), (9.5, StickCommand(connected=False))], joy_timeout_s=4.0)
     world.run_until(10.0)
-    hold = [m for _, m in world.commands(176) if (m.param2, m.param3) == (4, 3)]
-    assert hold and hold[0].param1 == 1 | 128 and world.vehicle.custom_mode == LOITER
+    hold = [(t, m) for t, m in world.commands(176) if (m.param2, m.param3) == (4, 3)]
+    assert hold and hold[0][1].param1 == 1 | 128 and world.vehicle.custom_mode == LOITER
+    assert all((m.x, m.y, m.z) == (0, 0, 500) for _, m in world.manual(hold[0][0] - 0.28))  # steady first
+    assert "Pilot took over" not in "\n".join(world.vehicle.texts)
     assert "Joystick lost: Hold (AUTO.LOITER)" in world.notes() and not world.commands(21)
     world.run_until(13.6)
     assert world.commands(21) and world.commands(21)[0][0] == pytest.approx(13.5, abs=0.15)
@@ -181,14 +200,21 @@ def test_joystick_back_before_the_timeout_takes_posctl_again() -> None:
     assert world.session.phase is Phase.FLYING and world.vehicle.custom_mode == POSCTL
 
 
+def sweeping(start_s: float, end_s: float) -> list[tuple[float, StickCommand]]:
+    """The right stick swept to and fro, each 0.04 s a new deflection: PX4 sees sticks on the move."""
+    n = round((end_s - start_s) / 0.04)
+    return [(start_s + 0.04 * i, StickCommand(up=0.0, right=0.8 * abs((i % 10) - 5) / 5)) for i in range(n)]
+
+
 def test_ctrl_c_lands_with_centred_sticks_streams_until_disarmed_then_stops() -> None:
-    world = airborne([(9.0, StickCommand(up=0.5, forward=0.5))])
-    world.run_until(9.5)
-    world.session.request_exit()
+    world = airborne(sweeping(9.0, 12.0))
+    world.run_until(11.9)
+    world.session.request_exit()  # while the sticks move: PX4 must not take the landing back to Position mode
     world.run_until(40.0)
     assert world.session.phase is Phase.DONE and world.commands(21) and not world.vehicle.armed
     land_t = world.commands(21)[0][0]
-    assert all((m.x, m.z) == (0, 500) for _, m in world.manual(land_t))
+    assert land_t > 11.9 + 0.3 and all((m.x, m.y, m.z) == (0, 0, 500) for _, m in world.manual(land_t - 0.3))
+    assert "Pilot took over" not in "\n".join(world.vehicle.texts)
     assert_stream_stopped_at_the_end(world)
     assert world.vehicle.failsafe_since is None and "Failsafe" not in world.notes()
 
@@ -218,7 +244,8 @@ def test_a_link_outage_stops_the_stream_and_px4s_failsafe_is_not_fought() -> Non
 
 
 def test_moving_the_sticks_in_hold_takes_control_back_as_px4_hands_it() -> None:
-    world = airborne([(9.0, press(Action.HOLD)), (9.3, CENTRE), (11.0, StickCommand(up=0.0, forward=0.8))])
+    push = [(11.0 + 0.05 * i, StickCommand(up=0.0, forward=0.2 * i)) for i in range(1, 5)]  # a push, not a jump
+    world = airborne([(9.0, press(Action.HOLD)), (9.3, CENTRE), *push])
     world.run_until(10.5)
     assert world.session.phase is Phase.PAUSED and world.vehicle.custom_mode == LOITER
     world.run_until(12.5)

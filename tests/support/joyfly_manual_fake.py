@@ -8,7 +8,9 @@ only the rules a manual client meets (../notes/px4_manual_spec.md; the reference
 - POSCTL/ALTCTL fly the sticks: x north and y east at up to 5 m/s (heading north), the throttle climbs at up to
   3 m/s and takes off above z 650, centred sticks hold;
 - RC lost while armed (not in Land/Return): "Failsafe activated: entering Hold for 5 seconds", Hold, then Return;
-- in Hold/Return/Land a moved stick takes over to POSCTL ("Pilot took over using sticks").
+- in Hold/Return/Land sticks on the move take over to POSCTL ("Pilot took over using sticks"), by PX4's rule
+  (ManualControl.cpp, MovingDiff): on some axis the change per second, low-passed with tau 0.05 s, above
+  MAN_OVERRIDE_SPD (1 /s), after at least 3 consecutive changes of one sign; a held or a single jump never does.
 """
 
 from __future__ import annotations
@@ -31,6 +33,9 @@ class ManualFakeVehicle(FakeVehicle):
         super().__post_init__()
         self.manual: tuple[int, int, int, int] = (0, 0, 500, 0)
         self.manual_time = -math.inf
+        self.sticks_moving = False
+        self._rate = [0.0, 0.0, 0.0, 0.0]  # low-passed change per second of x, y, z, r (in -1..1 units)
+        self._same_sign = [0, 0, 0, 0]
         self.failsafe_since: float | None = None
         self.wrong_targets = 0
 
@@ -56,7 +61,23 @@ class ManualFakeVehicle(FakeVehicle):
         if msg.target not in (0, 1):
             self.wrong_targets += 1
             return
+        self._moving_diff((msg.x, msg.y, msg.z, msg.r))
         self.manual, self.manual_time = (msg.x, msg.y, msg.z, msg.r), self.now
+
+    def _moving_diff(self, sample: tuple[int, int, int, int]) -> None:
+        dt = self.now - self.manual_time
+        if not 0.0 < dt < RC_LOSS_S:
+            self._rate, self._same_sign = [0.0] * 4, [0] * 4
+            return
+        alpha = dt / (0.05 + dt)
+        for i, (new, old) in enumerate(zip(sample, self.manual, strict=True)):
+            step = (new - old) / (500.0 if i == 2 else 1000.0)
+            self._rate[i] += alpha * (step / dt - self._rate[i])
+            if step:
+                same = self._same_sign[i] > 0 if step > 0 else self._same_sign[i] < 0
+                self._same_sign[i] = self._same_sign[i] + (1 if step > 0 else -1) if same else (1 if step > 0 else -1)
+        self.sticks_moving = any(abs(r) > 1.0 and abs(c) >= 3 for r, c in zip(self._rate, self._same_sign,
+                                                                               strict=True))
 
     def _set_mode(self, msg: Any, mode: int) -> None:
         if mode in MANUAL_MODES and self.armed and not self.rc_ok():
@@ -101,9 +122,7 @@ class ManualFakeVehicle(FakeVehicle):
             self._text(2, "Failsafe activated")
 
     def _takeover(self) -> None:
-        x, y, z, r = self.manual
-        moved = max(abs(x), abs(y), abs(r), abs(z - 500)) > 300
-        if self.armed and self.rc_ok() and moved and self.custom_mode in (LOITER, RTL, LAND):
+        if self.armed and self.rc_ok() and self.sticks_moving and self.custom_mode in (LOITER, RTL, LAND):
             self.custom_mode = self.intention = POSCTL
             self.failsafe_since = None
             self._text(6, "Pilot took over using sticks")
