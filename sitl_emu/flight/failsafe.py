@@ -3,7 +3,7 @@
 After src/modules/commander/failsafe/failsafe.cpp (checkModeFallback, fromOffboardLossActParam,
 fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activated", clear conditions):
 - mode fallbacks act at once (no COM_FAIL_ACT_T hold); the manual-control loss action holds first
-  (flight/manual_control.py);
+  (flight/manual_control.py), and a manual mode left without sticks is its business, not a fallback's;
 - OFFBOARD without a fresh signal -> COM_OBL_RC_ACT; a Position/Altitude/Stabilized fallback without manual control
   (the SITL norm) becomes NAV_RCL_ACT (default Return);
 - a fallback mode that cannot run degrades further: Position -> Altitude -> Stabilized -> NAV_RCL_ACT,
@@ -134,7 +134,7 @@ class Failsafe:
         if terminated:
             return self._decide(NavState.TERMINATION, False, "")
         rank, mode, disarm = 0, user, False
-        if not can_run(user, inputs):
+        if not can_run(user, _manual_control_aside(inputs)):
             fallback = resolve_fallback(user, settings, inputs)
             rank, mode, disarm = (_DISARM_RANK, user, True) if fallback is None else (_RANK[fallback], fallback, False)
         if manual_loss is not None:
@@ -155,3 +155,11 @@ class Failsafe:
     def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
         self.active = True
         return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text)
+
+
+def _manual_control_aside(inputs: CheckInputs) -> CheckInputs:
+    """framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with its
+    Hold first): for the user's own mode, a missing stick input is not a reason to fall back at once."""
+    if inputs.manual_control:
+        return inputs
+    return CheckInputs(inputs.estimator_ready, inputs.home_valid, inputs.offboard_signal, True, inputs.mission_valid)

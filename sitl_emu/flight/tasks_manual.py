@@ -24,6 +24,7 @@ from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.flight.manual_control import CENTRED
 from sitl_emu.flight.smoothing import AxisSmoother
 from sitl_emu.flight.sticks import (
+    FLT_EPSILON,
     NAN,
     StickAccelerationXY,
     StickXYSettings,
@@ -40,7 +41,6 @@ TASK_PERIOD_US: Final = 20_000  # FlightModeManager's vehicle_local_position int
 WANT_TAKEOFF_THROTTLE: Final = 0.3  # FlightTaskManualAltitude::_checkTakeoff
 LOCK_VEL_M_S: Final = 0.1  # ManualVelocitySmoothingZ::checkPositionLock
 LOCK_ACC_M_S2: Final = 0.2
-FLT_EPSILON: Final = 1.1920929e-07
 
 
 @dataclass(frozen=True, slots=True)

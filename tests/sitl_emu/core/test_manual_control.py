@@ -106,3 +106,19 @@ def test_a_vehicle_armed_without_sticks_ignores_their_absence_until_they_appear(
     assert "Failsafe activated: entering Hold for 5 seconds" in p.texts()
     p.run(5.0)
     assert p.v.commander.nav_state is NavState.AUTO_RTL
+
+
+def test_sticks_lost_in_position_mode_hold_first_then_return():
+    """failsafe.cpp: a manual mode without sticks is the manual-control loss failsafe's (Hold COM_FAIL_ACT_T, then
+    NAV_RCL_ACT), not an immediate mode fallback."""
+    p = Pilot().flying_in_position_mode()
+    n = len(p.texts())
+    p.sticks = None
+    p.run(1.0)
+    assert p.v.commander.nav_state is NavState.AUTO_LOITER and p.v.commander.failsafe
+    p.run(4.0)
+    assert p.v.commander.nav_state is NavState.AUTO_LOITER
+    p.run(1.0)
+    assert p.v.commander.nav_state is NavState.AUTO_RTL
+    assert p.texts()[n:n + 2] == ["Failsafe activated: entering Hold for 5 seconds", "Failsafe activated"]
+    assert p.v.commander.intention.user_intended is NavState.POSCTL
