@@ -16,14 +16,16 @@ import click
 from joyfly.cli_joystick import joystick
 from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
-from joyfly.config import BOUNDS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
+from joyfly.config import BOUNDS, CONTROLS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
 from joyfly.session.core import Note
-from joyfly.session.flight_session import FlightSession
+from joyfly.session.factory import make_session
+from joyfly.session.manual_session import MANUAL_CONTROLS
+from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
 
@@ -45,12 +47,13 @@ def main(verbose: int) -> None:
 main.add_command(joystick)
 
 
-def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, **kw: Any) -> Callable[[Any], Any]:
+def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_text: str | None = None,
+         **kw: Any) -> Callable[[Any], Any]:
     """An option whose default lives in FlyOptions (a --config file may set it too): the help shows the default and
     the range, and the value stays None unless given, so the file's value is not overridden."""
     key = name.lstrip("-").replace("-", "_")
     default = getattr(D, key)
-    shown = [] if default is None else [f"default: {default}"]
+    shown = [] if default is None else [f"default: {default_text or default}"]
     if key in BOUNDS and show_range:
         shown.append(f"{BOUNDS[key].lo:g} to {BOUNDS[key].hi:g}")
     return click.option(name, type=kind, default=None, help=f"{help_text} [{'; '.join(shown)}]" if shown
@@ -62,18 +65,25 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, **kw: An
                     "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
-@_opt("--control", click.Choice(["velocity", "step"]), "velocity: the sticks set the vehicle's velocity and "
-      "releasing them holds position; step: the setpoint is the vehicle's position plus --step metres x stick.")
+@_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "
+      "the vehicle's velocity and releasing them holds position; step: the setpoint is the vehicle's position plus "
+      "--step metres x stick. PX4's manual modes with MANUAL_CONTROL, as QGroundControl's joystick: position: "
+      "Position mode (POSCTL), the throttle stick takes off, climbs and descends, the right stick flies forward/right "
+      "of the nose, releasing the sticks holds position; altitude: Altitude mode (ALTCTL), the same but the right "
+      "stick tilts the vehicle and nothing holds it horizontally. In these two PX4's parameters set the speeds "
+      "(MPC_VEL_MANUAL...) and --alt, --step, --max-speed, --max-climb, --max-yaw-rate do not apply.")
 @_opt("--step", float, "Step control: metres per full stick.")
-@_opt("--alt", float, "Take-off altitude, metres above home, from --min-alt to --max-alt.", show_range=False)
-@_opt("--max-climb", float, "Climb/descent rate at full throttle stick, m/s.")
-@_opt("--max-speed", float, "Horizontal speed at full stick, m/s.")
-@_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick, deg/s.")
+@_opt("--alt", float, "Take-off altitude (OFFBOARD), metres above home, from --min-alt to --max-alt.",
+      show_range=False)
+@_opt("--max-climb", float, "Climb/descent rate at full throttle stick (OFFBOARD), m/s.")
+@_opt("--max-speed", float, "Horizontal speed at full stick (OFFBOARD), m/s.")
+@_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick (OFFBOARD), deg/s.")
 @_opt("--fence", float, "Half-width of the square fence around this flight's home (where joyfly arms the vehicle), "
-      "metres; 0 disables.")
-@_opt("--min-alt", float, "Lowest setpoint, metres above home.")
-@_opt("--max-alt", float, "Highest setpoint, metres above home.")
-@_opt("--rate", float, "Setpoint stream rate, Hz.")
+      "metres; 0 disables. In position/altitude control joyfly limits the sticks near it.")
+@_opt("--min-alt", float, "Lowest altitude, metres above home.")
+@_opt("--max-alt", float, "Highest altitude, metres above home.")
+@_opt("--rate", float, "Stream rate, Hz: setpoints (OFFBOARD), or MANUAL_CONTROL (position, altitude).",
+      default_text=f"{D.rate:g} (OFFBOARD), {MANUAL_RATE_HZ:g} (position, altitude: QGroundControl's)")
 @_opt("--on-exit", click.Choice(["land", "hold", "rtl"]), "What the vehicle does when joyfly exits.")
 @_opt("--record", str, "Record the joystick's states with timestamps to this file (replay with --joy FILE).")
 @_opt("--joy-timeout", float, "Seconds without the joystick before landing.")
@@ -83,7 +93,8 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, **kw: An
       "vehicle's clock says otherwise.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 def fly(config_path: str | None, **cli_options: Any) -> None:
-    """Connect, take off to --alt in OFFBOARD and fly with the joystick; Ctrl-C lands (see --on-exit)."""
+    """Connect, take off to --alt in OFFBOARD (or arm in PX4's Position/Altitude mode with --control position/altitude)
+    and fly with the joystick; Ctrl-C lands (see --on-exit)."""
     try:
         file_options, profile_table = load_file(config_path) if config_path else ({}, {})
         opts = build_options(file_options, cli_options, source=config_path)
@@ -100,6 +111,10 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
         sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
     except JoystickError as err:
         raise UserError(str(err)) from None
+    problem = throttle_problem(opts.control, sticks.profile)
+    if problem:
+        sticks.close()
+        raise UserError(problem)
     try:
         transport = open_transport(opts.url)
     except TransportError as err:
@@ -108,10 +123,19 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
     view = make_view(out)
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
-    session = FlightSession(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
+    session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), "warn", text)))
     session.link.on_message.append(watch.observe)
     return fly_session(session, view, out)
+
+
+def throttle_problem(control: str, profile: Any) -> str | None:
+    """PX4's manual modes take off with the throttle: a profile without a throttle axis could never leave the ground."""
+    if control in MANUAL_CONTROLS and profile.axis("up") is None and profile.axis("throttle_abs") is None:
+        return (f"--control {control} takes off with the throttle stick, but the profile {profile.name} maps no "
+                "throttle: pick a profile with --profile, or set [profile.up] index (a centring stick) or "
+                "[profile.throttle] index (a radio's throttle) in a --config file.")
+    return None
 
 
 @main.command(short_help="A whole flight with no hardware.")
@@ -121,12 +145,16 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
                    "the speed that vehicle runs at.")
 @click.option("--script", "script_path", default=None, help="Joystick script (default: the built-in demo flight).")
 @click.option("--live/--plain", default=None, help="Force the live terminal view or plain log lines.")
-def demo(url: str | None, speed: float, script_path: str | None, live: bool | None) -> None:
+@click.option("--control", type=click.Choice(list(CONTROLS)), default=D.control, show_default=True,
+              help="How to fly, as `joyfly fly --control`: OFFBOARD setpoints (velocity, step) or PX4's Position / "
+                   "Altitude mode with MANUAL_CONTROL (position, altitude; the script then takes off with the "
+                   "throttle).")
+def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str) -> None:
     """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
     from joyfly.demo import DemoError, run_demo
 
     try:
-        sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live))
+        sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control))
     except (DemoError, TransportError, JoystickError) as err:
         raise UserError(str(err)) from None
 

@@ -1,8 +1,9 @@
 """`joyfly joystick list` and `joyfly joystick test`: find joysticks and watch what they send.
 
-`test` is what `rostopic echo /joy` was for, plus the flying commands the matched profile makes of it: a live view
-on a terminal, one plain line per change otherwise (a pipe, a log, a test). It ends on Ctrl-C, after --duration,
-or when a virtual joystick reaches its end.
+`test` is what `rostopic echo /joy` was for, plus the flying commands the matched profile makes of it (and the
+MANUAL_CONTROL values `--control position/altitude` sends for them, before the fence): a live view on a terminal, one
+plain line per change otherwise (a pipe, a log, a test). It ends on Ctrl-C, after --duration, or when a virtual
+joystick reaches its end.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from joyfly.sticks.joystick import (
     list_devices,
     open_joystick,
 )
+from joyfly.sticks.manual import to_manual
 from joyfly.sticks.mapping import StickMapper
 from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
 from joyfly.sticks.virtual import TimedSource, record_to
@@ -184,7 +186,7 @@ class PlainView:
             self.echo(f"t={state.time_s - start_s:.2f} disconnected {error}".rstrip())
             return
         self.echo(f"t={state.time_s - start_s:.2f} axes={list(state.axes)} buttons={list(state.buttons)} "
-                  f"{_sticks(cmd)} pressed={_pressed(cmd)}")
+                  f"{_sticks(cmd)} manual=({to_manual(cmd).describe()}) pressed={_pressed(cmd)}")
 
     def close(self) -> None:
         pass
@@ -215,7 +217,8 @@ class LiveView:
         buttons = " ".join(f"{i}:{v}" for i, v in enumerate(state.buttons)) or "(none yet)"
         status = "connected" if state.connected else f"DISCONNECTED {error}".rstrip()
         self._block.draw([f"t={state.time_s - start_s:7.2f}  {status}", f"axes     {axes}", f"buttons  {buttons}",
-                    f"flying   {_sticks(cmd)}", f"pressed  {_pressed(cmd)}"])
+                          f"flying   {_sticks(cmd)}", f"manual   MANUAL_CONTROL {to_manual(cmd).describe()} "
+                          "(--control position/altitude)", f"pressed  {_pressed(cmd)}"])
 
     def close(self) -> None:
         self.out.write("\n")

@@ -7,7 +7,7 @@ Command-line options win over the file, the file over the defaults::
     [fly]
     url = "udp://:14540@127.0.0.1:14557"
     joy = "/dev/input/js0"
-    control = "velocity"      # or "step"
+    control = "velocity"      # or "step" (OFFBOARD), "position" or "altitude" (PX4's manual modes)
     max-speed = 3.0
     fence = 8.0
     on-exit = "rtl"
@@ -27,11 +27,13 @@ from typing import Any
 
 from joyfly.link.transport import UrlError, parse_url
 from joyfly.session.core import SessionSettings
+from joyfly.session.manual_session import MANUAL_CONTROLS
+from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.profiles import read_config
 from joyfly.sticks.setpoints import Limits
 
 DEFAULT_URL = "udp://:14540@127.0.0.1:14557"
-CONTROLS = ("velocity", "step")
+CONTROLS = ("velocity", "step", *MANUAL_CONTROLS)
 ON_EXIT = ("land", "hold", "rtl")
 MIN_RATE_HZ = 10.0  # PX4 needs a setpoint younger than COM_OF_LOSS_T = 1 s; 10 Hz leaves room for lost datagrams
 # --speed: the vehicle's simulated seconds per wall second; the same range as `sitl-emu serve --speed`
@@ -57,7 +59,7 @@ class FlyOptions:
     fence: float = 5.0  # m half-width of the square around home; 0 disables
     min_alt: float = 0.5  # m above home
     max_alt: float = 10.0  # m above home
-    rate: float = 20.0  # Hz setpoint stream
+    rate: float = 20.0  # Hz setpoint stream (OFFBOARD); --control position/altitude: MANUAL_RATE_HZ unless given
     on_exit: str = "land"
     record: str | None = None
     joy_timeout: float = 5.0  # s
@@ -94,8 +96,8 @@ BOUNDS: dict[str, Bound] = {
     "fence": Bound(0.0, 10000.0, "m", " (0 turns the fence off)"),
     "min_alt": Bound(0.0, 1000.0, "m"),
     "max_alt": Bound(0.1, 1000.0, "m"),
-    "rate": Bound(MIN_RATE_HZ, 200.0, "Hz", " (PX4 leaves OFFBOARD after 1 s without a setpoint; it needs no more "
-                                            "than 50 Hz)"),
+    "rate": Bound(MIN_RATE_HZ, 200.0, "Hz", " (PX4 leaves OFFBOARD after 1 s without a setpoint, and takes "
+                                            "MANUAL_CONTROL for lost after 0.5 s; it needs no more than 50 Hz)"),
     "joy_timeout": Bound(0.1, 600.0, "s"),
     "connect_timeout": Bound(1.0, 3600.0, "s"),
     "speed": Bound(SPEED_MIN, SPEED_MAX, "times real time", " (the vehicle's sitl-emu serve --speed; 1 for PX4 SITL)"),
@@ -158,6 +160,8 @@ def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any
     """Defaults, then the config file (`source`), then the options given on the command line; validated."""
     origins = _Origins(file_options, cli_options, source)
     merged = {**file_options, **{k: v for k, v in cli_options.items() if v is not None}}
+    if merged.get("control") in MANUAL_CONTROLS and "rate" not in merged:
+        merged["rate"] = MANUAL_RATE_HZ  # QGroundControl's joystick rate
     opts = replace(FlyOptions(), **{k: _coerce(k, v, origins) for k, v in merged.items()})
     validate(opts, origins)
     return opts

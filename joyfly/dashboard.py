@@ -45,20 +45,29 @@ def _link_word(view: SessionView) -> str:
     return "ok" if view.link_ok else ("waiting" if view.phase is Phase.CONNECTING or not view.heard else "LOST")
 
 
+def _sent_line(view: SessionView) -> str:
+    """What joyfly sends: the OFFBOARD setpoint, or the MANUAL_CONTROL sticks (x, y, z, r) in the manual modes."""
+    if view.control != "OFFBOARD":
+        sent = view.manual.describe() if view.manual is not None else "-"
+        return f"sticks sent  {sent}   (MANUAL_CONTROL, flying {view.control})"
+    sp = view.setpoint
+    return f"setpoint NED {fmt_vec(sp.pos_ned_m if sp else None)} m   yaw {math.degrees(sp.yaw_rad) if sp else 0:+6.1f}"
+
+
 def render(view: SessionView) -> list[str]:
     """The live block for one view snapshot."""
     link = "waiting" if _link_word(view) == "waiting" else _link_word(view).upper()
     pos = view.pos_ned_m
     margin = view.fence.margin_m(pos) if pos is not None else math.inf
-    sp = view.setpoint
     stream = "streaming" if view.streaming else "not streaming"
+    what = "setpoints" if view.control == "OFFBOARD" else "MANUAL_CONTROL"
     joy = "ok" if view.joystick_ok else "LOST (holding)" if view.phase is Phase.FLYING else "LOST"
     lines = [
-        f"t {view.time_s:7.1f} s  {view.phase.value:<28} link {link:<4} ({view.link_description})",
+        f"t {view.time_s:7.1f} s  {view.phase_text or view.phase.value:<28} link {link:<4} ({view.link_description})",
         f"mode {view.mode:<14} {'ARMED' if view.armed else 'disarmed':<9} {_LANDED.get(view.landed_state, '?'):<10}"
-        f" setpoints {stream}",
+        f" {what} {stream}",
         f"position NED {fmt_vec(pos)} m   alt {view.fence.alt_m(pos) if pos else 0.0:5.2f} m",
-        f"setpoint NED {fmt_vec(sp.pos_ned_m if sp else None)} m   yaw {math.degrees(sp.yaw_rad) if sp else 0:+6.1f}",
+        _sent_line(view),
         f"fence margin {fmt_margin(margin)}   closest {fmt_margin(view.stats.min_fence_margin_m)}   joystick {joy}",
         stick_line(view.stick),
     ]
@@ -66,14 +75,17 @@ def render(view: SessionView) -> list[str]:
     return lines
 
 
-def summary_lines(stats: FlightStats) -> list[str]:
+def summary_lines(stats: FlightStats, control: str = "OFFBOARD", extra: list[str] | None = None) -> list[str]:
+    """The flight's summary: distance, closest approach to the fence, time in joyfly's mode (`control`), the lines
+    of the way of flying (`extra`), and the highest altitude (always the last line)."""
     closest = "n/a" if math.isinf(stats.min_fence_margin_m) else f"{stats.min_fence_margin_m:.2f} m inside"
     if stats.min_fence_margin_m < 0:
         closest = f"{-stats.min_fence_margin_m:.2f} m OUTSIDE"
     return [
         f"distance flown        {stats.distance_m:6.1f} m",
         f"closest to the fence  {closest}",
-        f"time in OFFBOARD      {stats.offboard_time_s:6.1f} s",
+        f"{'time in ' + control:<22}{stats.control_time_s:6.1f} s",
+        *(extra or []),
         f"highest               {stats.max_alt_m:6.1f} m above home",
     ]
 
@@ -135,8 +147,10 @@ class PlainLog:
         pos = view.pos_ned_m
         margin = view.fence.margin_m(pos) if pos is not None else math.inf
         sp = view.setpoint.pos_ned_m if view.setpoint is not None else None
-        self.out.write(f"[{view.time_s:7.2f}] {view.phase.value}; {view.mode} {'armed' if view.armed else 'disarmed'}"
-                       f"; link {_link_word(view)}; pos {fmt_vec(pos)} sp {fmt_vec(sp)}"
+        sent = f"sent {view.manual.describe()}" if view.manual is not None else f"sp {fmt_vec(sp)}"
+        phase = view.phase_text or view.phase.value
+        self.out.write(f"[{view.time_s:7.2f}] {phase}; {view.mode} {'armed' if view.armed else 'disarmed'}"
+                       f"; link {_link_word(view)}; pos {fmt_vec(pos)} {sent}"
                        f"; fence margin {fmt_margin(margin)}\n")
         self.out.flush()
 

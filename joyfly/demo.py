@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
+from dataclasses import replace
 from typing import Any, TextIO
 
 from joyfly.clock import ScaledClock
@@ -18,7 +19,9 @@ from joyfly.config import FlyOptions
 from joyfly.dashboard import make_view
 from joyfly.link.transport import UdpTransport, open_transport
 from joyfly.link.vehicle_link import VehicleLink
-from joyfly.session.flight_session import FlightSession
+from joyfly.session.factory import make_session
+from joyfly.session.manual_session import MANUAL_CONTROLS
+from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.mapping import MappedSource
 from joyfly.sticks.profiles import load_profile
 from joyfly.sticks.virtual import ScriptSource
@@ -43,6 +46,25 @@ DEMO_SCRIPT = """\
 +2     land=1
 +0.3   land=0
 +30    end
+"""
+# --control position/altitude: PX4 takes off with the throttle (joyfly arms with it centred in about 3 s); in POSCTL
+# half a stick is about 2.3 m/s (PX4's deadzone and expo, MPC_VEL_MANUAL 10 m/s at full stick), the nose points north.
+MANUAL_DEMO_SCRIPT = """\
+6      up=1                      # throttle up: PX4 lifts off after its spool-up and takeoff ramp, climbs 1.5 m/s
++5     up=0                      # centred: holds its altitude, about 4 m
++3     forward=0.6               # forward, north
++3     forward=0
++3     right=0.6                 # right, east
++3     right=0
++3     forward=-0.6              # south
++3     forward=0
++3     right=-0.6                # west, back over home
++3     right=0
++3     forward=1                 # full stick north: joyfly limits the stick as the fence nears
++6     forward=0
++3     land=1
++0.3   land=0
++40    end
 """
 DEMO_TIMEOUT_S = 120.0  # simulated seconds; the scripted flight needs about 50
 
@@ -103,20 +125,24 @@ class EmbeddedVehicle:
         self.node.close()
 
 
-def script_source(script_path: str | None, clock: Any) -> MappedSource:
+def script_source(script_path: str | None, clock: Any, control: str = "velocity") -> MappedSource:
     """The scripted joystick, mapped through the built-in `script` profile."""
+    text = MANUAL_DEMO_SCRIPT if control in MANUAL_CONTROLS else DEMO_SCRIPT
     source = ScriptSource.from_file(script_path, clock) if script_path else ScriptSource.from_text(
-        DEMO_SCRIPT, clock, "<built-in demo script>")
+        text, clock, "<built-in demo script>")
     return MappedSource(source, load_profile("auto", source.name))
 
 
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
-             out: TextIO | None = None, options: FlyOptions | None = None) -> int:
-    """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed)."""
+             out: TextIO | None = None, options: FlyOptions | None = None, control: str | None = None) -> int:
+    """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed). `control` picks the way
+    of flying (FlyOptions.control), position/altitude at QGroundControl's MANUAL_CONTROL rate."""
     from joyfly.run import fly_session
 
     out = out or sys.stdout
     opts = options or FlyOptions()
+    if control is not None:
+        opts = replace(opts, control=control, rate=MANUAL_RATE_HZ if control in MANUAL_CONTROLS else opts.rate)
     transport: Any = open_transport(url) if url else UdpTransport(("127.0.0.1", 0), None)
     emulator = None
     if url is None:
@@ -126,12 +152,12 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
         emulator.start()
     # with --url, `speed` is the speed that vehicle runs at
     clock: ScaledClock | VehicleTimeClock = emulator.clock() if emulator is not None else ScaledClock(speed)
-    sticks = script_source(script_path, clock)
+    sticks = script_source(script_path, clock, opts.control)
     view = make_view(out, live)
     out.write(f"joyfly demo: {transport.description}, scripted joystick "
               f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}\n")
     settings = opts.session_settings(exit_when_landed=True)
-    session = FlightSession(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
+    session = make_session(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
     watchdog = threading.Timer(DEMO_TIMEOUT_S / clock.speed, session.request_exit)
     watchdog.daemon = True
     watchdog.start()

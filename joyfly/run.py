@@ -15,10 +15,11 @@ from typing import Any
 import click
 
 from joyfly.dashboard import summary_lines
-from joyfly.session.flight_session import FlightSession, Phase
+from joyfly.session.core import Phase
+from joyfly.session.loop import SessionLoop
 
 
-def fly_session(session: FlightSession, view: Any, out: Any) -> int:
+def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     """Run the session with Ctrl-C/SIGTERM handling, close everything, then say how it ended; returns the exit
     status (0 done, 1 failed, 130 quit at once by a second Ctrl-C)."""
     interrupted = False
@@ -35,7 +36,8 @@ def fly_session(session: FlightSession, view: Any, out: Any) -> int:
         out.write(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}\n")
         return 130
     if session.armed_seen:
-        out.writelines(line + "\n" for line in summary_lines(session.stats))
+        lines = summary_lines(session.stats, session.control_label(), session.summary_extra())
+        out.writelines(line + "\n" for line in lines)
     elif session.phase is not Phase.FAILED:
         out.write(f"joyfly: {nothing_flown(session)}\n")
     if session.phase is Phase.FAILED:
@@ -44,7 +46,7 @@ def fly_session(session: FlightSession, view: Any, out: Any) -> int:
     return 0
 
 
-def nothing_flown(session: FlightSession) -> str:
+def nothing_flown(session: SessionLoop) -> str:
     """The closing sentence of a session that ended before the vehicle was ever armed."""
     st = session.link.state
     if st.last_heartbeat_s is None:
@@ -60,9 +62,13 @@ _NEXT = {
     "OFFBOARD": "with no more setpoints, PX4's offboard-loss failsafe takes over within COM_OF_LOSS_T (1 s; "
                 "Return in SITL without RC).",
 }
+_RC_LOSS = ("with no more MANUAL_CONTROL, PX4's manual-control-loss failsafe holds it for COM_FAIL_ACT_T (5 s), "
+            "then returns it home (NAV_RCL_ACT).")
+# The same once a manual session's MANUAL_CONTROL stream stops (failsafe.cpp: Land and Return go on; the rest fail)
+_NEXT_MANUAL = {**_NEXT, "AUTO.LOITER": _RC_LOSS, "POSCTL": _RC_LOSS, "ALTCTL": _RC_LOSS}
 
 
-def left_behind(session: FlightSession) -> str:
+def left_behind(session: SessionLoop) -> str:
     """In what state joyfly leaves the vehicle when it quits at once, and what the vehicle does next."""
     st = session.link.state
     if st.last_heartbeat_s is None:
@@ -70,12 +76,14 @@ def left_behind(session: FlightSession) -> str:
     heard = "" if st.link_ok(session.clock.now()) else " (as last heard)"
     if not st.armed:
         return f"the vehicle was left disarmed in {st.mode}{heard}."
-    mode = session.exit_mode if st.offboard and session.exit_mode else st.mode  # the HEARTBEAT trails the ACK
-    return f"the vehicle was left armed in {mode}{heard}: {_NEXT.get(mode, 'take over with a ground station.')}"
+    # the HEARTBEAT trails the ACK
+    mode = session.exit_mode if session.in_control(st) and session.exit_mode else st.mode
+    nexts = _NEXT if session.control_label() == "OFFBOARD" else _NEXT_MANUAL
+    return f"the vehicle was left armed in {mode}{heard}: {nexts.get(mode, 'take over with a ground station.')}"
 
 
 @contextmanager
-def exit_signals(session: FlightSession) -> Iterator[None]:
+def exit_signals(session: SessionLoop) -> Iterator[None]:
     """First SIGINT/SIGTERM: ask the session to perform --on-exit; the second: KeyboardInterrupt, at once."""
 
     def handler(signum: int, frame: FrameType | None) -> None:

@@ -54,6 +54,8 @@ MAV_RESULT_ACCEPTED = 0
 MAV_RESULT_IN_PROGRESS = 5
 
 # PX4 custom_mode = (sub_mode << 24) | (main_mode << 16) (src/modules/commander/px4_custom_mode.h)
+MAIN_ALTCTL = 2
+MAIN_POSCTL = 3
 MAIN_OFFBOARD = 6
 MAIN_AUTO = 4
 SUB_AUTO_LOITER = 3
@@ -74,6 +76,11 @@ def mode_name(custom_mode: int) -> str:
 
 def is_offboard(custom_mode: int) -> bool:
     return (custom_mode >> 16) & 0xFF == MAIN_OFFBOARD
+
+
+def main_mode(custom_mode: int) -> int:
+    """PX4's main mode (MAIN_POSCTL, MAIN_AUTO...) of a custom_mode."""
+    return (custom_mode >> 16) & 0xFF
 
 
 @dataclass(frozen=True, slots=True)
@@ -317,6 +324,11 @@ class VehicleLink:
         boot_ms = int((self._clock.now() - self._t0_s) * 1000) & 0xFFFFFFFF
         self._mav.set_position_target_local_ned_send(boot_ms, sysid, compid, FRAME_LOCAL_NED, sp.type_mask,
                                                      x, y, z, vx, vy, vz, 0.0, 0.0, 0.0, sp.yaw_rad, 0.0)
+
+    def send_manual_control(self, x: int, y: int, z: int, r: int) -> None:
+        """MANUAL_CONTROL to the vehicle, as QGroundControl's joystick sends it: x forward (pitch), y right (roll), r
+        yaw in -1000..1000, z throttle 0..1000 (500 centred); no buttons (PX4's multicopter modes use none)."""
+        self._mav.manual_control_send(self._target()[0], x, y, z, r, 0)
 
     def close(self) -> None:
         self.transport.close()

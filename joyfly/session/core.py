@@ -14,6 +14,7 @@ from typing import Protocol
 from joyfly.link.vehicle_link import VehicleLink, VehicleState
 from joyfly.session.retry import ExitPlan, Retry
 from joyfly.session.watchdogs import JoystickWatch, LinkWatch
+from joyfly.sticks.manual import ManualInput
 from joyfly.sticks.setpoints import Fence, Limits, Setpoint, hold_setpoint
 from joyfly.types import Action, Clock, StickCommand
 
@@ -77,8 +78,13 @@ class Note:
 class FlightStats:
     distance_m: float = 0.0
     min_fence_margin_m: float = math.inf
-    offboard_time_s: float = 0.0
+    control_time_s: float = 0.0  # time in joyfly's mode: OFFBOARD, or POSCTL/ALTCTL with --control position/altitude
     max_alt_m: float = 0.0
+
+    @property
+    def offboard_time_s(self) -> float:
+        """The time in OFFBOARD, for an OFFBOARD session (its control_time_s)."""
+        return self.control_time_s
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,20 +108,25 @@ class SessionView:
     notes: tuple[Note, ...]
     link_description: str
     heard: bool = True  # a vehicle has answered
+    control: str = "OFFBOARD"  # the mode joyfly flies in
+    manual: ManualInput | None = None  # the last MANUAL_CONTROL sent (--control position/altitude), else None
+    phase_text: str = ""  # the phase in words for this way of flying ("" = phase.value)
 
 
 def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None, st: VehicleState, fence: Fence,
-                 dt_s: float, now_s: float) -> FlightStats:
-    """Accumulate distance flown, closest approach to the fence (in the air) and time in OFFBOARD, while armed and
-    while the vehicle is heard (a link outage is not time in OFFBOARD: we do not know what it did)."""
+                 dt_s: float, now_s: float, in_control: bool | None = None) -> FlightStats:
+    """Accumulate distance flown, closest approach to the fence (in the air) and time in joyfly's mode (`in_control`,
+    OFFBOARD by default), while armed and while the vehicle is heard (a link outage is not time in OFFBOARD: we do
+    not know what it did)."""
     pos = st.pos_ned_m
     if pos is None or not st.armed or st.stamped_s is None or now_s - st.stamped_s > STALE_S:
         return stats
     dist = stats.distance_m + (math.dist(pos, prev_pos) if prev_pos is not None else 0.0)
     in_air = st.landed_state != 1
     margin = min(stats.min_fence_margin_m, fence.margin_m(pos)) if in_air else stats.min_fence_margin_m
-    offboard = stats.offboard_time_s + (dt_s if st.offboard else 0.0)
-    return FlightStats(dist, margin, offboard, max(stats.max_alt_m, fence.alt_m(pos)))
+    controlled = st.offboard if in_control is None else in_control
+    control_time = stats.control_time_s + (dt_s if controlled else 0.0)
+    return FlightStats(dist, margin, control_time, max(stats.max_alt_m, fence.alt_m(pos)))
 
 
 def no_vehicle_message(where: str, heard: bool, timeout_s: float) -> str:
@@ -171,6 +182,7 @@ class SessionCore:
         self._arm_hold_s = float(getattr(getattr(sticks, "profile", None), "arm_hold_s", 1.0))
         self._last_pos: tuple[float, float, float] | None = None
         self.setpoints_sent = 0
+        self.manual_sent: ManualInput | None = None  # the last MANUAL_CONTROL (ManualSession)
         self.on_setpoint: list[Callable[[Setpoint], None]] = []
         self._exit: ExitPlan | None = None
         self._dirty = False  # the sticks changed since the last setpoint was sent
@@ -182,6 +194,21 @@ class SessionCore:
         self._restarts_seen = 0
         self._restart_s = -math.inf  # when joyfly last reported a restart of the vehicle
         self._home_from_vehicle = False  # True when joyfly took over a flying vehicle: its HOME_POSITION is home
+
+    def in_control(self, st: VehicleState) -> bool:
+        """Whether the vehicle is in the mode joyfly flies it in (OFFBOARD here; ManualSession: POSCTL/ALTCTL)."""
+        return st.offboard
+
+    def control_label(self) -> str:
+        """The mode joyfly flies in, as the live view and the summary name it."""
+        return "OFFBOARD"
+
+    def phase_text(self) -> str:
+        return self.phase.value
+
+    def summary_extra(self) -> list[str]:
+        """Lines the flight's summary adds for this way of flying."""
+        return []
 
     @property
     def finished(self) -> bool:
@@ -242,7 +269,8 @@ class SessionCore:
 
     def _update_stats(self, now: float) -> None:
         st = self.link.state
-        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s, now)
+        self.stats = update_stats(self.stats, self._last_pos, st, self.fence, now - self._last_tick_s, now,
+                                  self.in_control(st))
         self._last_pos = st.pos_ned_m
 
     def _note_once(self, text: str) -> None:
@@ -258,4 +286,5 @@ class SessionCore:
             streaming=self._streaming_allowed(), stick=self.cmd, joystick_ok=not self._joy.lost,
             fence=self.fence, stats=self.stats, statustexts=tuple(t.text for t in list(self.link.statustexts)[-5:]),
             notes=tuple(self.notes[-5:]), link_description=self.link.transport.description,
-            heard=st.last_heartbeat_s is not None)
+            heard=st.last_heartbeat_s is not None, control=self.control_label(), manual=self.manual_sent,
+            phase_text=self.phase_text())

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink
+from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink, VehicleState
 
 # PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
@@ -93,11 +93,14 @@ EXIT_MODES = {"land": "AUTO.LAND", "rtl": "AUTO.RTL", "hold": "AUTO.LOITER"}  # 
 
 class ExitPlan:
     """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
-    until the vehicle is disarmed (land, rtl) or out of OFFBOARD (hold). The caller enforces the overall timeout."""
+    until the vehicle is disarmed (land, rtl) or out of joyfly's mode (hold: `in_control`, OFFBOARD by default).
+    The caller enforces the overall timeout."""
 
-    def __init__(self, on_exit: str, link: VehicleLink, now_s: float) -> None:
+    def __init__(self, on_exit: str, link: VehicleLink, now_s: float,
+                 in_control: Callable[[VehicleState], bool] | None = None) -> None:
         self.on_exit = on_exit
         self.link = link
+        self.in_control = in_control or (lambda st: st.offboard)
         self.started_s = now_s
         self.retry = Retry(f"Exit action {on_exit}", 3, now_s, settle_s=math.inf)
         self._gave_up = False
@@ -116,11 +119,11 @@ class ExitPlan:
         return self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
 
     def done(self) -> bool:
-        """Out of OFFBOARD (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not
+        """Out of joyfly's mode (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not
         show in the 1 Hz HEARTBEAT yet)."""
         st = self.link.state
         if self.on_exit == "hold":
-            return not st.offboard
+            return not self.in_control(st)
         return not st.armed and st.last_heartbeat_s is not None and st.last_heartbeat_s > self.started_s
 
     def update(self, now_s: float) -> str | None:

@@ -58,16 +58,24 @@ class SessionWatch(SessionCore):
     def _watch_joystick(self, now: float) -> None:
         change = self._joy.update(self.cmd.connected, now)
         if change is Change.LOST and self.phase is Phase.FLYING:
-            self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
-                               "unless it comes back.")
-            self.sp = self._hold_here()
+            self._hold_for_joystick()
         elif change is Change.LOST and self.phase is Phase.LANDING:
             self._note("warn", "Joystick lost: the vehicle keeps landing; joyfly quits once it has disarmed.")
         elif change is Change.LOST and self.phase is not Phase.GROUNDED:  # landed: _grounded says it
             self._note("warn", "Joystick lost.")
         elif change is Change.BACK:
             self._note("info", "Joystick back: you have control again.")
+            self._joystick_back()
         if self._joy.expired(now) and self.phase is Phase.FLYING:
             self._note("warn", f"Joystick still lost after {self.s.joy_timeout_s:g} s: landing.")
             self.link.land()
             self._set_phase(Phase.LANDING)
+
+    def _hold_for_joystick(self) -> None:
+        """The joystick went away in flight: hold until it comes back or the timeout lands the vehicle."""
+        self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
+                           "unless it comes back.")
+        self.sp = self._hold_here()
+
+    def _joystick_back(self) -> None:
+        """The joystick came back (the sticks fly again from the next setpoint)."""

@@ -64,6 +64,8 @@ def test_fly_help_says_what_the_control_choices_do_and_how_speed_relates() -> No
     text = " ".join(invoke("joyfly", "fly", "--help").output.split())
     assert "(the seed)" not in text
     assert "velocity: the sticks set the vehicle's velocity" in text and "step: the setpoint is" in text
+    assert "position: Position mode (POSCTL)" in text and "altitude: Altitude mode (ALTCTL)" in text
+    assert "default: 20 (OFFBOARD), 25 (position, altitude: QGroundControl's)" in text
     assert "sitl-emu serve --speed N" in text
     serve = " ".join(invoke("sitl-emu", "serve", "--help").output.split())
     assert "joyfly fly --speed N" in serve

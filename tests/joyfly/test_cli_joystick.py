@@ -110,7 +110,8 @@ def test_live_view_redraws_in_place():
     view.show(JoyState(1.1, (0, 0), (0, 0)), StickCommand(time_s=1.1), 0.0, "")
     text = out.getvalue()
     assert "axes     0:+0.00 1:-1.00" in text and "forward=+1.00" in text
-    assert "\x1b[5F" in text  # the second frame moved the cursor back over the first
+    assert "MANUAL_CONTROL x +1000 y    +0 z  500 r    +0" in text  # what --control position would send
+    assert "\x1b[6F" in text  # the second frame moved the cursor back over the first
     assert get_profile("xbox").name == "xbox"
 
 

@@ -50,3 +50,18 @@ def test_demo_flies_a_vehicle_already_listening_at_url() -> None:
     finally:
         vehicle.stop()
     assert "Landed and disarmed" in out.getvalue()
+
+
+def test_demo_in_position_mode_takes_off_with_the_throttle_and_stays_inside_the_fence() -> None:
+    # PX4 takes MANUAL_CONTROL for lost 0.5 s (simulated) after the last one: 50 ms of wall time at x10, which a busy
+    # CI machine can take from the process (joyfly and the emulator share it here); at x4 it is 125 ms
+    out = io.StringIO()
+    assert run_demo(speed=URL_SPEED, live=False, out=out, control="position") == 0, out.getvalue()
+    text = out.getvalue()
+    assert "Armed in Position mode" in text and "Vehicle: Takeoff detected" in text, text
+    assert "LAND pressed: landing" in text and "Landed and disarmed" in text, text
+    assert "time in POSCTL" in text and "Position mode (POSCTL), MANUAL_CONTROL at 25 Hz" in text
+    closest = next(line for line in text.splitlines() if line.startswith("closest to the fence"))
+    assert "inside" in closest  # the full stick north stops at the fence
+    distance = next(line for line in text.splitlines() if line.startswith("distance flown"))
+    assert float(distance.split()[2]) > 15.0  # climb + square + fence push

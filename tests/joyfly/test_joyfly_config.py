@@ -41,7 +41,7 @@ def test_top_level_keys_work_without_a_fly_table(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("options", "fragment"), [
     ({"rate": 5.0}, "--rate 5 is out of range: use 10 to 200 Hz (PX4 leaves OFFBOARD after 1 s"),
     ({"on_exit": "crash"}, "--on-exit crash is not a choice here: use one of land, hold, rtl."),
-    ({"control": "rate"}, "--control rate is not a choice here: use one of velocity, step."),
+    ({"control": "rate"}, "--control rate is not a choice here: use one of velocity, step, position, altitude."),
     ({"min_alt": 5.0, "max_alt": 4.0}, "--min-alt 5 must be below --max-alt (4 m)"),
     ({"alt": 20.0}, "--alt 20 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),
     ({"max_alt": 2.0}, "the default --alt 3 is out of range: use 0.5 to 2 m"),
@@ -108,3 +108,23 @@ def test_unknown_config_key_is_named(tmp_path: Path) -> None:
 
 def test_every_option_has_a_default() -> None:
     assert FlyOptions().speed == 1.0 and FlyOptions().record is None
+
+
+def test_position_and_altitude_control_stream_at_qgcs_25_hz_unless_told() -> None:
+    assert build_options({}, {"control": "position"}).rate == 25.0
+    assert build_options({"control": "altitude"}, {}).rate == 25.0
+    assert build_options({}, {"control": "position", "rate": 40.0}).rate == 40.0
+    assert build_options({"rate": 15}, {"control": "altitude"}).rate == 15.0
+    assert build_options({}, {"control": "step"}).rate == 20.0
+    assert build_options({}, {"control": "position"}).session_settings().limits.control == "position"
+
+
+def test_position_control_refuses_a_profile_without_a_throttle() -> None:
+    from joyfly.cli import throttle_problem
+    from joyfly.sticks.profiles import load_profile
+
+    problem = throttle_problem("position", load_profile("generic", "some pad"))
+    assert problem is not None and "maps no throttle" in problem and "[profile.up] index" in problem
+    assert throttle_problem("position", load_profile("xbox", "x")) is None
+    assert throttle_problem("altitude", load_profile("radio", "x")) is None  # a radio's throttle_abs
+    assert throttle_problem("velocity", load_profile("generic", "some pad")) is None

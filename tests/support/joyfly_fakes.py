@@ -231,7 +231,7 @@ class FakeVehicle:
         now = self.now
         if now >= self._next["hb"]:
             base = 1 | (128 if self.armed else 0)
-            self.mav.heartbeat_send(2, 12, base, self.custom_mode, 4 if self.armed else 3)
+            self.mav.heartbeat_send(2, 12, base, self.custom_mode, self._system_status())
             self._next["hb"] = now + 1.0
         if now >= self._next["pos"]:
             ms = int((now - self.boot_s) * 1000)
@@ -244,6 +244,9 @@ class FakeVehicle:
         if now >= self._next["home"]:
             self.mav.home_position_send(0, 0, 0, *self.home, [1, 0, 0, 0], 0, 0, 0)
             self._next["home"] = now + 2.0  # PX4 streams HOME_POSITION at 0.5 Hz (px4-behaviour.md 1.5)
+
+    def _system_status(self) -> int:
+        return 4 if self.armed else 3  # ACTIVE, STANDBY
 
     def received(self, kind: str) -> list[tuple[float, Any]]:
         return [(t, m) for t, k, m in self.log if k == kind]
