@@ -142,20 +142,20 @@ def _limit_axis(u: float, pos: float, vel: tuple[float, float], centre: float, h
     return max(-1.0, min(1.0, u))
 
 
-def _rotate(f: float, r: float, yaw: float) -> tuple[float, float]:
+def heading_to_world(f: float, r: float, yaw: float) -> tuple[float, float]:
     """Body (forward, right) -> world (north, east), as PX4's rotateIntoHeadingFrameXY."""
     c, s = math.cos(yaw), math.sin(yaw)
     return c * f - s * r, s * f + c * r
 
 
-def _unit_limited(f: float, r: float) -> tuple[float, float]:
+def unit_limited(f: float, r: float) -> tuple[float, float]:
     norm = math.hypot(f, r)
     return (f / norm, r / norm) if norm > 1.0 else (f, r)
 
 
 def shaped_world(inp: ManualInput, yaw: float, m: ManualModel = PX4) -> tuple[float, float]:
     """The right stick as PX4's POSCTL acts on it: shaped, limited to the unit circle, rotated into north/east."""
-    return _rotate(*_unit_limited(px4_shape(inp.x / 1000, m), px4_shape(inp.y / 1000, m)), yaw)
+    return heading_to_world(*unit_limited(px4_shape(inp.x / 1000, m), px4_shape(inp.y / 1000, m)), yaw)
 
 
 def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence: Fence, altitude_mode: bool,
@@ -165,7 +165,7 @@ def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence
     if not fence.enabled:
         return x, y
     shape: Callable[[float], float] = (lambda s: s) if altitude_mode else (lambda s: px4_shape(s, m))
-    north, east = _rotate(*_unit_limited(shape(x), shape(y)), yaw)  # PX4 limits the stick to the unit circle
+    north, east = heading_to_world(*unit_limited(shape(x), shape(y)), yaw)  # PX4 limits the stick to the unit circle
     if not altitude_mode and abs(north) < STICK_EPS and abs(east) < STICK_EPS:
         return x, y  # POSCTL brakes harder and locks the position by itself when the stick is released
     acc, drag = (m.tilt_acc_m_s2, 0.0) if altitude_mode else (m.pos_acc_m_s2, m.pos_drag_1_s)
@@ -176,7 +176,8 @@ def limit_horizontal(x: float, y: float, pos: Vec3, vel: Vec3, yaw: float, fence
     if abs(n2 - north) < STICK_EPS and abs(e2 - east) < STICK_EPS:
         return x, y
     n2, e2 = (0.0 if abs(n2) < SNAP else n2), (0.0 if abs(e2) < SNAP else e2)  # PX4 then brakes and locks
-    f, r = (0.0 if abs(v) < SNAP else v for v in _rotate(n2, e2, -yaw))  # no residue becomes PX4's deadzone edge
+    # back into the heading frame; no residue becomes PX4's deadzone edge
+    f, r = (0.0 if abs(v) < SNAP else v for v in heading_to_world(n2, e2, -yaw))
     unshape: Callable[[float], float] = (lambda e: e) if altitude_mode else (lambda e: px4_unshape(e, m))
     return unshape(f), unshape(r)
 

@@ -18,20 +18,10 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
-from joyfly.sticks.manual_fence import G, px4_shape
+from joyfly.sticks.manual_fence import G, heading_to_world, px4_shape, unit_limited
 
 EPS = 1.19e-7  # FLT_EPSILON
 Vec2 = list[float]
-
-
-def _rotate(f: float, r: float, yaw: float) -> tuple[float, float]:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return c * f - s * r, s * f + c * r
-
-
-def _unit_limited(a: float, b: float) -> tuple[float, float]:
-    n = math.hypot(a, b)
-    return (a / n, b / n) if n > 1.0 else (a, b)
 
 
 @dataclass
@@ -60,7 +50,7 @@ class Plant:
         self._vertical(throttle, dt)
 
     def _posctl_xy(self, x: float, y: float, dt: float) -> None:
-        e = _rotate(*_unit_limited(px4_shape(x), px4_shape(y)), self.yaw)
+        e = heading_to_world(*unit_limited(px4_shape(x), px4_shape(y)), self.yaw)
         released = e[0] ** 2 + e[1] ** 2 < EPS
         self.boost += dt / (0.8 + dt) * ((max(2.0, math.sqrt(10.0)) if released else 1.0) - self.boost)
         speed = math.hypot(*self.v_sp)
@@ -80,7 +70,7 @@ class Plant:
         self.pos = [p + v * dt for p, v in zip(self.pos, self.vel, strict=True)]
 
     def _altctl_xy(self, x: float, y: float, dt: float) -> None:
-        e = _rotate(*_unit_limited(x, y), self.yaw)
+        e = heading_to_world(*unit_limited(x, y), self.yaw)
         tilt = math.tan(math.radians(35.0)) * G
         target = [tilt * ei for ei in e]
         self.acc_sp = [a + (t - a) * dt / 0.2 for a, t in zip(self.acc_sp, target, strict=True)]
