@@ -23,8 +23,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from support import REPO_ROOT
-from support.ports import free_udp_ports
+from support.serve_process import serve, stop_process
 
 from sitl_emu.params import default_registry
 
@@ -34,21 +33,10 @@ WAIT_S = 30.0  # the longest any single step may take (wall clock)
 @pytest.fixture()
 def gcs_port(tmp_path: Path) -> Iterator[int]:
     """`sitl-emu serve` in tmp_path/serve on free ports; yields the port its ground-station link sends to."""
-    api_port, api_remote, gcs_local, gcs_remote = free_udp_ports(4)
     workdir = tmp_path / "serve"
     workdir.mkdir()
-    args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", "2",
-            "--port", str(api_port), "--remote", f"127.0.0.1:{api_remote}",
-            "--gcs-port", str(gcs_local), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
-    log_path = workdir / "serve.log"
-    with log_path.open("w") as log_file:
-        proc = subprocess.Popen(args, cwd=workdir, stdout=log_file, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                env={**os.environ, "PYTHONPATH": str(REPO_ROOT)})
-        try:
-            yield gcs_remote
-        finally:
-            _stop(proc)
-            print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-2000:])
+    with serve(workdir, workdir / "serve.log", 2.0) as ports:
+        yield ports.gcs_remote
 
 
 class MavProxy:
@@ -93,16 +81,7 @@ class MavProxy:
     def close(self) -> None:
         if self.proc.stdin is not None and not self.proc.stdin.closed:
             self.proc.stdin.close()  # end of input: MAVProxy's input loop exits
-        _stop(self.proc)
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    proc.terminate()
-    try:
-        proc.wait(timeout=5)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait(timeout=5)
+        stop_process(self.proc)
 
 
 def _wait_for_file_line(path: Path, pattern: str, timeout_s: float = WAIT_S) -> str:

@@ -31,8 +31,8 @@ CALL_TIMEOUT_S = 15.0  # no single MAVSDK call may hang the test
 def server(tmp_path: Path):
     """`sitl-emu serve` on free ports, in tmp_path (the parameters it sets are saved there, not in the repository);
     yields the UDP port MAVSDK must listen on (the API link's remote)."""
-    with serve(tmp_path, tmp_path / "serve.log", SPEED) as client_port:
-        yield client_port
+    with serve(tmp_path, tmp_path / "serve.log", SPEED) as ports:
+        yield ports.api_remote
 
 
 class Session:

@@ -9,7 +9,7 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import pytest
 
@@ -26,10 +26,15 @@ def load_mavsdk() -> Any:
     return mavsdk_asyncio
 
 
+class ServedPorts(NamedTuple):
+    api_remote: int  # where the API link sends (MAVSDK listens here)
+    gcs_remote: int  # where the ground-station link sends (a ground station listens here)
+
+
 @contextmanager
-def serve(workdir: Path, log_path: Path, speed: float) -> Iterator[int]:
+def serve(workdir: Path, log_path: Path, speed: float) -> Iterator[ServedPorts]:
     """`sitl-emu serve --speed SPEED` on free ports, run in `workdir` (its parameters file and FTP root go there);
-    yields the UDP port its API link sends to (where MAVSDK listens). The log's tail is printed at the end."""
+    yields the UDP ports its two links send to. The log's tail is printed at the end."""
     client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
     args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(speed),
             "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
@@ -39,12 +44,17 @@ def serve(workdir: Path, log_path: Path, speed: float) -> Iterator[int]:
         proc = subprocess.Popen(args, cwd=workdir, env=env, stdout=log_file, stderr=subprocess.STDOUT,
                                 stdin=subprocess.DEVNULL)
         try:
-            yield client_port
+            yield ServedPorts(client_port, gcs_remote)
         finally:
-            proc.terminate()
-            try:
-                proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait(timeout=5)
+            stop_process(proc)
             print("\n--- sitl-emu serve output (tail) ---\n" + log_path.read_text()[-3000:])
+
+
+def stop_process(proc: subprocess.Popen[Any]) -> None:
+    """SIGTERM, then SIGKILL if it is still there after 5 s."""
+    proc.terminate()
+    try:
+        proc.wait(timeout=5)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(timeout=5)

@@ -30,8 +30,8 @@ def served(tmp_path: Path):
     (root / "hello.txt").write_bytes(b"hello from the emulator\n")
     (root / "big.bin").write_bytes(os.urandom(80_000))
     (tmp_path / "outside.txt").write_bytes(b"secret")
-    with serve(work, tmp_path / "serve.log", SPEED) as client_port:
-        yield client_port, root
+    with serve(work, tmp_path / "serve.log", SPEED) as ports:
+        yield ports.api_remote, root
 
 
 @pytest.mark.timeout(240)
