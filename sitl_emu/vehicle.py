@@ -114,7 +114,8 @@ class Vehicle:
             c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             c.update(now)
         chain = self.chain
-        out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s)
+        out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s,
+                                    c.manual.setpoint)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
         motors = self._motor_commands = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
@@ -171,8 +172,7 @@ class Vehicle:
         """A MAVLink joystick's sticks (MANUAL_CONTROL): the vehicle's manual input per COM_RC_IN_MODE, in any mode
         (flight/manual_control.py)."""
         self._snap = None
-        if self.commander.manual_control_signal(self._time_us, setpoint):
-            self.chain.executor.manual(setpoint)
+        self.commander.manual_control_signal(self._time_us, setpoint)
 
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""

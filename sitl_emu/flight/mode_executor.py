@@ -76,7 +76,6 @@ class ModeExecutor:
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
-        self.sticks: ManualControlSetpoint = CENTRED  # the last manual input (flight/manual_control.py)
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -87,15 +86,14 @@ class ModeExecutor:
             self._offboard_att = attitude
         self._offboard_out = None
 
-    def manual(self, setpoint: ManualControlSetpoint) -> None:
-        self.sticks = setpoint
-
     def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
-               commands: list[NavCommand], ref: GeoRef, dt_s: float) -> ExecutorOutput:
-        """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts)."""
+               commands: list[NavCommand], ref: GeoRef, dt_s: float,
+               sticks: ManualControlSetpoint = CENTRED) -> ExecutorOutput:
+        """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts); `sticks`
+        is the last manual input (the commander's, flight/manual_control.py), for the manual modes."""
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
         if nav_state in _STICK_ATTITUDE_MODES:
-            return self._stick_attitude(armed, nav_fn, dt_s)
+            return self._stick_attitude(armed, nav_fn, dt_s, sticks)
         self._stabilized = None
         if nav_state is NavState.OFFBOARD:
             if self._offboard_out is None:
@@ -103,9 +101,10 @@ class ModeExecutor:
             return self._offboard_out
         if self.task is None:
             return _NO_SETPOINT
-        return self._run_task(self.task, now_us, nav_fn, dt_s, new_task)
+        return self._run_task(self.task, now_us, nav_fn, dt_s, new_task, sticks)
 
-    def _stick_attitude(self, armed: bool, nav_fn: Callable[[], tasks.NavInput], dt_s: float) -> ExecutorOutput:
+    def _stick_attitude(self, armed: bool, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
+                        sticks: ManualControlSetpoint) -> ExecutorOutput:
         """STABILIZED / MANUAL: the sticks' attitude and thrust, every tick (mc_att_control)."""
         if not armed:
             self._stabilized = None
@@ -113,11 +112,11 @@ class ModeExecutor:
         nav = nav_fn()
         if self._stabilized is None:
             self._stabilized = StabilizedMode(nav, self.params)
-        self._stabilized.sticks = self.sticks
+        self._stabilized.sticks = sticks
         return ExecutorOutput(None, self._stabilized.update(nav, dt_s), SetpointType.NONE, False, ())
 
     def _run_task(self, task: FlightTask, now_us: int, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
-                  new_task: bool) -> ExecutorOutput:
+                  new_task: bool, sticks: ManualControlSetpoint) -> ExecutorOutput:
         """The task's setpoint, computed every task.period_us (the last one is held in between)."""
         held = self._held
         dt = dt_s
@@ -126,7 +125,7 @@ class ModeExecutor:
                 return held
             dt = (now_us - self._last_us) * 1e-6
         if isinstance(task, ManualAltitudeTask):
-            task.sticks = self.sticks
+            task.sticks = sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
         self._last_us = now_us
