@@ -113,9 +113,9 @@ def missing(nav_state: NavState, c: CheckInputs) -> int:
     return requirements(nav_state) & ~(c.available() | Req.PREVENT_ARMING)
 
 
-def can_run(nav_state: NavState, c: CheckInputs) -> bool:
-    """True if nav_state's requirements are met (HealthAndArmingChecks::canRun)."""
-    return not missing(nav_state, c)
+def can_run(nav_state: NavState, c: CheckInputs, ignoring: int = Req.NONE) -> bool:
+    """True if nav_state's requirements are met (HealthAndArmingChecks::canRun), leaving out the `ignoring` bits."""
+    return not (missing(nav_state, c) & ~ignoring)
 
 
 def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> str | None:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from sitl_emu.flight.arming import CheckInputs, can_run
+from sitl_emu.flight.arming import CheckInputs, Req, can_run
 from sitl_emu.flight.manual_control import ManualLossFailsafe, ManualLossSettings
 from sitl_emu.px4 import NavState
 
@@ -134,7 +134,9 @@ class Failsafe:
         if terminated:
             return self._decide(NavState.TERMINATION, False, "")
         rank, mode, disarm = 0, user, False
-        if not can_run(user, _manual_control_aside(inputs)):
+        # framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with
+        # its Hold first): for the user's own mode, missing sticks are not a reason to fall back at once
+        if not can_run(user, inputs, ignoring=Req.MANUAL):
             fallback = resolve_fallback(user, settings, inputs)
             rank, mode, disarm = (_DISARM_RANK, user, True) if fallback is None else (_RANK[fallback], fallback, False)
         if manual_loss is not None:
@@ -155,11 +157,3 @@ class Failsafe:
     def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
         self.active = True
         return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text)
-
-
-def _manual_control_aside(inputs: CheckInputs) -> CheckInputs:
-    """framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with its
-    Hold first): for the user's own mode, a missing stick input is not a reason to fall back at once."""
-    if inputs.manual_control:
-        return inputs
-    return CheckInputs(inputs.estimator_ready, inputs.home_valid, inputs.offboard_signal, True, inputs.mission_valid)
