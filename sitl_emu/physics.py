@@ -90,11 +90,15 @@ class SihConfig:
         return self.mass_kg * GRAVITY_M_S2 / (4.0 * self.t_max_n)
 
 
-def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig) -> RigidBodyState:
-    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed."""
+def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig,
+         wind_ned_m_s: Vec3 | None = None) -> RigidBodyState:
+    """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
+
+    `wind_ned_m_s` is the air mass velocity (sitl_emu/disturbance/wind.py); None: cfg's constant wind."""
     u = _motor_lag(state.motors, motor_cmd, dt_s, cfg.t_tau_s)
     thrust_n = cfg.t_max_n * (u[0] + u[1] + u[2] + u[3])  # along body -z
-    acc = _acceleration_ned(state.q_wxyz, state.vel_ned_m_s, thrust_n, cfg)
+    wind = (cfg.wind_n_m_s, cfg.wind_e_m_s, 0.0) if wind_ned_m_s is None else wind_ned_m_s
+    acc = _acceleration_ned(state.q_wxyz, state.vel_ned_m_s, thrust_n, cfg, wind)
     pos, vel = state.pos_ned_m, state.vel_ned_m_s
     if state.on_ground and acc[2] >= 0.0:
         return _grounded(state, u, (pos[0], pos[1], 0.0))
@@ -121,13 +125,13 @@ def _motor_lag(motors: Vec4, cmd: Sequence[float], dt_s: float, tau_s: float) ->
     return m0 + k * (c0 - m0), m1 + k * (c1 - m1), m2 + k * (c2 - m2), m3 + k * (c3 - m3)
 
 
-def _acceleration_ned(q: Vec4, vel: Vec3, thrust_n: float, cfg: SihConfig) -> Vec3:
+def _acceleration_ned(q: Vec4, vel: Vec3, thrust_n: float, cfg: SihConfig, wind: Vec3) -> Vec3:
     """sih.cpp generate_force_and_torques: thrust along body -z, linear drag on the air-relative velocity, gravity."""
     body_z = dcm_z(q)
     m, kdv = cfg.mass_kg, cfg.kdv
-    return ((-thrust_n * body_z[0] - kdv * (vel[0] - cfg.wind_n_m_s)) / m,
-            (-thrust_n * body_z[1] - kdv * (vel[1] - cfg.wind_e_m_s)) / m,
-            (-thrust_n * body_z[2] - kdv * vel[2] + m * GRAVITY_M_S2) / m)
+    return ((-thrust_n * body_z[0] - kdv * (vel[0] - wind[0])) / m,
+            (-thrust_n * body_z[1] - kdv * (vel[1] - wind[1])) / m,
+            (-thrust_n * body_z[2] - kdv * (vel[2] - wind[2]) + m * GRAVITY_M_S2) / m)
 
 
 def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:

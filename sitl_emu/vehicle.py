@@ -23,6 +23,8 @@ from typing import Final
 import numpy as np
 
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
+from sitl_emu.disturbance.estimate import EstimateNoiseSettings
+from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.commands import handle_command
 from sitl_emu.flight.mission_store import MissionStore
@@ -32,7 +34,7 @@ from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
-from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, LandedState, MavCmd, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
@@ -46,6 +48,7 @@ from sitl_emu.types import (
     VehicleEvent,
     VehicleSnapshot,
 )
+from sitl_emu.vehicle_faults import VehicleFaults
 from sitl_emu.vehicle_parts import ControlChain, published_setpoints
 
 EVENT_HISTORY: Final = 1000
@@ -60,11 +63,13 @@ class Vehicle:
 
     def __init__(self, *, params: ParamRegistry | None = None,
                  home: tuple[float, float, float] = (47.397742, 8.545594, 488.0), seed: int = 0, sysid: int = 1,
-                 ready_delay_s: float = 2.0, position_noise_m: float = 0.0) -> None:
+                 ready_delay_s: float = 2.0, position_noise_m: float = 0.0, wind: WindSettings | None = None,
+                 estimate_noise: EstimateNoiseSettings | None = None) -> None:
         """Boot disarmed in Hold on the ground at `home` (lat_deg, lon_deg, alt_amsl_m), the local frame's origin.
 
         `ready_delay_s` is the simulated estimator warm-up before arming is possible; `position_noise_m` (default 0)
-        adds seeded Gaussian noise to the position estimate.
+        adds seeded Gaussian noise to the position estimate; `wind` (mean, turbulence, gusts) and `estimate_noise`
+        (white noise and bias walk on position, velocity, attitude) are off by default (vehicle_faults.py).
         """
         self.params: ParamRegistry = params if params is not None else default_registry()
         self.sysid = sysid
@@ -72,6 +77,8 @@ class Vehicle:
         self._seed = seed
         self._ready_delay_us = round(ready_delay_s * 1e6)
         self._noise_m = position_noise_m
+        self._wind_settings = wind
+        self._estimate_noise = estimate_noise
         self._events: deque[VehicleEvent] = deque(maxlen=EVENT_HISTORY)
         self._seq = 0
         self._boot()
@@ -93,6 +100,8 @@ class Vehicle:
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
         self._missions = MissionStore()  # in memory only: a reboot empties it (flight/mission_store.py)
+        self.faults = VehicleFaults(self.params, self.commander.fault_flags, self._emit, seed=self._seed,
+                                    dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -111,6 +120,7 @@ class Vehicle:
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now
+            self.faults.update(now, c.armed, self._estimate)
             c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             c.update(now)
         chain = self.chain
@@ -118,9 +128,13 @@ class Vehicle:
                                     c.manual.setpoint)
         self._setpoint_type, self._task_finished = out.setpoint_type, out.task_finished
         motors_armed = c.armed and c.nav_state is not NavState.TERMINATION
-        motors = self._motor_commands = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
-        self._state = physics_step(self._state, motors, dt_s, self._sih_config())
+        faults = self.faults
+        motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
+        motors = self._motor_commands = faults.motors(motors)
+        self._state = physics_step(self._state, motors, dt_s, self._sih_config(), faults.wind_at(now, self._state))
         self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
+        if faults.noise is not None:
+            self._estimate = faults.estimate(self._estimate, dt_s)
         climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
         detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
         if detected is not None:
@@ -159,7 +173,13 @@ class Vehicle:
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
         self._snap = None
+        if cmd.command == MavCmd.INJECT_FAILURE:  # the failure injection manager (flight/failure_injection.py)
+            return self.faults.inject(cmd, self._time_us)
         return handle_command(self.commander, cmd, self._time_us)
+
+    def gcs_heartbeat(self) -> None:
+        """A ground station's HEARTBEAT arrived (the COM_DL_LOSS_T data-link watchdog, vehicle_faults.py)."""
+        self.faults.gcs_heartbeat(self._time_us)
 
     def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
                        attitude: AttitudeSetpoint | None = None) -> None:
@@ -239,7 +259,8 @@ class Vehicle:
         return VehicleSnapshot(
             time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
             user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe, landed_state=self.landed_state(),
-            pre_flight_checks_pass=c.pre_flight_checks_pass(), position_valid=c.estimator_ready,
+            pre_flight_checks_pass=c.pre_flight_checks_pass(),
+            position_valid=c.estimator_ready and not c.fault_flags.position_lost,
             takeoff_detected=c.have_taken_off, offboard_control=c.offboard_mode,
             pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s, acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz,
             rates_frd_rad_s=s.rates_frd_rad_s, euler_rad=euler, lat_deg=lat, lon_deg=lon,
@@ -248,4 +269,5 @@ class Vehicle:
             thrust_setpoint=thrust, motors=self._state.motors, extras={"system_status": float(c.system_status())},
             motor_commands=self._motor_commands, offboard_control_last=offboard_last,
             manual_control=c.manual_control_valid(self._time_us),
+            battery_voltage_v=self.faults.battery.voltage_v, battery_remaining=self.faults.battery.remaining,
         )

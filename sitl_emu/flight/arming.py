@@ -77,18 +77,22 @@ class CheckInputs:
     offboard_signal: bool  # an offboard_control_mode with a setpoint kind, younger than COM_OF_LOSS_T
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # missions are stored (flight/mission_store.py) but not flown yet: never valid
+    position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle_faults.py)
 
     def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
-                 mission_valid: bool = False) -> None:
+                 mission_valid: bool = False, position_lost: bool = False) -> None:
         self.estimator_ready = estimator_ready
         self.home_valid = home_valid
         self.offboard_signal = offboard_signal
         self.manual_control = manual_control
         self.mission_valid = mission_valid
+        self.position_lost = position_lost
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
         have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else Req.NONE
+        if self.position_lost:
+            have &= ~Req.POSITION
         if self.home_valid:
             have |= Req.HOME
         if self.mission_valid:

@@ -16,6 +16,7 @@ from enum import Enum
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
+from sitl_emu.flight.fault_failsafes import FaultFlags, FaultSettings
 from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
@@ -47,6 +48,7 @@ class CommanderSettings:
     manual_loss: ManualLossSettings  # NAV_RCL_ACT, COM_RCL_EXCEPT, COM_FAIL_ACT_T
     arm_gesture: bool  # MAN_ARM_GESTURE
     override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
+    faults: FaultSettings  # NAV_DLL_ACT, COM_LOW_BAT_ACT, CBRK_FLIGHTTERM... (flight/fault_failsafes.py)
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> CommanderSettings:
@@ -64,6 +66,7 @@ class CommanderSettings:
                                            input_disabled=int(p["COM_RC_IN_MODE"]) == INPUT_DISABLED),
             arm_gesture=int(p["MAN_ARM_GESTURE"]) == 1,
             override_speed=float(p["MAN_OVERRIDE_SPD"]),
+            faults=FaultSettings.from_params(p),
         )
 
 
@@ -124,6 +127,7 @@ class Commander:
         self._gestures = GestureDetector()
         self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
+        self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle_faults.py)
 
     @property
     def settings(self) -> CommanderSettings:
@@ -210,7 +214,8 @@ class Commander:
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
         t = self.now_us if now_us is None else now_us
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t))
+                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t),
+                                  position_lost=self.fault_flags.position_lost)
 
     def can_run(self, nav_state: NavState) -> bool:
         return arming.can_run(nav_state, self.check_inputs())
@@ -308,7 +313,8 @@ class Commander:
         st = self.settings
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
                                          settings=st.fallback, terminated=self.terminated, now_us=now_us,
-                                         manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss)
+                                         manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss,
+                                         faults=(self.fault_flags, st.faults))
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe

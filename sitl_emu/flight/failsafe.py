@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from sitl_emu.flight.arming import CheckInputs, Req, can_run
+from sitl_emu.flight.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
 from sitl_emu.flight.manual_control import ManualLossFailsafe, ManualLossSettings
 from sitl_emu.px4 import NavState
 
@@ -116,6 +117,7 @@ class Failsafe:
     def __init__(self) -> None:
         self.active = False
         self.manual_loss = ManualLossFailsafe()
+        self.faults = FaultFailsafes()  # link loss, battery, failure detector (flight/fault_failsafes.py)
         self._rank = 0  # the action in force (0: none)
 
     def reset(self) -> None:
@@ -123,10 +125,12 @@ class Failsafe:
         self.active = False
         self._rank = 0
         self.manual_loss.reset()
+        self.faults.reset()
 
     def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False, now_us: int = 0, manual_lost: bool = False,
-               manual_loss: ManualLossSettings | None = None) -> Decision:
+               manual_loss: ManualLossSettings | None = None,
+               faults: tuple[FaultFlags, FaultSettings] | None = None) -> Decision:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.reset()
@@ -145,10 +149,16 @@ class Failsafe:
                 rank, mode, disarm = _DISARM_RANK, user, True
             elif wanted is not None and _RANK[wanted] > rank:
                 rank, mode, disarm = _RANK[wanted], wanted, False
+        if faults is not None:
+            for want in self.faults.wanted(now_us, user, *faults):
+                if want.disarm and rank < _DISARM_RANK:
+                    rank, mode, disarm = _DISARM_RANK, user, True
+                elif want.mode is not None and _RANK[want.mode] > rank:
+                    rank, mode, disarm = _RANK[want.mode], want.mode, False
         if rank == 0:
             self.active, self._rank = False, 0
             return Decision(user, False)
-        hold_s = self.manual_loss.hold_s(now_us) if mode is NavState.AUTO_LOITER else 0
+        hold_s = max(self.manual_loss.hold_s(now_us), self.faults.hold_s(now_us)) if mode is NavState.AUTO_LOITER else 0
         text = f"{FAILSAFE_TEXT}: entering Hold for {hold_s} seconds" if hold_s > 0 else FAILSAFE_TEXT
         decision = self._decide(mode, disarm, text if rank > self._rank else "")
         self._rank = rank

@@ -34,7 +34,7 @@ from sitl_emu.params.registry import FLT_MAX, INT32_MAX, INT32_MIN, ParamDef, Pa
 
 DATA_FILE = "px4_params.csv"
 META_FILE = "px4_param_meta.csv"
-DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system")  # one defs_<domain>.py module each
+DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system", "faults")  # one defs_<domain>.py module each
 
 # PX4's @volatile parameters among the listed ones (the system changes them itself; _HASH_CHECK leaves them out):
 # src/modules/commander/commander_params.c COM_FLIGHT_UUID, src/modules/land_detector/land_detector_params.c

@@ -24,5 +24,5 @@ PARAMS: list[ParamDef] = [
     integer("COM_ARM_WO_GPS", 1, 0, 2),
     integer("COM_HOME_EN", 1, 0, 1),
     integer("COM_RC_IN_MODE", 1, 0, 8),  # 5-8: RC and MAVLink by priority
-    integer("COM_LOW_BAT_ACT", 3, 0, 3),
+    integer("COM_LOW_BAT_ACT", 3, 0, 4),  # 0 warning, 2 Land, 3 Return then Land, 4 Return then Terminate
 ]

@@ -1,0 +1,162 @@
+"""The faults and disturbances of one vehicle, between the controllers, the physics and the commander.
+
+Vehicle.step asks `VehicleFaults` for: the motor outputs after injected motor failures, the wind for the physics,
+the estimate (the truth, or with estimator noise), and once per commander cycle `update` turns the battery, the GPS,
+the failure detector and the ground-station link into the commander's failsafe flags (flight/fault_failsafes.py)
+and PX4's texts. With no wind, no noise and nothing injected, nothing here changes what the vehicle does.
+
+- Battery: flight/battery.py (BatterySimulator.cpp; texts: HealthAndArmingChecks/checks/batteryCheck.cpp and the
+  failsafe framework's warning events, failsafe/framework.cpp notifyUser).
+- GPS off: the estimator (ekf2) dead-reckons on the IMU for EKF2_NOAID_TOUT, then has no horizontal position; the
+  commander's mode checks (flight/arming.py) then see no position and the failsafe falls back (Hold -> Land ->
+  Descend, failsafe.cpp checkModeFallback).
+- Failure detector (commander/failure_detector/FailureDetector.cpp updateAttitudeStatus): while armed, roll beyond
+  FD_FAIL_R for FD_FAIL_R_TTRI or pitch beyond FD_FAIL_P for FD_FAIL_P_TTRI -> fd_critical_failure.
+- GCS link (Commander.cpp dataLinkCheck): a GCS heartbeat seen, then none for COM_DL_LOSS_T -> "Connection to ground
+  station lost", gcs_connection_lost (NAV_DLL_ACT); a heartbeat again -> "GCS connection regained".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from sitl_emu.control.qmath import euler_from_q
+from sitl_emu.disturbance.estimate import EstimateNoise, EstimateNoiseSettings
+from sitl_emu.disturbance.wind import WindModel, WindSettings
+from sitl_emu.flight import failure_injection as fi
+from sitl_emu.flight.battery import (
+    HEALTH_TEXTS,
+    WARN_EVENTS,
+    WARNING_EMERGENCY,
+    BatterySettings,
+    BatterySimulator,
+    battery_action,
+)
+from sitl_emu.flight.fault_failsafes import FaultFlags
+from sitl_emu.params import ParamRegistry
+from sitl_emu.physics import RigidBodyState
+from sitl_emu.px4 import MavResult, Severity
+from sitl_emu.types import CommandAck, Vec3, VehicleCommand
+
+# emit(severity, module, text, is_event, statustext)
+Emit = Callable[[Severity, str, str, bool, bool], None]
+WIND_STREAM, NOISE_STREAM = 1, 2  # Generator streams beside the vehicle's own: np.random.default_rng([seed, n])
+
+
+class VehicleFaults:
+    """See the module docstring. `flags` is the commander's FaultFlags, written here."""
+
+    def __init__(self, params: ParamRegistry, flags: FaultFlags, emit: Emit, *, seed: int, dt_s: float,
+                 wind: WindSettings | None = None, noise: EstimateNoiseSettings | None = None) -> None:
+        self.params, self.flags, self._emit = params, flags, emit
+        self.failures = fi.FailureTable()
+        self.manager_running = int(params["SYS_FAILURE_EN"]) == 1  # reboot_required: read at boot
+        self.battery = BatterySimulator()
+        self._battery_settings, self._params_version = BatterySettings.from_params(params), params.version
+        self.wind = WindModel(wind, dt_s, np.random.default_rng([seed, WIND_STREAM])) if wind and wind.active else None
+        self.noise = (EstimateNoise(noise, np.random.default_rng([seed, NOISE_STREAM]))
+                      if noise is not None and noise.active else None)
+        self._gps_off_us: int | None = None
+        self._fd_since_us: int | None = None
+        self._last_gcs_us: int | None = None
+        self._armed = False
+
+    # ---- per tick -----------------------------------------------------------------------------------------------
+    def motors(self, cmd: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+        """The mixer's commands with the stopped motors at 0 (ControlAllocator motor_stop_mask)."""
+        stop = self.failures.mask(fi.MOTOR)
+        if not stop:
+            return cmd
+        m0, m1, m2, m3 = cmd
+        return (0.0 if stop & 1 else m0, 0.0 if stop & 2 else m1, 0.0 if stop & 4 else m2, 0.0 if stop & 8 else m3)
+
+    def wind_at(self, time_us: int, state: RigidBodyState) -> Vec3 | None:
+        """The air mass velocity for the physics; None: the physics' own (SIH_WIND_N/E, as without this module)."""
+        if self.wind is None:
+            return None
+        return self.wind.sample(time_us, -state.pos_ned_m[2],
+                                (self.params.get("SIH_WIND_N"), self.params.get("SIH_WIND_E")))
+
+    def estimate(self, est: RigidBodyState, dt_s: float) -> RigidBodyState:
+        return est if self.noise is None else self.noise.apply(est, dt_s)
+
+    # ---- per commander cycle ------------------------------------------------------------------------------------
+    def update(self, now_us: int, armed: bool, est: RigidBodyState) -> None:
+        f = self.flags
+        if armed and not self._armed:
+            f.armed_at_us, f.battery_warning_at_arming = now_us, f.battery_warning
+        self._armed = armed
+        self._update_battery(now_us, armed)
+        tout_us = int(self.params["EKF2_NOAID_TOUT"])
+        f.position_lost = self._gps_off_us is not None and now_us - self._gps_off_us >= tout_us
+        f.fd_critical_failure = self._attitude_failed(now_us, armed, est)
+        self._check_gcs_link(now_us)
+
+    def _update_battery(self, now_us: int, armed: bool) -> None:
+        if self.params.version != self._params_version:
+            self._battery_settings, self._params_version = BatterySettings.from_params(self.params), self.params.version
+        bat, before = self.battery, self.battery.warning
+        bat.update(now_us, armed, self._battery_settings)
+        self.flags.battery_warning = bat.warning
+        if bat.warning > before:
+            severity = Severity.EMERGENCY if bat.warning == WARNING_EMERGENCY else Severity.CRITICAL
+            self._emit(severity, "commander", HEALTH_TEXTS[bat.warning], True, True)
+            action = battery_action(bat.warning, int(self.params["COM_LOW_BAT_ACT"]),
+                                    self.flags.battery_warning_at_arming)
+            if armed and action is None:  # a warning-only failsafe: framework.cpp's event, not a STATUSTEXT
+                self._emit(Severity.WARNING, "commander", WARN_EVENTS[bat.warning], True, False)
+
+    def _attitude_failed(self, now_us: int, armed: bool, est: RigidBodyState) -> bool:
+        if not armed:
+            self._fd_since_us = None
+            return False
+        roll, pitch, _ = euler_from_q(est.q_wxyz)
+        g = self.params.get
+        max_r, max_p = math.radians(abs(g("FD_FAIL_R"))), math.radians(abs(g("FD_FAIL_P")))
+        beyond = (max_r > 0.0 and abs(roll) > max_r) or (max_p > 0.0 and abs(pitch) > max_p)
+        if not beyond:
+            self._fd_since_us = None
+            return False
+        if self._fd_since_us is None:
+            self._fd_since_us = now_us
+        return now_us - self._fd_since_us >= round(min(g("FD_FAIL_R_TTRI"), g("FD_FAIL_P_TTRI")) * 1e6)
+
+    def _check_gcs_link(self, now_us: int) -> None:
+        last = self._last_gcs_us
+        if last is None or self.flags.gcs_connection_lost:
+            return
+        if now_us - last > int(self.params["COM_DL_LOSS_T"]) * 1_000_000:
+            self.flags.gcs_connection_lost = True
+            self._emit(Severity.INFO, "commander", "Connection to ground station lost", True, True)
+
+    # ---- inputs -------------------------------------------------------------------------------------------------
+    def gcs_heartbeat(self, now_us: int) -> None:
+        """A heartbeat from a ground station (MAV_TYPE_GCS)."""
+        if self.flags.gcs_connection_lost:
+            self.flags.gcs_connection_lost = False
+            self._emit(Severity.INFO, "commander", "GCS connection regained", True, True)
+        self._last_gcs_us = now_us
+
+    def inject(self, cmd: VehicleCommand, now_us: int) -> CommandAck | None:
+        """MAV_CMD_INJECT_FAILURE: DENIED by the mavlink module while SYS_FAILURE_EN is 0 (MAVLink only: the `failure`
+        command checks it itself); no ACK if the manager did not start at boot."""
+        if cmd.from_external and int(self.params["SYS_FAILURE_EN"]) != 1:
+            return CommandAck(cmd.command, int(MavResult.DENIED))
+        if not self.manager_running:
+            return None
+        unit, ftype, mask = fi.command_target(cmd.param(1), cmd.param(2), cmd.param(3), cmd.param(4))
+        result = self.failures.inject(unit, ftype, mask)
+        if result == MavResult.ACCEPTED and mask:
+            self._emit(Severity.WARNING, "failure_injection_manager", fi.announcement(unit, ftype, mask), False, True)
+            self._apply(unit, now_us)
+        return CommandAck(cmd.command, int(result))
+
+    def _apply(self, unit: int, now_us: int) -> None:
+        if unit == fi.GPS:
+            off = bool(self.failures.mask(fi.GPS))
+            self._gps_off_us = (self._gps_off_us if self._gps_off_us is not None else now_us) if off else None
+        elif unit == fi.BATTERY:
+            self.battery.failed = bool(self.failures.mask(fi.BATTERY))
