@@ -20,6 +20,7 @@ from typing import Any
 
 from sitl_emu import listener
 from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavCmd, MavResult, NavState, main_sub
+from sitl_emu.shell_failure import failure_command
 from sitl_emu.shell_param import log_line, param_command
 from sitl_emu.types import VehicleCommand
 
@@ -62,6 +63,7 @@ class Shell:
         self._job: listener.ListenerJob | None = None
         self._apps: dict[str, App] = {
             "commander": self._commander,
+            "failure": lambda args: failure_command(self.vehicle, args),
             "listener": self._listener,
             "param": self._param,
             "shutdown": self._shutdown,

@@ -75,6 +75,7 @@ class Receiver:
     def _heartbeat(msg: dialect.MAVLink_heartbeat_message, ctx: EndpointContext) -> None:
         if msg.type == MAV_TYPE_GCS and msg.get_srcSystem() != ctx.sysid:
             ctx.last_gcs_heartbeat_us = ctx.now_us
+            ctx.vehicle.gcs_heartbeat()  # the commander's data-link watchdog (COM_DL_LOSS_T)
 
     @staticmethod
     def _ping(msg: dialect.MAVLink_ping_message, ctx: EndpointContext) -> None:
