@@ -137,16 +137,31 @@ def stored_params(params_file: Path | None, instance: int, first: int, reset: bo
     return registry, store, None
 
 
-def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int) -> Any:
+def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int,
+                  wind: Any = None) -> Any:
     from sitl_emu.vehicle import Vehicle
 
     if "MAV_SYS_ID" in params:  # rcS: param set MAV_SYS_ID $((px4_instance+1))
         with contextlib.suppress(ValueError):  # ParamError: outside MAV_SYS_ID's range
             params.set("MAV_SYS_ID", sysid)
     kwargs: dict[str, Any] = {"params": params, "seed": seed, "sysid": sysid}
+    if wind is not None:
+        kwargs["wind"] = wind
     if home is not None:
         kwargs["home"] = home
     return Vehicle(**kwargs)
+
+
+def _wind_option(text: str | None) -> Any:
+    """--wind SPEED@FROM[,TURBULENCE] -> WindSettings (sitl_emu/disturbance/wind.py), None without it."""
+    if text is None:
+        return None
+    from sitl_emu.disturbance.wind import parse_wind
+
+    try:
+        return parse_wind(text)
+    except ValueError as err:
+        raise UsageProblem(f"--wind: {err}") from None
 
 
 @click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
@@ -190,15 +205,20 @@ def main(verbose: int) -> None:
 @click.option("--seed", type=WholeRange(0, SEED_MAX), default=0, show_default=True,
               help="Random seed for the sensor noise: the same seed, parameters and inputs fly the same trajectory.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
+@click.option("--wind", "wind_text", default=None, metavar="SPEED@FROM[,TURBULENCE]",
+              help="Wind: SPEED m/s blowing FROM degrees (5@270: 5 m/s from the west), optionally Dryden "
+                   "turbulence: light, moderate, severe or the 20 ft wind speed W20 in m/s (5@270,light). Seeded "
+                   "by --seed; SIH_WIND_N/E add to it.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
-          params_reset: bool, seed: int, no_console: bool) -> None:
+          params_reset: bool, seed: int, no_console: bool, wind_text: str | None) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         check_host(bind_host, "--bind")
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
                                 parse_address(gcs_remote, "--gcs-remote"))
         home_lla = parse_home(home) if home else DEFAULT_HOME
+        wind = _wind_option(wind_text)
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
         stores: list[Any] = []
@@ -207,7 +227,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             registry, store, warning = stored_params(params_file, i, instance, params_reset)
             if warning:
                 click.echo(f"{TOOL}: {warning}", err=True)
-            built = build_vehicle(registry, h, seed + i - instance, i + 1)
+            built = build_vehicle(registry, h, seed + i - instance, i + 1, wind)
             store.mark_saved()  # PX4's rcS sets MAV_SYS_ID at every boot: nothing to save for that
             apply_params(registry, parse_assignments(assignments))  # saved like any change (PX4's `param set`)
             if params_reset and store.path.exists():

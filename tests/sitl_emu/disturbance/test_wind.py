@@ -130,3 +130,22 @@ def test_hover_in_turbulence_stays_near_and_calm_air_stays_level():
     assert math.hypot(s.pos_ned_m[0], s.pos_ned_m[1]) < 2.0
     calm = _hover(None, 10.0).snapshot()
     assert max(abs(a) for a in euler_from_q(calm.q_wxyz)[:2]) < 1e-3
+
+
+def test_with_only_the_attitude_controlled_the_wind_carries_the_vehicle_downwind():
+    from sitl_emu.px4 import NavState, custom_mode, decode_custom_mode
+    from sitl_emu.types import AttitudeSetpoint, OffboardControlMode
+
+    v = _hover(WindSettings(5.0, 270.0), 10.0)
+    e0 = v.snapshot().pos_ned_m[1]
+    mode = OffboardControlMode(attitude=True)
+    level = AttitudeSetpoint(q_wxyz=(1.0, 0.0, 0.0, 0.0), thrust_body=(0.0, 0.0, -0.5))
+    v.offboard_input(mode, attitude=level)
+    main, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
+    v.handle_command(VehicleCommand(MavCmd.DO_SET_MODE, (1.0, main, sub) + (NAN,) * 4))
+    for _ in range(60):  # 3 s of level attitude, no position control
+        v.offboard_input(mode, attitude=level)
+        v.run_for(0.05)
+    s = v.snapshot()
+    assert s.nav_state is NavState.OFFBOARD
+    assert s.pos_ned_m[1] - e0 > 3.0 and s.vel_ned_m_s[1] > 2.0  # blown east, towards the wind's 5 m/s

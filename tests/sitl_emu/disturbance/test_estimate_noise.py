@@ -1,0 +1,49 @@
+"""Estimator noise: white noise and a wandering bias on the estimate, the truth untouched; off by default."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sitl_emu.disturbance.estimate import EstimateNoise, EstimateNoiseSettings
+from sitl_emu.physics import hover_state
+from sitl_emu.px4 import MavCmd
+from sitl_emu.types import VehicleCommand
+from sitl_emu.vehicle import Vehicle
+
+NAN = math.nan
+
+
+def test_white_noise_and_bias_walk_statistics():
+    truth = hover_state(10.0)
+    noise = EstimateNoise(EstimateNoiseSettings(pos_white_m=0.3, vel_walk_m_s=0.1), np.random.default_rng(5))
+    dt, n = 0.004, 25_000  # 100 s
+    est = [noise.apply(truth, dt) for _ in range(n)]
+    pos = np.array([e.pos_ned_m for e in est]) - truth.pos_ned_m
+    vel = np.array([e.vel_ned_m_s for e in est])
+    assert pos.std(axis=0) == pytest.approx([0.3] * 3, rel=0.05)
+    assert abs(pos.mean(axis=0)).max() < 0.02
+    # a random walk: its increments over 1 s have the walk intensity as their std (0.1 / sqrt(s))
+    steps = vel[250::250] - vel[:-250:250]
+    assert steps.std() == pytest.approx(0.1, rel=0.15)
+    assert est[-1].q_wxyz == truth.q_wxyz  # no attitude noise asked for
+
+
+def test_the_default_is_the_truth_and_noise_moves_only_the_estimate():
+    def fly(noise: EstimateNoiseSettings | None) -> Vehicle:
+        v = Vehicle(estimate_noise=noise, seed=2)
+        v.run_for(2.5)
+        v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0) + (NAN,) * 5))
+        v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (NAN,) * 7))
+        v.run_for(15.0)
+        return v
+
+    calm = fly(None)
+    assert calm.snapshot().pos_ned_m == calm._state.pos_ned_m
+    noisy = fly(EstimateNoiseSettings(pos_white_m=0.05, pos_walk_m=0.05, att_white_rad=0.002))
+    s, truth = noisy.snapshot(), noisy._state
+    assert s.pos_ned_m != truth.pos_ned_m and s.q_wxyz != truth.q_wxyz
+    assert math.dist(s.pos_ned_m, truth.pos_ned_m) < 1.0  # the controllers fly on the estimate, still nearby
+    assert truth.pos_ned_m[2] == pytest.approx(-2.5, abs=1.0)
