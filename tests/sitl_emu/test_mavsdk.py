@@ -324,3 +324,50 @@ async def _fly_manual(mavsdk_asyncio: Any, port: int, s: Session) -> None:
             await s.wait_for("landed and disarmed", telemetry.armed, lambda armed: not armed, timeout_s=90)
         finally:
             streamer.cancel()
+
+
+
+@pytest.mark.timeout(300)
+def test_mavsdk_failure_injection_example_gps_off(server: int) -> None:
+    """MAVSDK's failure_injection example flow (issue 16): with SYS_FAILURE_EN 0 the mavlink module denies the
+    injection; with 1 the failure injection manager accepts GPS off, the estimator loses its position after
+    EKF2_NOAID_TOUT and the failsafe descends and lands (src/modules/failure_injection_manager/,
+    src/modules/commander/failsafe/failsafe.cpp), as on PX4 SITL."""
+    mavsdk_asyncio = load_mavsdk()
+    session = Session()
+    try:
+        asyncio.run(asyncio.wait_for(_failure_injection(mavsdk_asyncio, server, session), timeout=240))
+    finally:
+        print("\nMAVSDK calls and outcomes:\n" + session.table())
+
+
+async def _failure_injection(mavsdk_asyncio: Any, port: int, s: Session) -> None:
+    from mavsdk.asyncio.plugins.action import ActionAsync
+    from mavsdk.asyncio.plugins.failure import FailureAsync
+    from mavsdk.asyncio.plugins.param import ParamAsync
+    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
+    from mavsdk.plugins.failure import FailureError, FailureType, FailureUnit
+    from mavsdk.plugins.telemetry import FlightMode
+
+    config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
+    async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
+        system = await _connect(mavsdk, port, s)
+        param, action, telemetry, failure = (ParamAsync(system), ActionAsync(system), TelemetryAsync(system),
+                                             FailureAsync(system))
+        await s.call("Param.set_param_int(SYS_FAILURE_EN, 0)", param.set_param_int("SYS_FAILURE_EN", 0))
+        with pytest.raises(FailureError) as denied:
+            await s.call("Failure.inject(GPS, OFF, 0) disabled", failure.inject(FailureUnit.SENSOR_GPS,
+                                                                              FailureType.OFF, 0))
+        assert denied.value.result.name == "DENIED"
+        await s.call("Param.set_param_int(SYS_FAILURE_EN, 1)", param.set_param_int("SYS_FAILURE_EN", 1))
+        await s.call("Action.arm", action.arm())
+        await s.call("Action.takeoff", action.takeoff())
+        await s.wait_for("in_air", telemetry.in_air, bool, timeout_s=20)
+        await s.wait_for("relative altitude > 2 m", telemetry.position, lambda p: p.relative_altitude_m > 2.0,
+                         timeout_s=30)
+        await s.wait_for("flight mode HOLD after takeoff", telemetry.flight_mode, lambda m: m == FlightMode.HOLD,
+                         timeout_s=30)
+        await s.call("Failure.inject(GPS, OFF, 0)", failure.inject(FailureUnit.SENSOR_GPS, FailureType.OFF, 0))
+        await s.wait_for("failsafe descends (AUTO.LAND)", telemetry.flight_mode, lambda m: m == FlightMode.LAND,
+                         timeout_s=15)
+        await s.wait_for("landed and disarmed", telemetry.armed, lambda armed: not armed, timeout_s=40)

@@ -112,6 +112,7 @@ def test_port_in_use_is_one_sentence_and_status_2():
     (("--param", "MIS_TAKEOFF_ALT=high"), "number"),
     (("--home", "47.3,8.5"), "LAT,LON,ALT"),
     (("--remote", "nowhere"), "HOST:PORT"),
+    (("--wind", "5"), "SPEED@FROM_DEG"),
 ])
 def test_bad_options_are_one_sentence_and_status_2(args, words):
     api_port, gcs_port = free_udp_ports(2)
@@ -119,6 +120,16 @@ def test_bad_options_are_one_sentence_and_status_2(args, words):
     _out, err = proc.communicate(timeout=10)
     assert proc.returncode == 2
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1 and words in err
+
+
+def test_wind_option_reaches_the_vehicle():
+    from sitl_emu.cli import _wind_option, build_vehicle
+    from sitl_emu.params import default_registry
+
+    wind = _wind_option("5@270,light")
+    v = build_vehicle(default_registry(), None, 3, 1, wind)
+    assert v.faults.wind is not None and v.faults.wind.settings == wind
+    assert build_vehicle(default_registry(), None, 3, 1).faults.wind is None
 
 
 def test_params_file_in_both_formats_sets_parameters(tmp_path):
