@@ -81,6 +81,8 @@ class SihConfig:
     kdv: float = 1.0
     kdw: float = 0.025
     t_tau_s: float = 0.05
+    # SIH_WIND_N/E: wind FROM the north/east (sih_params.yaml); sih.cpp ecefToNed adds them to the ground velocity to
+    # get the apparent air velocity, so the air moves towards (-wind_n, -wind_e)
     wind_n_m_s: float = 0.0
     wind_e_m_s: float = 0.0
 
@@ -94,10 +96,10 @@ def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: Si
          wind_ned_m_s: Vec3 | None = None) -> RigidBodyState:
     """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
 
-    `wind_ned_m_s` is the air mass velocity (sitl_emu/disturbance/wind.py); None: cfg's constant wind."""
+    `wind_ned_m_s` is the air mass velocity (sitl_emu/disturbance/wind.py); None: cfg's constant SIH wind."""
     u = _motor_lag(state.motors, motor_cmd, dt_s, cfg.t_tau_s)
     thrust_n = cfg.t_max_n * (u[0] + u[1] + u[2] + u[3])  # along body -z
-    wind = (cfg.wind_n_m_s, cfg.wind_e_m_s, 0.0) if wind_ned_m_s is None else wind_ned_m_s
+    wind = (-cfg.wind_n_m_s, -cfg.wind_e_m_s, 0.0) if wind_ned_m_s is None else wind_ned_m_s
     acc = _acceleration_ned(state.q_wxyz, state.vel_ned_m_s, thrust_n, cfg, wind)
     pos, vel = state.pos_ned_m, state.vel_ned_m_s
     if state.on_ground and acc[2] >= 0.0:

@@ -124,7 +124,7 @@ def test_a_right_roll_accelerates_the_vehicle_east():
 
 
 def test_drag_and_wind_set_a_terminal_drift_velocity():
-    cfg = SihConfig(wind_n_m_s=3.0)
+    cfg = SihConfig(wind_n_m_s=3.0)  # SIH_WIND_N: from the north (sih.cpp: v_apparent = v + wind), blows south
     h = cfg.hover_command
     end = run(hover_state(50.0, cfg), (h,) * 4, 10.0, cfg)
-    assert end.vel_ned_m_s[0] == pytest.approx(3.0, abs=0.01)
+    assert end.vel_ned_m_s[0] == pytest.approx(-3.0, abs=0.01)
