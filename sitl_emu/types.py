@@ -167,3 +167,5 @@ class VehicleSnapshot:
     # mode from the last offboard_control_mode it received (HEARTBEAT base_mode), whatever its age
     offboard_control_last: OffboardControlMode | None = None
     manual_control: bool = False  # a manual input (MAVLink joystick) is present: SYS_STATUS's RC receiver
+    battery_warning: int = 0  # battery_status_s::WARNING_* (0 none, 1 low, 2 critical, 3 emergency)
+    gps_fix_type: int = 3  # SIH's GPS: 3D fix; 0 while a GPS failure is injected

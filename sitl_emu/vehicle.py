@@ -270,4 +270,5 @@ class Vehicle:
             motor_commands=self._motor_commands, offboard_control_last=offboard_last,
             manual_control=c.manual_control_valid(self._time_us),
             battery_voltage_v=self.faults.battery.voltage_v, battery_remaining=self.faults.battery.remaining,
+            battery_warning=self.faults.battery.warning, gps_fix_type=self.faults.gps_fix_type,
         )

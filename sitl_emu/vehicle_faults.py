@@ -132,6 +132,11 @@ class VehicleFaults:
             self.flags.gcs_connection_lost = True
             self._emit(Severity.INFO, "commander", "Connection to ground station lost", True, True)
 
+    @property
+    def gps_fix_type(self) -> int:
+        """sensor_gps_sim's fix: 3D, or nothing while GPS is failed (the driver publishes no sample)."""
+        return 0 if self._gps_off_us is not None else 3
+
     # ---- inputs -------------------------------------------------------------------------------------------------
     def gcs_heartbeat(self, now_us: int) -> None:
         """A heartbeat from a ground station (MAV_TYPE_GCS)."""

@@ -153,12 +153,14 @@ def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
 
 
 def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
-    """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot."""
+    """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot; no fix and no satellites while failed."""
     vn, ve, _ = snap.vel_ned_m_s
     vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
     cog = _iround(math.degrees(_wrap_2pi(math.atan2(ve, vn))) * 100.0) % 36000 if vel_cm_s > 0 else 0
-    return ctx.encoder.gps_raw_int_encode(snap.time_us, 3, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
-                                      50, 80, vel_cm_s, cog, 10, _mm(snap.alt_amsl_m), 500, 800, 200, 0, 0)
+    fix = snap.gps_fix_type
+    return ctx.encoder.gps_raw_int_encode(snap.time_us, fix, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
+                                      50, 80, vel_cm_s, cog, 10 if fix else 0, _mm(snap.alt_amsl_m), 500, 800, 200, 0,
+                                      0)
 
 
 def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
@@ -166,8 +168,9 @@ def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
     voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
     remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
-    return ctx.encoder.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, 1, [0, 0, 0, 0],
-                                         0, 0)
+    charge_state = min(max(snap.battery_warning, 0), 3) + 1  # BATTERY_STATUS.hpp: WARNING_* -> CHARGE_STATE_*
+    return ctx.encoder.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, charge_state,
+                                             [0, 0, 0, 0], 0, 0)
 
 
 def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -21,6 +22,14 @@ class GcsClient(FlightClient):
     """A client that says it is a ground station (the vehicle sends STATUSTEXT only while one is heard)."""
 
     _next_gcs_s = -math.inf
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.last: dict[str, Any] = {}  # the last message of each type
+
+    def _observe(self, msg: Any) -> None:
+        self.last[msg.get_type()] = msg
+        super()._observe(msg)
 
     def pump(self) -> None:
         if self.clock.now() >= self._next_gcs_s:
@@ -66,6 +75,8 @@ def test_gps_off_over_mavlink_acks_tells_and_descends():
         client.wait(lambda: client.in_mode(NavState.DESCEND), 7.0, "Descend")
         assert "Injected: gps off, all instances" in client.seen.texts
         assert "Failsafe activated\t" in client.seen.texts
+        assert client.last["GPS_RAW_INT"].fix_type == 0 and client.last["GPS_RAW_INT"].satellites_visible == 0
+        assert not client.seen.sys_status.onboard_control_sensors_health & 0x20  # SYS_STATUS: GPS unhealthy
         client.wait(lambda: not client.armed, 20.0, "landed and disarmed")
         client.close()
 
@@ -90,6 +101,8 @@ def test_battery_drain_ends_in_return_with_px4_texts():
         low, crit = texts.index("Low battery\t"), texts.index("Critical battery\t")
         assert low < crit < texts.index("Failsafe activated: entering Hold for 5 seconds\t")
         assert client.seen.sys_status.battery_remaining in (6, 7)
+        client.spin(2.5)  # BATTERY_STATUS at 0.5 Hz
+        assert client.last["BATTERY_STATUS"].charge_state == 3  # MAV_BATTERY_CHARGE_STATE_CRITICAL
         client.close()
 
 
