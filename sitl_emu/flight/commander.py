@@ -214,8 +214,16 @@ class Commander:
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
         t = self.now_us if now_us is None else now_us
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t),
+                                  offboard_signal=self._offboard_available(t),
+                                  manual_control=self.manual_control_valid(t),
                                   position_lost=self.fault_flags.position_lost)
+
+    def _offboard_available(self, now_us: int) -> bool:
+        """offboardCheck.cpp: a fresh signal, and for position or velocity setpoints a local position and velocity."""
+        if not self.offboard_fresh(now_us):
+            return False
+        mode = self._offboard.mode
+        return not (self.fault_flags.position_lost and mode is not None and (mode.position or mode.velocity))
 
     def can_run(self, nav_state: NavState) -> bool:
         return arming.can_run(nav_state, self.check_inputs())

@@ -189,3 +189,22 @@ def test_failure_shell_command():
     v.params.set("SYS_FAILURE_EN", 0)
     assert shell.execute("failure gps ok") == ("ERROR [failure] Failure injection disabled by SYS_FAILURE_EN param.\n"
                                                "Command 'failure' failed, returned 1.\n")
+
+
+def test_gps_off_in_offboard_position_control_falls_back():
+    from sitl_emu.px4 import custom_mode, decode_custom_mode
+    from sitl_emu.types import OffboardControlMode, TrajectorySetpoint
+
+    v = _flying()
+    mode, sp = OffboardControlMode(position=True), TrajectorySetpoint(position_ned_m=(0.0, 0.0, -2.5))
+    v.offboard_input(mode, sp)
+    main, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
+    _cmd(v, MavCmd.DO_SET_MODE, 1.0, main, sub)
+    _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0)
+    seen = []
+    for _ in range(80):  # the setpoints keep coming: only the lost position ends OFFBOARD
+        v.offboard_input(mode, sp)
+        v.run_for(0.1)
+        if not seen or seen[-1] != v.snapshot().nav_state:
+            seen.append(v.snapshot().nav_state)
+    assert seen == [NavState.OFFBOARD, NavState.DESCEND]  # offboardCheck.cpp: "Offboard requires local position"
