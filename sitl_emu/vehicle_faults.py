@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -46,6 +47,28 @@ Emit = Callable[[Severity, str, str, bool, bool], None]
 WIND_STREAM, NOISE_STREAM = 1, 2  # Generator streams beside the vehicle's own: np.random.default_rng([seed, n])
 
 
+@dataclass(frozen=True, slots=True)
+class MonitorSettings:
+    """The parameters read here, once per parameter change."""
+
+    battery: BatterySettings
+    low_bat_act: int  # COM_LOW_BAT_ACT
+    noaid_us: int  # EKF2_NOAID_TOUT
+    dl_loss_us: int  # COM_DL_LOSS_T
+    fd_max_rad: tuple[float, float]  # FD_FAIL_R, FD_FAIL_P (0: off)
+    fd_ttri_us: tuple[int, int]  # FD_FAIL_R_TTRI, FD_FAIL_P_TTRI
+    sih_wind_from: tuple[float, float]  # SIH_WIND_N, SIH_WIND_E
+
+    @classmethod
+    def from_params(cls, p: ParamRegistry) -> MonitorSettings:
+        g = p.get
+        return cls(BatterySettings.from_params(p), int(p["COM_LOW_BAT_ACT"]), int(p["EKF2_NOAID_TOUT"]),
+                   int(p["COM_DL_LOSS_T"]) * 1_000_000,
+                   (math.radians(abs(g("FD_FAIL_R"))), math.radians(abs(g("FD_FAIL_P")))),
+                   (round(g("FD_FAIL_R_TTRI") * 1e6), round(g("FD_FAIL_P_TTRI") * 1e6)),
+                   (g("SIH_WIND_N"), g("SIH_WIND_E")))
+
+
 class VehicleFaults:
     """See the module docstring. `flags` is the commander's FaultFlags, written here."""
 
@@ -55,12 +78,12 @@ class VehicleFaults:
         self.failures = fi.FailureTable()
         self.manager_running = int(params["SYS_FAILURE_EN"]) == 1  # reboot_required: read at boot
         self.battery = BatterySimulator()
-        self._battery_settings, self._params_version = BatterySettings.from_params(params), params.version
+        self._settings, self._params_version = MonitorSettings.from_params(params), params.version
         self.wind = WindModel(wind, dt_s, np.random.default_rng([seed, WIND_STREAM])) if wind and wind.active else None
         self.noise = (EstimateNoise(noise, np.random.default_rng([seed, NOISE_STREAM]))
                       if noise is not None and noise.active else None)
         self._gps_off_us: int | None = None
-        self._fd_since_us: int | None = None
+        self._fd_since_us: list[int | None] = [None, None]  # roll, pitch beyond their limit since
         self._last_gcs_us: int | None = None
         self._armed = False
 
@@ -77,58 +100,64 @@ class VehicleFaults:
         """The air mass velocity for the physics; None: the physics' own (SIH_WIND_N/E, as without this module)."""
         if self.wind is None:
             return None
-        return self.wind.sample(time_us, -state.pos_ned_m[2],
-                                (self.params.get("SIH_WIND_N"), self.params.get("SIH_WIND_E")))
+        return self.wind.sample(time_us, -state.pos_ned_m[2], self.settings.sih_wind_from)
 
     def estimate(self, est: RigidBodyState, dt_s: float) -> RigidBodyState:
         return est if self.noise is None else self.noise.apply(est, dt_s)
 
+    @property
+    def settings(self) -> MonitorSettings:
+        if self.params.version != self._params_version:
+            self._settings, self._params_version = MonitorSettings.from_params(self.params), self.params.version
+        return self._settings
+
     # ---- per commander cycle ------------------------------------------------------------------------------------
     def update(self, now_us: int, armed: bool, est: RigidBodyState) -> None:
-        f = self.flags
+        f, s = self.flags, self.settings
         if armed and not self._armed:
             f.armed_at_us, f.battery_warning_at_arming = now_us, f.battery_warning
         self._armed = armed
-        self._update_battery(now_us, armed)
-        tout_us = int(self.params["EKF2_NOAID_TOUT"])
-        f.position_lost = self._gps_off_us is not None and now_us - self._gps_off_us >= tout_us
-        f.fd_critical_failure = self._attitude_failed(now_us, armed, est)
-        self._check_gcs_link(now_us)
+        self._update_battery(now_us, armed, s)
+        f.position_lost = self._gps_off_us is not None and now_us - self._gps_off_us >= s.noaid_us
+        f.fd_critical_failure = self._attitude_failed(now_us, armed, est, s)
+        self._check_gcs_link(now_us, s)
 
-    def _update_battery(self, now_us: int, armed: bool) -> None:
-        if self.params.version != self._params_version:
-            self._battery_settings, self._params_version = BatterySettings.from_params(self.params), self.params.version
+    def _update_battery(self, now_us: int, armed: bool, s: MonitorSettings) -> None:
         bat, before = self.battery, self.battery.warning
-        bat.update(now_us, armed, self._battery_settings)
+        bat.update(now_us, armed, s.battery)
         self.flags.battery_warning = bat.warning
         if bat.warning > before:
             severity = Severity.EMERGENCY if bat.warning == WARNING_EMERGENCY else Severity.CRITICAL
             self._emit(severity, "commander", HEALTH_TEXTS[bat.warning], True, True)
-            action = battery_action(bat.warning, int(self.params["COM_LOW_BAT_ACT"]),
-                                    self.flags.battery_warning_at_arming)
+            action = battery_action(bat.warning, s.low_bat_act, self.flags.battery_warning_at_arming)
             if armed and action is None:  # a warning-only failsafe: framework.cpp's event, not a STATUSTEXT
                 self._emit(Severity.WARNING, "commander", WARN_EVENTS[bat.warning], True, False)
 
-    def _attitude_failed(self, now_us: int, armed: bool, est: RigidBodyState) -> bool:
-        if not armed:
-            self._fd_since_us = None
+    def _attitude_failed(self, now_us: int, armed: bool, est: RigidBodyState, s: MonitorSettings) -> bool:
+        """Roll or pitch beyond its limit for its trigger time (each with its own hysteresis, as PX4's)."""
+        since = self._fd_since_us
+        _, qx, qy, _ = est.q_wxyz
+        # cos(tilt) = cos(roll) cos(pitch): a vehicle tilted less than both limits has neither beyond (cheap test)
+        if not armed or 1.0 - 2.0 * (qx * qx + qy * qy) > math.cos(min(s.fd_max_rad)):
+            since[0] = since[1] = None
             return False
-        roll, pitch, _ = euler_from_q(est.q_wxyz)
-        g = self.params.get
-        max_r, max_p = math.radians(abs(g("FD_FAIL_R"))), math.radians(abs(g("FD_FAIL_P")))
-        beyond = (max_r > 0.0 and abs(roll) > max_r) or (max_p > 0.0 and abs(pitch) > max_p)
-        if not beyond:
-            self._fd_since_us = None
-            return False
-        if self._fd_since_us is None:
-            self._fd_since_us = now_us
-        return now_us - self._fd_since_us >= round(min(g("FD_FAIL_R_TTRI"), g("FD_FAIL_P_TTRI")) * 1e6)
+        failed = False
+        for axis, angle in enumerate(euler_from_q(est.q_wxyz)[:2]):
+            limit = s.fd_max_rad[axis]
+            if not (limit > 0.0 and abs(angle) > limit):
+                since[axis] = None
+                continue
+            start = since[axis]
+            if start is None:
+                since[axis] = start = now_us
+            failed = failed or now_us - start >= s.fd_ttri_us[axis]
+        return failed
 
-    def _check_gcs_link(self, now_us: int) -> None:
+    def _check_gcs_link(self, now_us: int, s: MonitorSettings) -> None:
         last = self._last_gcs_us
         if last is None or self.flags.gcs_connection_lost:
             return
-        if now_us - last > int(self.params["COM_DL_LOSS_T"]) * 1_000_000:
+        if now_us - last > s.dl_loss_us:
             self.flags.gcs_connection_lost = True
             self._emit(Severity.INFO, "commander", "Connection to ground station lost", True, True)
 
