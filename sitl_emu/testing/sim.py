@@ -27,6 +27,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.mavlink.link import Address
 from sitl_emu.params import default_registry
@@ -88,7 +89,7 @@ class Sim:
                  home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
                  api_remote: Address | None = None, gcs_remote: Address | None = None,
                  bind_host: str = "127.0.0.1", vehicle_options: Mapping[str, Any] | None = None,
-                 wind: WindSettings | None = None) -> None:
+                 wind: WindSettings | None = None, estimate_noise: EstimateNoiseSettings | None = None) -> None:
         self._sink = _sink_socket(bind_host)
         sink: Address = self._sink.getsockname()
         self._param_values = dict(params or {})
@@ -96,6 +97,8 @@ class Sim:
         self._vehicle_options = dict(vehicle_options or {})
         if wind is not None:  # sitl_emu/disturbance/wind.py: WindSettings(5.0, 270.0) or parse_wind("5@270,light")
             self._vehicle_options["wind"] = wind
+        if estimate_noise is not None:  # sitl_emu/disturbance/estimate.py: white noise and bias walk on the estimate
+            self._vehicle_options["estimate_noise"] = estimate_noise
         settings = LinkSettings(bind_host, 0, api_remote or sink, 0, gcs_remote or sink)
         try:
             self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,

@@ -120,3 +120,21 @@ def test_gcs_heartbeats_stopping_trigger_nav_dll_act():
         assert texts[lost + 1:lost + 3] == ["Failsafe activated: entering Hold for 5 seconds", "Failsafe activated"]
         gcs.close()
         client.close()
+
+
+def test_estimate_noise_reaches_local_position_ned_and_is_seeded():
+    from sitl_emu.disturbance.estimate import EstimateNoiseSettings
+
+    def fly(seed: int) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+        with Sim(seed=seed, estimate_noise=EstimateNoiseSettings(pos_white_m=0.2)) as sim:
+            client = GcsClient(sim.ports(0).api, sim.clock)
+            _airborne(sim, client)
+            client.spin(1.0)
+            seen = client.seen.pos_ned_m
+            client.close()
+            assert seen is not None
+            return seen, sim.vehicle(0)._state.pos_ned_m
+
+    seen, truth = fly(1)
+    assert seen != pytest.approx(truth, abs=1e-3) and math.dist(seen, truth) < 1.5  # an estimate, not the truth
+    assert fly(1)[0] == seen and fly(2)[0] != seen
