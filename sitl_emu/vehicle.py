@@ -5,8 +5,9 @@ Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (400
  2. commander (every COMMANDER_PERIOD_US): readiness ("Ready for takeoff!"), home, auto-disarm, takeoff
     completion, failsafes, mode in force;
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
- 4. control cascade: setpoint -> motor commands (zero when disarmed or terminated);
- 5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
+ 4. control cascade: setpoint -> motor commands (zero when disarmed or terminated), then injected motor failures;
+ 5. physics: rigid-body step by dt in the wind; the new truth state (plus optional seeded noise) becomes the
+    estimate (wind, noise, failures, battery and link watchdog: vehicle_faults.py, once per commander cycle too);
  6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
     "Landing detected");
  7. events: the task's messages join the event stream.
