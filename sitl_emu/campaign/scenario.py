@@ -4,7 +4,9 @@ what happened (metrics, a refusal, an exception, the simulated-time limit) into 
 A scenario is `def fly(sim: Sim, case: Case) -> Outcome | Mapping`: it flies the user's own client against `sim`
 (in lockstep: `sim.clock`, `sim.run_for`) and returns `Outcome(passed, {"name": value, ...})`, or a mapping of metrics
 with a boolean "passed". Everything here runs in the worker, whichever engine started it; the row depends only on
-the case and the scenario (the wall time excepted).
+the case and the scenario (the wall time excepted), as long as the scenario keeps no state from one case to the next
+(a worker flies many cases) and draws its own randomness from `case.seed`. A scenario file's directory is added to
+sys.path (last), so it may import the modules beside it.
 """
 
 from __future__ import annotations
@@ -105,6 +107,8 @@ def _load_file(path_text: str) -> Any:
         raise CampaignError(f"scenario file {path_text} cannot be loaded as Python.")
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
+    if str(path.parent) not in sys.path:
+        sys.path.append(str(path.parent))
     try:
         spec.loader.exec_module(module)
     except Exception as err:

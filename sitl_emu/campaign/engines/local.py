@@ -20,16 +20,24 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from sitl_emu.campaign.cases import Case
-from sitl_emu.campaign.scenario import Limits, Row, failure_row, run_case
+from sitl_emu.campaign.errors import CampaignError
+from sitl_emu.campaign.scenario import Limits, Row, failure_row, load_scenario, run_case
 
 __all__ = ["LocalEngine"]
 
 STOP_WAIT_S = 5.0
+READY = "ready"
 
 
-def _serve(conn: Connection) -> None:
-    """A worker's loop: (ref, case, limits) in, the row out; None ends it. Ctrl-C is the parent's to handle."""
+def _serve(conn: Connection, ref: str) -> None:
+    """A worker's loop: "ready" once its imports are done (they do not count in a case's wall time), then
+    (ref, case, limits) in, the row out; None ends it. Ctrl-C is the parent's to handle."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import sitl_emu.testing  # noqa: F401  (the Sim and its MAVLink side)
+
+    with contextlib.suppress(CampaignError):  # a scenario that cannot load is each case's error row
+        load_scenario(ref)
+    conn.send(READY)
     while True:
         try:
             job = conn.recv()
@@ -47,12 +55,26 @@ class _Busy:
 
 
 class _Worker:
-    def __init__(self, context: Any) -> None:
+    def __init__(self, context: Any, ref: str) -> None:
         self.conn, child = context.Pipe()
-        self.process = context.Process(target=_serve, args=(child,), daemon=True, name="sitl-emu-campaign")
+        self.process = context.Process(target=_serve, args=(child, ref), daemon=True, name="sitl-emu-campaign")
         self.process.start()
         child.close()
+        self.ready = False
         self.busy: _Busy | None = None
+
+    def poll_ready(self) -> None:
+        """Note the worker's "ready"; CampaignError if it died before (it cannot start: no case is to blame)."""
+        if self.ready:
+            return
+        try:
+            if self.conn.poll():
+                self.ready = self.conn.recv() == READY
+                return
+        except (EOFError, OSError):
+            self.process.join(STOP_WAIT_S)
+        if not self.process.is_alive():
+            raise CampaignError(f"a worker process could not start (exit code {self.process.exitcode}).")
 
     def give(self, ref: str, case: Case, limits: Limits) -> None:
         self.conn.send((ref, case, limits))
@@ -78,11 +100,12 @@ class LocalEngine:
 
     def run(self, ref: str, cases: Sequence[Case], limits: Limits) -> Iterator[tuple[Case, Row]]:
         pending = deque(cases)
-        pool = [_Worker(self.context) for _ in range(min(self.workers, len(pending)))]
+        pool = [_Worker(self.context, ref) for _ in range(min(self.workers, len(pending)))]
         try:
             while pending or any(w.busy for w in pool):
                 for worker in pool:
-                    if worker.busy is None and pending:
+                    worker.poll_ready()
+                    if worker.ready and worker.busy is None and pending:
                         worker.give(ref, pending.popleft(), limits)
                 for index, worker in enumerate(pool):
                     result = _collect(worker, limits)
@@ -91,7 +114,7 @@ class LocalEngine:
                     yield result
                     if not worker.process.is_alive():
                         worker.stop()
-                        pool[index] = _Worker(self.context) if pending else worker
+                        pool[index] = _Worker(self.context, ref) if pending else worker
                 _wait(pool, limits)
         finally:
             for worker in pool:
@@ -132,12 +155,14 @@ def _died(worker: _Worker, elapsed: float) -> Row:
 
 
 def _wait(pool: list[_Worker], limits: Limits) -> None:
-    """Sleep until a worker answers or dies, or the next wall-time limit falls due."""
+    """Sleep until a worker answers (a row, or ready) or dies, or the next wall-time limit falls due."""
     busy = [w for w in pool if w.busy is not None]
-    if not busy:
+    starting = [w for w in pool if not w.ready and w.process.is_alive()]
+    if not busy and not starting:
         return
     timeout = None
-    if limits.wall_s is not None:
+    if limits.wall_s is not None and busy:
         first = min(w.busy.started for w in busy if w.busy is not None)
         timeout = max(0.0, first + limits.wall_s - time.monotonic()) + 0.01
-    wait([w.conn for w in busy] + [w.process.sentinel for w in busy], timeout)
+    watched = busy + starting
+    wait([w.conn for w in watched] + [w.process.sentinel for w in watched], timeout)

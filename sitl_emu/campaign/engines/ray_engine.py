@@ -9,15 +9,18 @@ a worker that dies is that case's failure: tasks are never retried, a retry woul
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Iterator, Sequence
 from typing import Any
 
 from sitl_emu.campaign.cases import Case
 from sitl_emu.campaign.errors import CampaignError
-from sitl_emu.campaign.scenario import Limits, Row, failure_row, one_line, run_case
+from sitl_emu.campaign.scenario import Limits, Row, failure_row, load_scenario, one_line, run_case
 
 __all__ = ["RayEngine"]
+
+PRELOAD_HOLD_S = 0.2
 
 
 def _ray() -> Any:
@@ -60,6 +63,7 @@ class RayEngine:
     def _run(self, ray: Any, ref: str, cases: Sequence[Case], limits: Limits) -> Iterator[tuple[Case, Row]]:
         task = ray.remote(max_retries=0)(run_case)
         slots = self.workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        ray.get([ray.remote(max_retries=0)(_preload).remote(ref) for _ in range(min(slots, len(cases)))])
         pending = list(reversed(cases))
         running: dict[Any, tuple[Case, float]] = {}
         while pending or running:
@@ -77,6 +81,16 @@ class RayEngine:
                                              "Ray task was cancelled.")
                 row.update(sim_s=None, wall_s=round(time.monotonic() - started, 3))
                 yield case, row
+
+
+def _preload(ref: str) -> None:
+    """Import the Sim and the scenario in a Ray worker before the first case's wall time starts; the short sleep
+    keeps the worker busy so that the next of these lands on another worker."""
+    import sitl_emu.testing  # noqa: F401
+
+    with contextlib.suppress(CampaignError):
+        load_scenario(ref)
+    time.sleep(PRELOAD_HOLD_S)
 
 
 def _result(ray: Any, obj: Any, started: float) -> Row:

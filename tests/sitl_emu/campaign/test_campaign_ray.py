@@ -50,7 +50,7 @@ def test_fifty_cases_give_the_same_rows_on_ray_as_on_the_process_pool(local_ray:
 def test_on_ray_a_dead_worker_and_a_hanging_case_fail_alone(local_ray: None, tmp_path: Path) -> None:
     cases = make_cases({"options.bad_seeds": [1]}, {"options.behave": ["die", "hang"], "seed": [0, 1, 2]})
     summary = run_campaign(f"{SCENARIOS}:misbehave", cases, tmp_path / "out.csv", engine="ray",
-                           limits=Limits(sim_s=5.0, wall_s=10.0))
+                           limits=Limits(sim_s=5.0, wall_s=15.0))
     rows = {(r["option.behave"], r["seed"]): r for r in rows_of(tmp_path / "out.csv")}
     assert rows[("die", "1")]["status"] == "crashed" and rows[("hang", "1")]["status"] == "timeout"
     assert all(rows[(b, s)]["status"] == "passed" for b in ("die", "hang") for s in ("0", "2"))
