@@ -36,10 +36,10 @@ def run_campaign(scenario: str | Callable[..., Any], cases: Sequence[Case], out:
     _check_ids(cases)
     check_params(cases)
     limits = limits or Limits()
+    runner = make_engine(engine, workers, address) if isinstance(engine, str) else engine
     results = ResultsFile(Path(out) if out is not None else None, input_columns(cases))
     done = results.finished(cases)
     todo = [c for c in cases if c.id not in done]
-    runner = make_engine(engine, workers, address) if isinstance(engine, str) else engine
     with (progress(len(todo)) if progress else nullcontext()) as bar:
         for case, row in _guarded(runner.run(ref, todo, limits)):
             full = {**case_columns(case), "passed": row.get("status") == "passed", **row}

@@ -5,11 +5,16 @@ Ray is started for the campaign and shut down after it. The scenario must be imp
 filesystem, an installed package, or Ray's runtime_env). At most one task per CPU of the cluster is in flight, so a
 task's wall time counts from when it starts; one past its limit is cancelled with its worker (ray.cancel force), and
 a worker that dies is that case's failure: tasks are never retried, a retry would hide it.
+
+Joining a cluster from `ray start --head` was tried here with Ray 2.60 by the node's address (the one `ray start`
+prints) and RAY_AUTH_MODE=disabled on both sides; by 127.0.0.1 with Ray's default token authentication the driver
+did not connect (not investigated further).
 """
 
 from __future__ import annotations
 
 import contextlib
+import socket
 import time
 from collections.abc import Iterator, Sequence
 from typing import Any
@@ -21,6 +26,7 @@ from sitl_emu.campaign.scenario import Limits, Row, failure_row, load_scenario, 
 __all__ = ["RayEngine"]
 
 PRELOAD_HOLD_S = 0.2
+PROBE_TIMEOUT_S = 5.0
 
 
 def _ray() -> Any:
@@ -34,6 +40,10 @@ def _ray() -> Any:
 
 class RayEngine:
     def __init__(self, address: str | None = None, workers: int | None = None) -> None:
+        """Checks at once that Ray is installed and that a HOST:PORT `address` answers; joins or starts it later."""
+        _ray()
+        if address:
+            _probe(address)
         self.address = address
         self.workers = workers
 
@@ -81,6 +91,19 @@ class RayEngine:
                                              "Ray task was cancelled.")
                 row.update(sim_s=None, wall_s=round(time.monotonic() - started, 3))
                 yield case, row
+
+
+def _probe(address: str) -> None:
+    """A HOST:PORT nobody listens on fails here in one sentence (Ray itself retries for minutes, logging each try);
+    "auto" and ray:// addresses are left to Ray."""
+    host, sep, port = address.rpartition(":")
+    if not sep or "://" in address or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host, int(port)), timeout=PROBE_TIMEOUT_S).close()
+    except OSError as err:
+        raise CampaignError(f"no Ray cluster answers at {address} ({err.strerror or err}); start one with "
+                            "`ray start --head` or leave out --address to start Ray here.") from None
 
 
 def _preload(ref: str) -> None:

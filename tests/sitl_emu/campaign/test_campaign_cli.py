@@ -4,6 +4,7 @@ that reruns a failed case alone, and one sentence for each mistake."""
 from __future__ import annotations
 
 import csv
+import importlib.util
 import shlex
 from pathlib import Path
 
@@ -113,3 +114,15 @@ def test_a_toml_error_or_an_unknown_parameter_in_the_file_is_one_line_naming_the
     assert result.stderr.strip() == "sitl-emu: case c0000: Unknown parameter NO_SUCH_PARAM."
     result = run("campaign", str(bad), "--seed", "3")
     assert "give the cases either in CASES.toml or with --seed" in result.stderr
+
+
+def test_the_ray_engine_without_ray_or_with_no_cluster_at_the_address_is_one_line(tmp_path: Path) -> None:
+    result = run("campaign", "--scenario", f"{SCENARIOS}:hover", "--engine", "ray", "--address", "127.0.0.1:1",
+                 "--out", str(tmp_path / "x.csv"))
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    if importlib.util.find_spec("ray") is None:
+        assert lines[0].startswith("sitl-emu: the ray engine needs Ray: pip install 'joyfly[ray]'")
+    else:
+        assert lines[0].startswith("sitl-emu: no Ray cluster answers at 127.0.0.1:1 (")
+    assert not (tmp_path / "x.csv").exists()  # refused before anything was written
