@@ -16,6 +16,7 @@ from typing import Any
 
 import click
 
+from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli_options import (
     CONTEXT,
     MAX_SYSID,
@@ -282,6 +283,9 @@ def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:
         with contextlib.suppress(OSError, ValueError):  # stdout already gone: nothing to tell
             click.echo(f"\n{SHUTDOWN_LINE}")
             sys.stdout.flush()
+
+
+main.add_command(campaign)  # sitl_emu/campaign/cli.py (issue 16)
 
 
 if __name__ == "__main__":
