@@ -111,6 +111,8 @@ class Vehicle:
             return
         now = self._time_us = self._time_us + self.dt_us
         self._snap = None
+        if c.nav_commands:  # the navigator refuses targets outside the geofence (vehicle_fence.py)
+            self._fence.check_commands(c, self.ref, self._estimate.pos_ned_m, self._emit)
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now

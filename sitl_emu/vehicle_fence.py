@@ -1,7 +1,9 @@
 """The vehicle's geofence and rally-point glue: the stored plans, the parameters and the estimate turned into the
 navigator's geofence check (flight/geofence_monitor.py) and RTL's destination (flight/rally.py).
 
-Vehicle.step calls `FenceChecks.step` before each commander cycle (PX4: the navigator's geofence_breach_check
+Vehicle.step calls `FenceChecks.check_commands` on the navigator's new requests (DO_REPOSITION and
+DO_CHANGE_ALTITUDE targets outside the fence are refused, navigator_main.cpp geofence_allows_position) and
+`FenceChecks.step` before each commander cycle (PX4: the navigator's geofence_breach_check
 publishes geofence_result, the commander's health check and failsafe act on it); the mode executor asks
 `rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation).
 """
@@ -10,10 +12,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
-from sitl_emu.flight.geofence import GeofenceSettings, GeoPoint
+from sitl_emu.flight.geofence import (
+    GF_ACTION_NONE,
+    GF_ACTION_WARN,
+    GeofenceSettings,
+    GeoPoint,
+    mission_fence_violation,
+    point_allowed,
+)
 from sitl_emu.flight.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
-from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_RALLY, MissionStore
+from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore
 from sitl_emu.flight.rally import choose_destination
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
@@ -66,6 +76,39 @@ class FenceChecks:
         if out.reposition is not None:
             p = out.reposition
             c.nav_commands.append(NavCommand(NavCommandKind.REPOSITION, p.lat_deg, p.lon_deg, p.alt_amsl_m))
+
+
+    def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:
+        """Drop a reposition or altitude change whose target the fence forbids (GF_ACTION other than None and
+        Warning), with PX4's text; NaN coordinates mean the current ones. An allowed reposition ends the Hold latch
+        after a breach."""
+        s = self.settings
+        if s.action in (GF_ACTION_NONE, GF_ACTION_WARN) or not c.armed:
+            return
+        here = _geo(ref, here_ned_m)
+        kept = []
+        for cmd in c.nav_commands:
+            if cmd.kind is NavCommandKind.TAKEOFF:
+                kept.append(cmd)
+                continue
+            has_xy = isfinite(cmd.lat_deg) and isfinite(cmd.lon_deg)
+            target = GeoPoint(cmd.lat_deg if has_xy else here.lat_deg, cmd.lon_deg if has_xy else here.lon_deg,
+                              cmd.alt_amsl_m if isfinite(cmd.alt_amsl_m) else here.alt_amsl_m)
+            if point_allowed(self.monitor.fence, s, target, home_point(c)):
+                kept.append(cmd)
+                if cmd.kind is NavCommandKind.REPOSITION:
+                    self.monitor.unlatch()
+            else:
+                what = "Reposition" if cmd.kind is NavCommandKind.REPOSITION else "Altitude change"
+                emit(Severity.CRITICAL, "navigator", f"{what} is outside geofence", True, True)
+        c.nav_commands[:] = kept
+
+    def mission_violation(self, store: MissionStore, c: Commander) -> str | None:
+        """MissionFeasibilityChecker::checkMissionAgainstGeofence for the stored mission against the fence in force:
+        None, or the CRITICAL text the navigator logs (an event: module navigator) and the mission is not valid.
+        PX4 runs it when the mission, the fence (geofence_id) or home changes (mission_base.cpp check_mission_valid)."""
+        return mission_fence_violation(store.plan(PLAN_MISSION).items, self.monitor.fence, self.settings,
+                                       home_point(c))
 
 
 def rtl_destination(nav: NavInput, params: ParamRegistry, store: MissionStore, c: Commander,

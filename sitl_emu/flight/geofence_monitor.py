@@ -93,11 +93,15 @@ class GeofenceMonitor:
         self._last_check_us = now_us
         before = self.result
         self.result = self._flags(point, s, inp.home)
-        if self.result.breached and (self.result.max_dist, self.result.max_alt, self.result.custom) != (
-                before.max_dist, before.max_alt, before.custom):
-            step.health_texts = self.result.health_texts()
+        texts = self.result.health_texts()
+        if texts and texts != before.health_texts():  # the commander's report changed (a flag, or GF_ACTION)
+            step.health_texts = texts
         step.reposition = self._hold_reposition(now_us, s, inp)
         return step
+
+    def unlatch(self) -> None:
+        """A manual reposition ends the post-breach latch (navigator_main.cpp DO_REPOSITION)."""
+        self._latched_at_us = 0
 
     def _flags(self, point: GeoPoint, s: GeofenceSettings, home: GeoPoint | None) -> GeofenceResult:
         dist = not closer_than_max_dist(s, point, home)

@@ -1,6 +1,7 @@
 """Conformance: MAVSDK's geofence plugin (the `geofence` example) against `sitl-emu serve`: a polygon and a circle
-uploaded and downloaded back, GF_ACTION set to Return, the vehicle sent out of the fence with goto_location; PX4's
-breach handling follows (the breach text, the Hold of COM_FAIL_ACT_T, Return, landing at home).
+uploaded and downloaded back, GF_ACTION set to Return: goto_location outside the fence is refused by the navigator
+("Reposition is outside geofence"); with GF_ACTION None it is flown, and setting GF_ACTION back to Return there is a
+breach handled as PX4 handles it (the breach text, the Hold of COM_FAIL_ACT_T, Return, landing at home).
 
 MAVSDK's timeouts run on the wall clock, so the server runs only a few times faster than real time. The test skips
 only when the MAVSDK library cannot be loaded on this machine.
@@ -72,15 +73,30 @@ async def _fly(mavsdk_asyncio: Any, port: int) -> None:
         reader = asyncio.create_task(_collect_texts(telemetry, texts))
         home = await _call(telemetry.home())
         await _upload_fence(system, home.latitude_deg, home.longitude_deg)
-        await _call(ParamAsync(system).set_param_int("GF_ACTION", 3))  # Return
+        param = ParamAsync(system)
+        await _call(param.set_param_int("GF_ACTION", 3))  # Return
         await _call(action.arm())
         await _call(action.takeoff())
         await _wait("in_air", telemetry.in_air, bool, 20.0)
         await asyncio.sleep(3.0)
         lat, lon = _offset(home.latitude_deg, home.longitude_deg, 60.0, 0.0)
         await _call(action.goto_location(lat, lon, home.absolute_altitude_m + 5.0, math.nan))
+        await _wait("the refusal", lambda: _value(texts), lambda t: "Reposition is outside geofence" in t, 10.0)
+        await _call(param.set_param_int("GF_ACTION", 0))  # None: no check of the target, no breach
+        await _call(action.goto_location(lat, lon, home.absolute_altitude_m + 5.0, math.nan))
+        await _wait("60 m north", lambda: _north(telemetry), lambda n: n > 58.0, 60.0)
+        assert not any(t.startswith("Geofence") for t in texts)
+        await _call(param.set_param_int("GF_ACTION", 3))
         await _breach_handled(telemetry, texts)
         reader.cancel()
+
+
+async def _value(value: Any) -> Any:
+    return value
+
+
+async def _north(telemetry: Any) -> float:
+    return float((await _call(telemetry.position_velocity_ned())).position.north_m)
 
 
 async def _collect_texts(telemetry: Any, texts: list[str]) -> None:
@@ -107,12 +123,11 @@ async def _upload_fence(system: Any, lat: float, lon: float) -> None:
 async def _breach_handled(telemetry: Any, texts: list[str]) -> None:
     from mavsdk.plugins.telemetry import FlightMode
 
+    await _wait("flight mode HOLD (the failsafe's delay)", telemetry.flight_mode, lambda m: m == FlightMode.HOLD, 30.0)
     await _wait("flight mode RETURN_TO_LAUNCH", telemetry.flight_mode, lambda m: m == FlightMode.RETURN_TO_LAUNCH,
-                60.0)
+                30.0)
     assert "Geofence: approaching or outside geofence" in texts
     assert "Failsafe activated: entering Hold for 5 seconds" in texts and "Failsafe activated" in texts
-    # goto_location is a reposition in Hold, and the failsafe's Hold leaves the mode (and so the reposition) as it is
-    # during the COM_FAIL_ACT_T delay, as in PX4 (the navigator restarts a mode only when nav_state changes)
     await _wait("landed and disarmed", telemetry.armed, lambda armed: not armed, 120.0)
     p = (await _call(telemetry.position_velocity_ned())).position
     assert math.hypot(p.north_m, p.east_m) < 1.5

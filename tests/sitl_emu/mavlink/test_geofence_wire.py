@@ -60,7 +60,8 @@ class Gcs(FlightClient):
 
     def texts_after(self, n: int) -> list[str]:
         """The geofence, failsafe and RTL texts since the n-th text (PX4's event tab removed)."""
-        return [t.rstrip("\t") for t in self.seen.texts[n:] if t.startswith(("Geofence", "Failsafe", "RTL", "Arming"))]
+        kinds = ("Geofence", "Failsafe", "RTL", "Arming", "Reposition")
+        return [t.rstrip("\t") for t in self.seen.texts[n:] if t.startswith(kinds)]
 
 
 @pytest.fixture()
@@ -101,6 +102,17 @@ def reposition(sim: Sim, gcs: Gcs, north: float, east: float, up: float) -> None
     assert gcs.command(MavCmd.DO_REPOSITION, -1, 1, 0, NAN, lat, lon, alt) == MavResult.ACCEPTED
 
 
+def offboard_to(gcs: Gcs, north_m: float, east_m: float, up_m: float) -> None:
+    """OFFBOARD (setpoints streamed first, PX4's rule), then a position setpoint: the way out of a fence that
+    DO_REPOSITION cannot take (the navigator refuses targets outside it)."""
+    assert gcs.seen.pos_ned_m is not None
+    gcs.setpoint_ned_m = gcs.seen.pos_ned_m
+    gcs.spin(1.0)
+    assert gcs.set_mode(NavState.OFFBOARD) == MavResult.ACCEPTED
+    gcs.wait(lambda: gcs.in_mode(NavState.OFFBOARD), 2.0, "OFFBOARD")
+    gcs.setpoint_ned_m = (north_m, east_m, -up_m)
+
+
 def north(gcs: Gcs) -> float:
     assert gcs.seen.pos_ned_m is not None
     return gcs.seen.pos_ned_m[0]
@@ -117,12 +129,15 @@ def test_fence_upload_and_breach_with_hold(sim):
     assert gcs.upload(fence, FENCE) == 0
     fly_up(sim, gcs, {})
     n0 = len(gcs.seen.texts)
-    reposition(sim, gcs, 70.0, 0.0, 5.0)
-    gcs.wait(lambda: gcs.seen.heartbeat.system_status == MAV_STATE_CRITICAL, 30.0, "the failsafe")
+    offboard_to(gcs, 70.0, 0.0, 5.0)
+    gcs.wait(lambda: gcs.in_mode(NavState.AUTO_LOITER), 30.0, "the Hold failsafe")
+    assert gcs.seen.heartbeat.system_status == MAV_STATE_CRITICAL
     assert gcs.texts_after(n0) == ["Geofence: approaching or outside geofence", "Failsafe activated"]
     assert 25.0 < north(gcs) < 40.0
-    gcs.spin(8.0)
-    assert gcs.in_mode(NavState.AUTO_LOITER) and abs(north(gcs) - 31.0) < 3.0  # back at the breach point
+    breach_north = north(gcs)
+    gcs.wait(lambda: north(gcs) > breach_north + 10.0, 10.0, "the overshoot (braking from ~10 m/s)")
+    gcs.wait(lambda: abs(north(gcs) - breach_north) < 1.5, 40.0, "Hold back at the breach point")
+    assert gcs.in_mode(NavState.AUTO_LOITER)
     assert not gcs.seen.sys_status.onboard_control_sensors_health & S_PREARM_CHECK
     assert gcs.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
     gcs.wait(lambda: not gcs.armed, 60.0, "landed at home")
@@ -137,7 +152,7 @@ def test_fence_breach_return_or_land_after_the_hold(sim, action, mode):
     assert gcs.upload(circle(gcs, sim, 25.0), FENCE) == 0
     fly_up(sim, gcs, {"GF_ACTION": action})
     n0 = len(gcs.seen.texts)
-    reposition(sim, gcs, 60.0, 0.0, 5.0)
+    offboard_to(gcs, 60.0, 0.0, 5.0)
     t_hold = gcs.wait(lambda: "Failsafe activated: entering Hold for 5 seconds" in gcs.texts_after(n0), 30.0,
                       "the delayed failsafe")
     t_action = gcs.wait(lambda: gcs.in_mode(mode), 10.0, "the failsafe action")
@@ -156,11 +171,11 @@ def test_max_horizontal_distance_breach_lands(sim):
     gcs = Gcs(sim)
     fly_up(sim, gcs, {"GF_MAX_HOR_DIST": 20.0, "GF_ACTION": 5, "COM_FAIL_ACT_T": 0.0})
     n0 = len(gcs.seen.texts)
-    reposition(sim, gcs, 0.0, 50.0, 5.0)
+    offboard_to(gcs, 0.0, 50.0, 5.0)
     gcs.wait(lambda: gcs.in_mode(NavState.AUTO_LAND), 30.0, "Land")
     assert gcs.texts_after(n0)[:2] == ["Geofence: exceeding maximum distance to Home", "Failsafe activated"]
     gcs.wait(lambda: not gcs.armed, 60.0, "landed")
-    assert gcs.seen.pos_ned_m is not None and 20.0 < gcs.seen.pos_ned_m[1] < 35.0
+    assert gcs.seen.pos_ned_m is not None and 20.0 < gcs.seen.pos_ned_m[1] < 50.0  # at the braking point
 
 
 def test_takeoff_above_max_vertical_distance_holds(sim):
@@ -232,3 +247,19 @@ def test_nan_vertex_is_refused(sim):
     gcs.send(gcs.mav.mission_item_encode(1, 1, 0, 3, POLY_IN, 0, 1, 3, 0, 0, 0, NAN, NAN, 0.0, FENCE))
     gcs.wait(lambda: gcs.mission[-1].get_type() == "MISSION_ACK", 2.0, "the ACK")
     assert gcs.mission[-1].type == 10  # MAV_MISSION_INVALID_PARAM5_X
+
+
+def test_reposition_outside_the_fence_is_refused(sim):
+    """navigator_main.cpp: a DO_REPOSITION target outside the fence is not flown ("Reposition is outside geofence");
+    commander acknowledges the command all the same. A target inside is flown."""
+    gcs = Gcs(sim)
+    gcs.wait(lambda: gcs.healthy, 10.0, "healthy")
+    assert gcs.upload(circle(gcs, sim, 25.0), FENCE) == 0
+    fly_up(sim, gcs, {})
+    n0 = len(gcs.seen.texts)
+    reposition(sim, gcs, 40.0, 0.0, 5.0)
+    gcs.spin(5.0)
+    assert gcs.texts_after(n0) == ["Reposition is outside geofence"]
+    assert abs(north(gcs)) < 1.0
+    reposition(sim, gcs, 15.0, 0.0, 5.0)
+    gcs.wait(lambda: abs(north(gcs) - 15.0) < 0.5, 20.0, "the allowed reposition")
