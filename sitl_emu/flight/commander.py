@@ -179,7 +179,8 @@ class Commander:
         Position cannot run); during a failsafe action the switch ends it too."""
         if not self.armed or not (self.nav_state in AUTO_MODES or self.nav_state is NavState.OFFBOARD):
             return
-        if self._failsafe.manual_loss.hold_s(self.now_us) > 0:
+        if self._failsafe.manual_loss.hold_s(self.now_us) > 0 or not self._failsafe.geofence.sticks_may_take_over(
+                self.now_us):
             return  # no stick takeover during the Hold before a failsafe action (framework.cpp)
         in_failsafe = self.failsafe  # taking over from a failsafe action is told as an event only
         if self.change_mode(NavState.POSCTL) or self.change_mode(NavState.ALTCTL):

@@ -42,6 +42,7 @@ class GeofenceFailsafe:
         self._hold_until_us = 0
         self._breached = False
         self._taken_over = False
+        self._fail_act_us = 0
 
     def reset(self) -> None:
         """Arming, disarming or a user mode change: the action ends; while the breach lasts it stays taken over."""
@@ -63,6 +64,15 @@ class GeofenceFailsafe:
             return NavState.AUTO_LOITER
         return self.action
 
+    def sticks_may_take_over(self, now_us: int) -> bool:
+        """framework.cpp allow_user_takeover: a Hold action, the delay before Return/Land, or Return/Land without a
+        delay (COM_FAIL_ACT_T 0.1 s or less) let the user leave by a mode switch only, not with the sticks."""
+        if self.action is None or self.action is NavState.TERMINATION:
+            return True
+        if self.action is NavState.AUTO_LOITER or now_us < self._hold_until_us:
+            return False
+        return self._fail_act_us > _MIN_DELAY_US
+
     def hold_s(self, now_us: int) -> int:
         """Whole seconds of Hold left before the action (0: not holding)."""
         if self.action is None or now_us >= self._hold_until_us:
@@ -72,5 +82,6 @@ class GeofenceFailsafe:
     def _start(self, now_us: int, gf_action: int, fail_act_us: int, worse_than_hold_active: bool) -> None:
         self._active = True  # Warning: registered, no mode
         self.action = _ACTION_MODES.get(gf_action)
+        self._fail_act_us = fail_act_us
         if self.action in _DELAYED and fail_act_us > _MIN_DELAY_US and not worse_than_hold_active:
             self._hold_until_us = now_us + fail_act_us

@@ -309,3 +309,16 @@ def test_rtl_type_1_prefers_rally_points_and_type_5_ignores_home():
     here = at(20, 0, 20)
     assert choose_destination(5, [], HOME, 0.0, here).point == here
     assert choose_destination(2, points, HOME, 0.0, at(190, 0, 20)).point == HOME
+
+
+def test_failsafe_sticks_take_over_only_after_the_delay_of_return_or_land():
+    hold = GeofenceFailsafe()
+    hold.update(0, BREACH[GF_ACTION_HOLD], NavState.POSCTL, 5 * S, False)
+    assert not hold.sticks_may_take_over(10 * S)  # Hold: a mode switch only
+    ret = GeofenceFailsafe()
+    ret.update(0, BREACH[GF_ACTION_RETURN], NavState.POSCTL, 5 * S, False)
+    assert not ret.sticks_may_take_over(1 * S) and ret.sticks_may_take_over(6 * S)
+    quick = GeofenceFailsafe()
+    quick.update(0, BREACH[GF_ACTION_LAND], NavState.POSCTL, 0, False)
+    assert not quick.sticks_may_take_over(1 * S)
+    assert GeofenceFailsafe().sticks_may_take_over(0)
