@@ -63,11 +63,14 @@ class FenceChecks:
              ref: GeoRef, emit: Emit) -> None:
         """One navigator geofence check: the result goes to the commander (c.geofence), the texts out, and the Hold
         position after a breach into the navigator's queue."""
+        plan = store.plan(PLAN_FENCE)
+        if not self.monitor.due(now_us, plan):
+            return
         ready = c.estimator_ready
         inputs = GeofenceInputs(estimate=_geo(ref, estimate_ned_m) if ready else None,
                                 gps=_geo(ref, truth_ned_m) if ready else None, home=home_point(c), landed=c.landed,
                                 armed=c.armed, in_hold=c.nav_state is NavState.AUTO_LOITER)
-        out = self.monitor.update(now_us, store.plan(PLAN_FENCE), self.settings, inputs)
+        out = self.monitor.update(now_us, plan, self.settings, inputs)
         c.geofence = self.monitor.result
         for text in out.navigator_texts:
             emit(Severity.CRITICAL, "navigator", text, True, True)

@@ -76,6 +76,11 @@ class GeofenceMonitor:
         self._latched_at_us = 0  # _time_loitering_after_gf_breach (0: not latched)
         self._reposition_sent = False
 
+    def due(self, now_us: int, plan: Plan) -> bool:
+        """Whether `update` would do anything now (the caller may skip building its inputs otherwise)."""
+        return ((plan.opaque_id, plan.count) != self._plan_key or bool(self._latched_at_us)
+                or self._last_check_us is None or now_us - self._last_check_us > CHECK_INTERVAL_US)
+
     def update(self, now_us: int, plan: Plan, s: GeofenceSettings, inp: GeofenceInputs) -> GeofenceStep:
         step = GeofenceStep()
         key = (plan.opaque_id, plan.count)

@@ -200,6 +200,7 @@ def test_monitor_checks_every_200_ms_and_reports_each_new_breach_once():
     assert m.result.custom and m.result.breached
     assert step.health_texts == ["Geofence: approaching or outside geofence"] and step.reposition is None
     assert m.update(400_008, plan, s, _inputs(60)).health_texts == []
+    assert not m.due(500_000, plan) and m.due(600_012, plan) and m.due(500_000, _plan([]))
     m.update(600_012, plan, s, _inputs(0))
     assert not m.result.triggered
 
