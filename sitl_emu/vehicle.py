@@ -2,8 +2,8 @@
 
 Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (4000 us, 250 Hz):
  1. pending reboot (PREFLIGHT_REBOOT_SHUTDOWN param1=1, acknowledged before): back to the boot state, time 0;
- 2. commander (every COMMANDER_PERIOD_US): readiness ("Ready for takeoff!"), home, auto-disarm, takeoff
-    completion, failsafes, mode in force;
+ 2. commander (every COMMANDER_PERIOD_US), after the navigator's geofence check (vehicle_fence.py): readiness
+    ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
  4. control cascade: setpoint -> motor commands (zero when disarmed or terminated), then injected motor failures;
  5. physics: rigid-body step by dt in the wind; the new truth state (plus optional seeded noise) becomes the
@@ -50,6 +50,7 @@ from sitl_emu.types import (
     VehicleSnapshot,
 )
 from sitl_emu.vehicle_faults import VehicleFaults
+from sitl_emu.vehicle_fence import FenceChecks, rtl_destination
 from sitl_emu.vehicle_parts import ControlChain, published_setpoints
 
 EVENT_HISTORY: Final = 1000
@@ -103,6 +104,8 @@ class Vehicle:
         self._missions = MissionStore()  # in memory only: a reboot empties it (flight/mission_store.py)
         self.faults = VehicleFaults(self.params, self.commander.fault_flags, self._emit, seed=self._seed,
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
+        self._fence = FenceChecks(self.params)  # the navigator's geofence check (vehicle_fence.py)
+        self.chain.executor.rtl_destination = self._rtl_destination
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -118,11 +121,15 @@ class Vehicle:
             return
         now = self._time_us = self._time_us + self.dt_us
         self._snap = None
+        if c.nav_commands:  # the navigator refuses targets outside the geofence (vehicle_fence.py)
+            self._fence.check_commands(c, self.ref, self._estimate.pos_ned_m, self._emit)
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now
             self.faults.update(now, c.armed, self._estimate)
             c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
+            self._fence.step(now, self._missions, c, self._estimate.pos_ned_m, self._state.pos_ned_m, self.ref,
+                             self._emit)
             c.update(now)
         chain = self.chain
         out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s,
@@ -156,6 +163,9 @@ class Vehicle:
     def _nav_input(self) -> NavInput:
         """The navigator task's input, built only when a task runs (before physics: the estimate of this tick)."""
         return self.chain.nav_input(self._time_us, self._estimate, self.commander, self.ref)
+
+    def _rtl_destination(self, nav: NavInput) -> tuple[Vec3, float] | None:
+        return rtl_destination(nav, self.params, self._missions, self.commander, self.ref)
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:

@@ -17,6 +17,7 @@ from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.fault_failsafes import FaultFlags, FaultSettings
+from sitl_emu.flight.geofence import NO_BREACH, GeofenceResult
 from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
@@ -128,6 +129,7 @@ class Commander:
         self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
         self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle_faults.py)
+        self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (flight/geofence_monitor.py)
 
     @property
     def settings(self) -> CommanderSettings:
@@ -181,7 +183,8 @@ class Commander:
         Position cannot run); during a failsafe action the switch ends it too."""
         if not self.armed or not (self.nav_state in AUTO_MODES or self.nav_state is NavState.OFFBOARD):
             return
-        if self._failsafe.manual_loss.hold_s(self.now_us) > 0:
+        if self._failsafe.manual_loss.hold_s(self.now_us) > 0 or not self._failsafe.geofence.sticks_may_take_over(
+                self.now_us):
             return  # no stick takeover during the Hold before a failsafe action (framework.cpp)
         in_failsafe = self.failsafe  # taking over from a failsafe action is told as an event only
         if self.change_mode(NavState.POSCTL) or self.change_mode(NavState.ALTCTL):
@@ -230,7 +233,7 @@ class Commander:
 
     def pre_flight_checks_pass(self) -> bool:
         """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed)."""
-        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed)
+        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed) and not self.geofence.breached
 
     def system_status(self) -> MavState:
         """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
@@ -265,6 +268,11 @@ class Commander:
             if failure is not None:
                 self.say(Severity.WARNING, f"Preflight Fail: {failure}", is_event=False, statustext=False,
                          module="health_and_arming_checks")
+                self.say(Severity.CRITICAL, "Arming denied: Resolve system health failures first")
+                return False
+            if self.geofence.breached:  # geofenceCheck.cpp: a breach fails the arming checks in every mode
+                for text in self.geofence.health_texts():
+                    self.say(Severity.CRITICAL, text, is_event=False)
                 self.say(Severity.CRITICAL, "Arming denied: Resolve system health failures first")
                 return False
         self.armed = True
@@ -322,7 +330,8 @@ class Commander:
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
                                          settings=st.fallback, terminated=self.terminated, now_us=now_us,
                                          manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss,
-                                         faults=(self.fault_flags, st.faults))
+                                         faults=(self.fault_flags, st.faults),
+                                         geofence=self.geofence, fail_act_us=st.manual_loss.fail_act_us)
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe

@@ -10,7 +10,8 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
   Hold/Return/Takeoff -> Land -> Descend;
 - the fallback clears as soon as the user's mode can run again (WhenConditionClears), and an explicit mode change
   by the user ends it (the new mode can run, or the change was refused);
-- flight termination (DO_FLIGHTTERMINATION) holds TERMINATION while armed.
+- flight termination (DO_FLIGHTTERMINATION) holds TERMINATION while armed;
+- a geofence breach acts as GF_ACTION says (flight/geofence_failsafe.py), ranked with the others.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from dataclasses import dataclass
 
 from sitl_emu.flight.arming import CheckInputs, Req, can_run
 from sitl_emu.flight.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
+from sitl_emu.flight.geofence import GeofenceResult
+from sitl_emu.flight.geofence_failsafe import GeofenceFailsafe
 from sitl_emu.flight.manual_control import ManualLossFailsafe, ManualLossSettings
 from sitl_emu.px4 import NavState
 
@@ -118,6 +121,7 @@ class Failsafe:
         self.active = False
         self.manual_loss = ManualLossFailsafe()
         self.faults = FaultFailsafes()  # link loss, battery, failure detector (flight/fault_failsafes.py)
+        self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
 
     def reset(self) -> None:
@@ -126,11 +130,13 @@ class Failsafe:
         self._rank = 0
         self.manual_loss.reset()
         self.faults.reset()
+        self.geofence.reset()
 
     def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False, now_us: int = 0, manual_lost: bool = False,
                manual_loss: ManualLossSettings | None = None,
-               faults: tuple[FaultFlags, FaultSettings] | None = None) -> Decision:
+               faults: tuple[FaultFlags, FaultSettings] | None = None, geofence: GeofenceResult | None = None,
+               fail_act_us: int = 0) -> Decision:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.reset()
@@ -155,14 +161,27 @@ class Failsafe:
                     rank, mode, disarm = _DISARM_RANK, user, True
                 elif want.mode is not None and _RANK[want.mode] > rank:
                     rank, mode, disarm = _RANK[want.mode], want.mode, False
+        if geofence is not None:
+            rank, mode, disarm = self._geofence(now_us, geofence, user, fail_act_us, (rank, mode, disarm))
         if rank == 0:
             self.active, self._rank = False, 0
             return Decision(user, False)
-        hold_s = max(self.manual_loss.hold_s(now_us), self.faults.hold_s(now_us)) if mode is NavState.AUTO_LOITER else 0
+        hold_s = 0
+        if mode is NavState.AUTO_LOITER:
+            hold_s = max(self.manual_loss.hold_s(now_us), self.faults.hold_s(now_us), self.geofence.hold_s(now_us))
         text = f"{FAILSAFE_TEXT}: entering Hold for {hold_s} seconds" if hold_s > 0 else FAILSAFE_TEXT
         decision = self._decide(mode, disarm, text if rank > self._rank else "")
         self._rank = rank
         return decision
+
+    def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
+                  current: tuple[int, NavState, bool]) -> tuple[int, NavState, bool]:
+        """The geofence_breached failsafe joins the others: the worse action wins."""
+        worse_than_hold = self._rank > _RANK[NavState.AUTO_LOITER]
+        wanted = self.geofence.update(now_us, result, user, fail_act_us, worse_than_hold)
+        if wanted is not None and _RANK[wanted] > current[0]:
+            return _RANK[wanted], wanted, False
+        return current
 
     def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
         self.active = True

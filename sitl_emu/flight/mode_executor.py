@@ -76,6 +76,8 @@ class ModeExecutor:
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
+        # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
+        self.rtl_destination: Callable[[tasks.NavInput], tuple[Vec3, float] | None] | None = None
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -181,7 +183,7 @@ class ModeExecutor:
         elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
-            self.task = tasks.make_rtl(nav, self.params)
+            self.task = tasks.make_rtl(nav, self.params, self.rtl_destination(nav) if self.rtl_destination else None)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
             self.task = ManualPositionTask(nav, self.params)
         elif nav_state is NavState.ALTCTL:

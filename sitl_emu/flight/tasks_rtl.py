@@ -2,7 +2,8 @@
 
 States as RtlDirect: CLIMBING (to the return altitude above the current position) -> MOVE_TO_LOITER (home at the
 return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise LOITER_DOWN (to RTL_DESCEND_ALT) ->
-LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The return altitude follows
+LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The destination is home or the rally
+point RTL_TYPE selects (flight/rally.py; "home" below means that destination). The return altitude follows
 RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
 """
 
@@ -47,10 +48,11 @@ def _f32(x: float) -> float:
 
 
 class RtlTask(Task):
-    def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
+    def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None) -> None:
         super().__init__(nav, params)
-        self._home: Vec3 = nav.home_ned_m
-        self._home_yaw = nav.home_yaw_rad
+        # the destination (rtl.cpp findRtlDestination: home, or a rally point chosen by flight/rally.py)
+        self._home: Vec3 = nav.home_ned_m if destination is None else destination[0]
+        self._home_yaw = nav.home_yaw_rad if destination is None else destination[1]
         self._rtl_up_m = self._return_altitude_up(nav)
         self._state = RtlState.IDLE
         self._hold_until_us = 0

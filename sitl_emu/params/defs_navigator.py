@@ -1,7 +1,7 @@
-"""Navigator (takeoff, hold, RTL) and multicopter land-detector parameters.
+"""Navigator (takeoff, hold, RTL, geofence) and multicopter land-detector parameters.
 
-Defaults: src/modules/navigator/{navigator_params.c, mission_params.yaml, rtl_params.yaml} with the multicopter
-overrides of ROMFS/px4fmu_common/init.d/rc.mc_defaults (RTL_RETURN_ALT 30, RTL_DESCEND_ALT 10), and
+Defaults: src/modules/navigator/{navigator_params.c, mission_params.yaml, rtl_params.yaml, geofence_params.yaml}
+with the multicopter overrides of ROMFS/px4fmu_common/init.d/rc.mc_defaults (RTL_RETURN_ALT 30, RTL_DESCEND_ALT 10), and
 src/modules/land_detector/land_detector_params_mc.c (LNDMC_*). The land-detector parameters live in this domain
 because the registry loads only the domains listed in sitl_emu/params/__init__.py.
 """
@@ -19,6 +19,12 @@ _NAVIGATOR: list[ParamDef] = [
     real("RTL_LAND_DELAY", 0.0, -1.0, 300.0, "s"),
     real("RTL_MIN_DIST", 10.0, 0.5, 10000.0, "m"),
     integer("RTL_CONE_ANG", 45, 0, 90, "deg"),
+    integer("RTL_TYPE", 0, 0, 5, ""),
+    # geofence_params.yaml (navigator/geofence.cpp reads these)
+    integer("GF_ACTION", 2, 0, 5, ""),
+    integer("GF_SOURCE", 0, 0, 1, ""),
+    real("GF_MAX_HOR_DIST", 0.0, 0.0, 10000.0, "m"),
+    real("GF_MAX_VER_DIST", 0.0, 0.0, 10000.0, "m"),
 ]
 
 # PX4's navigator looks these up only when a mission is uploaded, so PX4 lists them only from then on (catalog.py: not
