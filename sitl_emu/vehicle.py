@@ -9,7 +9,7 @@ Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (400
  5. physics: rigid-body step by dt; the new truth state (plus optional seeded noise) becomes the estimate;
  6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
     "Landing detected");
- 7. events: the task's messages join the event stream.
+ 7. events: the task's messages join the event stream; a mission's RTL item asks the commander for Return.
 Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
 on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
 """
@@ -32,7 +32,7 @@ from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
-from sitl_emu.px4 import AUTO_MODES, LandedState, NavState, Severity
+from sitl_emu.px4 import AUTO_MODES, LandedState, MavCmd, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
@@ -93,6 +93,8 @@ class Vehicle:
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
         self._missions = MissionStore()  # in memory only: a reboot empties it (flight/mission_store.py)
+        self.commander.mission_store = self._missions
+        self.chain.executor.attach_missions(self._missions)
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -128,6 +130,9 @@ class Vehicle:
         if out.messages:  # the task said something this tick
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)
+        if c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL:
+            # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
+            handle_command(c, VehicleCommand(MavCmd.NAV_RETURN_TO_LAUNCH, from_external=False), now)
 
     def run_until(self, time_us: int) -> None:
         """Step until time_us is reached (no-op if already there)."""

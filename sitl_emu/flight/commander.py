@@ -17,6 +17,7 @@ from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
 from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
+from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
 from sitl_emu.flight.stick_gestures import Gesture, GestureDetector, StickMotion
@@ -124,6 +125,7 @@ class Commander:
         self._gestures = GestureDetector()
         self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
+        self.mission_store: MissionStore | None = None  # the stored plans (the Vehicle's), for AUTO.MISSION's checks
 
     @property
     def settings(self) -> CommanderSettings:
@@ -210,7 +212,13 @@ class Commander:
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
         t = self.now_us if now_us is None else now_us
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t))
+                                  offboard_signal=self.offboard_fresh(t), manual_control=self.manual_control_valid(t),
+                                  mission_valid=self.mission_valid)
+
+    @property
+    def mission_valid(self) -> bool:
+        """failsafe_flags.auto_mission_missing inverted: a valid mission is stored."""
+        return self.mission_store is not None and self.mission_store.mission_valid
 
     def can_run(self, nav_state: NavState) -> bool:
         return arming.can_run(nav_state, self.check_inputs())

@@ -172,8 +172,22 @@ def _set_home(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 
 
 def _mission_start(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
-    c.say(Severity.CRITICAL, "Mission start denied! No valid mission")
-    return _ack(cmd, MavResult.DENIED)
+    """Commander.cpp MISSION_START: a valid mission and a first item in -1..count-1 -> AUTO.MISSION and arm; the
+    navigator then starts at param1 (navigator_main.cpp: when >= 0)."""
+    store = c.mission_store
+    if store is None or not c.mission_valid:
+        c.say(Severity.CRITICAL, "Mission start denied! No valid mission")
+        return _ack(cmd, MavResult.DENIED)
+    first = cmd.param(1)
+    if not (isfinite(first) and -1 <= first < store.count(0)):
+        return _ack(cmd, MavResult.DENIED)
+    if not (c.change_mode(NavState.AUTO_MISSION) and c.arm(now_us, external=cmd.from_external, run_checks=True,
+                                                           reason="mission start")):
+        c.reject_mode_text(NavState.AUTO_MISSION, now_us)
+        return _ack(cmd, MavResult.TEMPORARILY_REJECTED)
+    if first >= 0:
+        store.set_current(int(first))
+    return _ack(cmd, MavResult.ACCEPTED)
 
 
 def _termination(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:

@@ -47,8 +47,12 @@ def _f32(x: float) -> float:
 
 
 class RtlTask(Task):
-    def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
+    def __init__(self, nav: NavInput, params: ParamRegistry, loiter_at_ned_m: Vec3 | None = None) -> None:
+        """`loiter_at_ned_m`: the loiter the vehicle was established on when RTL began (a finished mission's last
+        setpoint): the climb keeps its centre (rtl_direct.cpp CLIMBING, is_established_on_loiter); else the climb
+        is centred where the vehicle is."""
         super().__init__(nav, params)
+        self._loiter_at = loiter_at_ned_m
         self._home: Vec3 = nav.home_ned_m
         self._home_yaw = nav.home_yaw_rad
         self._rtl_up_m = self._return_altitude_up(nav)
@@ -93,7 +97,8 @@ class RtlTask(Task):
         self._state = state
         s = self._settings
         if state is RtlState.CLIMB:
-            self._climb_xy = (nav.pos_ned_m[0], nav.pos_ned_m[1])
+            at = self._loiter_at if self._loiter_at is not None else nav.pos_ned_m
+            self._climb_xy = (at[0], at[1])
             self._climb_yaw = nav.yaw_rad
         elif state is RtlState.RETURN:
             self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN

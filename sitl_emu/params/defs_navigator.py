@@ -19,6 +19,10 @@ _NAVIGATOR: list[ParamDef] = [
     real("RTL_LAND_DELAY", 0.0, -1.0, 300.0, "s"),
     real("RTL_MIN_DIST", 10.0, 0.5, 10000.0, "m"),
     integer("RTL_CONE_ANG", 45, 0, 90, "deg"),
+    # AUTO.MISSION (flight/mission.py): a waypoint's heading, the loiter a finished mission leaves (RTL's climb)
+    real("MIS_YAW_ERR", 12.0, 0.0, 90.0, "deg"),
+    real("MIS_YAW_TMT", -1.0, -1.0, 20.0, "s"),
+    real("NAV_LOITER_RAD", 80.0, -10000.0, 10000.0, "m"),
 ]
 
 # PX4's navigator looks these up only when a mission is uploaded, so PX4 lists them only from then on (catalog.py: not

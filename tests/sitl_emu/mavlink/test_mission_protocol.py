@@ -265,8 +265,11 @@ def test_unanswered_count_is_repeated_then_times_out(setup):
 def test_set_current(setup):
     proto, ctx, client = setup
     upload(proto, ctx, client, [item(client, 0), item(client, 1)])
+    proto.tick(ctx)
+    ctx.take()
     proto.handle(client.msg("MISSION_SET_CURRENT", 1, 1, 1), ctx)
-    (current,) = ctx.broadcasts
+    proto.tick(ctx)  # the new current item is reported at the link's next pass
+    (current,) = ctx.take("MISSION_CURRENT")
     assert (current.seq, current.total) == (1, 2)
     assert [m.current for m in download(proto, ctx, client)] == [0, 1]
     proto.handle(client.msg("MISSION_SET_CURRENT", 1, 1, 2), ctx)
