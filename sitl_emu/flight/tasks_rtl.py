@@ -53,6 +53,7 @@ class RtlTask(Task):
         is centred where the vehicle is."""
         super().__init__(nav, params)
         self._loiter_at = loiter_at_ned_m
+        self._yaw_err_rad = math.radians(float(params.get("MIS_YAW_ERR")) if "MIS_YAW_ERR" in params else 12.0)
         self._home: Vec3 = nav.home_ned_m
         self._home_yaw = nav.home_yaw_rad
         self._rtl_up_m = self._return_altitude_up(nav)
@@ -109,6 +110,14 @@ class RtlTask(Task):
         elif state is RtlState.LAND:
             self._say(Severity.INFO, "RTL: land at destination")
 
+    def _heading_reached(self, nav: NavInput) -> bool:
+        """mission_block.cpp: an item with a heading (the return leg near home faces home's heading) is reached only
+        once the heading is within MIS_YAW_ERR (MIS_YAW_TMT -1: no timeout)."""
+        if not math.isfinite(self._return_yaw):
+            return True
+        err = (self._return_yaw - nav.yaw_rad + math.pi) % math.tau - math.pi
+        return abs(err) < self._yaw_err_rad
+
     def _loiter_up_m(self) -> float:
         return min(-self._home[2] + self._settings.rtl_descend_alt, self._rtl_up_m)
 
@@ -138,7 +147,8 @@ class RtlTask(Task):
         st = self._state
         if st is RtlState.CLIMB and up >= self._rtl_up_m - s.nav_mc_alt_rad:
             self._enter(RtlState.RETURN, nav)
-        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad:
+        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad \
+                and self._heading_reached(nav):
             self._enter(RtlState.LAND if s.rtl_land_delay == 0.0 else RtlState.DESCEND, nav)
         elif st is RtlState.DESCEND and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
             self._enter(RtlState.HOLD, nav)
