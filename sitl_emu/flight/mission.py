@@ -105,18 +105,24 @@ class MissionNavigator:
         self._active, self._planned_valid = False, True
 
     def set_current(self, seq: int, nav: NavInput | None, s: MissionSettings) -> None:
-        """MISSION_SET_CURRENT: while flying, go there at once (set_current_mission_index)."""
+        """MISSION_SET_CURRENT / MISSION_START(n) (Mission::set_current_mission_index): the same item keeps
+        everything; another one becomes current, and while flying the vehicle turns to it at once (the triplet is
+        reset: no line from the old item)."""
+        if seq == self.result.seq_current and not self.result.finished:
+            return
         self.result.seq_current = seq
         self.result.finished = False
         self._planned_valid = True
         if nav is not None and self._active:
+            self.previous = self.current = self.next = None
             self._work = Work.DEFAULT
             self._set_items(nav, s)
 
     # ---- activation ---------------------------------------------------------------------------------------------
     def activate(self, nav: NavInput, s: MissionSettings, current_seq: int) -> None:
-        """MissionBase::on_activation: from the stored current item; a finished mission restarts only through
-        MISSION_START / SET_CURRENT (which set the current item)."""
+        """MissionBase::on_activation (each activation follows an inactivation, which ends the mission type, so
+        "Executing Mission" is said again on a resume): from the current item; a finished mission loiters unless
+        MISSION_START / SET_CURRENT chose an item, or the vehicle is back on the ground (checkMissionRestart)."""
         self.result.seq_current = current_seq
         if not self._planned_valid and nav.landed and current_seq + 1 >= len(self.items):
             # checkMissionRestart: a mission flown to its end restarts from the first item once back on the ground
@@ -129,10 +135,8 @@ class MissionNavigator:
                       else "No valid mission available, loitering", Severity.CRITICAL)
             self._active = False
         else:
-            if not self._active:
-                self._say("Executing Mission")
+            self._say("Executing Mission")
             self._active = True
-            self.result.finished = False
         self._work = Work.DEFAULT
         self._climb_up_m = self._climb_needed(nav, s, self.result.seq_current)
         self._set_items(nav, s)

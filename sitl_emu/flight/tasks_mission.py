@@ -35,7 +35,7 @@ class MissionFlight:
         self.navigator = MissionNavigator()
         self._plan_id: int | None = None
         self._items_ref: object = None
-        self._current_seen = store.current_seq
+        self._changes_seen = store.current_changes
 
     def sync(self, ref: GeoRef, home_alt_amsl_m: float, nav: NavInput | None, settings: MissionSettings) -> None:
         """Follow the store: a changed plan is loaded (relative altitudes above home), a new current item is set."""
@@ -43,17 +43,17 @@ class MissionFlight:
         if plan.items is not self._items_ref:
             self._items_ref = plan.items
             self.navigator.load(nav_items(plan.items, ref, home_alt_amsl_m), self.store.current_seq)
-            self._current_seen = self.store.current_seq
+            self._changes_seen = self.store.current_changes
             self._publish()
-        elif self.store.current_seq != self._current_seen:
+        elif self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)
+            self._changes_seen = self.store.current_changes
             self.navigator.set_current(self.store.current_seq, nav, settings)
-            self._current_seen = self.store.current_seq
             self._publish()
 
     def _publish(self) -> None:
         """The navigator's mission_result into the store, for MISSION_CURRENT / MISSION_ITEM_REACHED."""
         r = self.navigator.result
-        self.store.current_seq = self._current_seen = r.seq_current
+        self.store.current_seq = r.seq_current
         self.store.seq_reached = r.seq_reached
         self.store.finished = r.finished
 
