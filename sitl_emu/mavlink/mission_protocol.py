@@ -60,6 +60,7 @@ log = logging.getLogger(__name__)
 MAV_COMP_ID_MISSIONPLANNER = 190
 RETRY_US = 250_000  # MAVLINK_MISSION_RETRY_TIMEOUT_DEFAULT
 TIMEOUT_US = 5_000_000  # MAVLINK_MISSION_PROTOCOL_TIMEOUT_DEFAULT
+REPEAT_US = 1_000_000  # the slow rate limiter of MavlinkMissionManager::send
 IDLE, GETLIST, SENDLIST = "idle", "getlist", "sendlist"
 
 
@@ -84,6 +85,8 @@ class MissionProtocol:
         self._recv_us = 0
         self._seen: tuple[int, bool] | None = None  # (current item, finished) last reported
         self._seen_reached = -1
+        self._reached_repeats = 0  # PX4 sends the last MISSION_ITEM_REACHED again with each 1 Hz report, 10 times
+        self._next_repeat_us = 0
         self._handlers: dict[str, Callable[[Any, LinkContext], None]] = {
             "MISSION_REQUEST_LIST": self._on_request_list, "MISSION_COUNT": self._on_count,
             "MISSION_CLEAR_ALL": self._on_clear_all, "MISSION_ITEM": self._on_item,
@@ -129,8 +132,14 @@ class MissionProtocol:
                 ctx.send(ctx.mav.mission_current_encode(*fields))
         if store.seq_reached != self._seen_reached:
             self._seen_reached = store.seq_reached
+            self._reached_repeats = 0
             if store.count(PLAN_MISSION) > 0 and store.seq_reached >= 0:
                 ctx.send(ctx.mav.mission_item_reached_encode(store.seq_reached))
+                self._reached_repeats, self._next_repeat_us = 10, ctx.now_us + REPEAT_US
+        elif self._reached_repeats and ctx.now_us >= self._next_repeat_us and store.count(PLAN_MISSION) > 0:
+            ctx.send(ctx.mav.mission_item_reached_encode(self._seen_reached))
+            self._reached_repeats -= 1
+            self._next_repeat_us = ctx.now_us + REPEAT_US
 
     # ---- upload ---------------------------------------------------------------------------------------------------
     def _on_count(self, msg: Any, ctx: LinkContext) -> None:

@@ -55,7 +55,7 @@ class Observed:
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
     texts: list[str] = field(default_factory=list)
     mission: list[Any] = field(default_factory=list)  # mission protocol answers (testing/mission_client.py)
-    reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED seqs, in arrival order
+    reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED seqs as they change
     mission_current: Any = None  # the last MISSION_CURRENT
 
 
@@ -126,8 +126,8 @@ class FlightClient:
             self.seen.texts.append(msg.text)
         elif kind in ("MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT"):
             self.seen.mission.append(msg)
-        elif kind == "MISSION_ITEM_REACHED":
-            self.seen.reached.append(msg.seq)
+        elif kind == "MISSION_ITEM_REACHED" and (not self.seen.reached or self.seen.reached[-1] != msg.seq):
+            self.seen.reached.append(msg.seq)  # PX4 repeats the last one (1 Hz, 10 times): kept once
         elif kind == "MISSION_CURRENT":
             self.seen.mission_current = msg
 

@@ -119,7 +119,8 @@ def test_mission_set_current_while_flying_turns_to_that_item() -> None:
     f.start()
     f.run_until(lambda: f.store.current_seq == 1)
     f.v.run_for(2.0)
-    assert f.store.set_current(3)  # what MISSION_SET_CURRENT does
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 7, 0) == MavResult.FAILED  # no item 7
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 3, 0) == MavResult.ACCEPTED  # as MISSION_SET_CURRENT 3
     f.run_until(lambda: f.store.finished)
     assert f.currents == [0, 1, 3] and [s for s, _ in f.reached] == [0, 3]
 

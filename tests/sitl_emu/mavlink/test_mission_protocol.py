@@ -328,3 +328,22 @@ def test_the_largest_mission_is_stored_and_one_more_item_is_no_space(setup):
         proto.handle(wp, ctx)
     assert [m.type for m in ctx.take()] == [MAV_MISSION_ACCEPTED]
     assert ctx.vehicle.mission_store().count(0) == limit == 10_000
+
+
+def test_progress_current_on_change_and_reached_repeated_ten_times(setup):
+    """MavlinkMissionManager::send: MISSION_CURRENT when the navigator's current item changes, MISSION_ITEM_REACHED
+    at once and then again once a second, 10 times."""
+    proto, ctx, client = setup
+    upload(proto, ctx, client, [item(client, 0), item(client, 1)])
+    proto.tick(ctx)
+    ctx.take()
+    store = ctx.vehicle.mission_store()
+    store.current_seq, store.seq_reached = 1, 0
+    proto.tick(ctx)
+    assert [(m.get_type(), m.seq) for m in ctx.take()] == [("MISSION_CURRENT", 1), ("MISSION_ITEM_REACHED", 0)]
+    later = []
+    for _ in range(15 * 250):
+        ctx.advance(4000)
+        proto.tick(ctx)
+        later += [(m.get_type(), m.seq) for m in ctx.take()]
+    assert later == [("MISSION_ITEM_REACHED", 0)] * 10
