@@ -96,6 +96,7 @@ class MavCmd(IntEnum):
     DO_FLIGHTTERMINATION = 185
     DO_CHANGE_ALTITUDE = 186
     DO_REPOSITION = 192
+    DO_SET_MISSION_CURRENT = 224  # the navigator answers it (navigator_main.cpp)
     PREFLIGHT_CALIBRATION = 241
     PREFLIGHT_REBOOT_SHUTDOWN = 246
     MISSION_START = 300

@@ -4,6 +4,7 @@ What each command sends and prints follows PX4 (v1.15):
 - `commander ...`: src/modules/commander/Commander.cpp custom_command(): every subcommand publishes an internal
   vehicle_command (from_external false, source = own sysid/compid); results appear later as log lines (events).
 - `param ...`: sitl_emu/shell_param.py (src/systemcmds/param/param.cpp).
+- `mission`: sitl_emu/shell_mission.py (our addition: the stored plans and the mission's progress).
 - `listener ...`: src/systemcmds/topic_listener/listener_main.cpp (see sitl_emu/listener.py). With -n N the messages
   come one by one as the topic is published, so the command keeps running after `execute` returns: the caller prints
   `poll()`'s output each loop and shows the next prompt once `busy` is False, as pxh does when the command returns.
@@ -21,6 +22,7 @@ from typing import Any
 from sitl_emu import listener
 from sitl_emu.px4 import SHELL_MODE_NAMES, UI_NAMES, MavCmd, MavResult, NavState, main_sub
 from sitl_emu.shell_failure import failure_command
+from sitl_emu.shell_mission import mission_command
 from sitl_emu.shell_param import log_line, param_command
 from sitl_emu.types import VehicleCommand
 
@@ -65,6 +67,7 @@ class Shell:
             "commander": self._commander,
             "failure": lambda args: failure_command(self.vehicle, args),
             "listener": self._listener,
+            "mission": self._mission,
             "param": self._param,
             "shutdown": self._shutdown,
             "ver": self._ver,
@@ -202,6 +205,9 @@ class Shell:
     # --- param -------------------------------------------------------------------------------------------------
     def _param(self, args: list[str]) -> tuple[int, str]:
         return param_command(self.vehicle.params, args, int(self.vehicle.sysid))
+
+    def _mission(self, args: list[str]) -> tuple[int, str]:
+        return mission_command(self.vehicle.mission_store(), self.vehicle.snapshot().nav_state, args)
 
     # --- system ------------------------------------------------------------------------------------------------
     def _shutdown(self, args: list[str]) -> tuple[int, str]:

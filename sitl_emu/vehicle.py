@@ -10,7 +10,7 @@ Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (400
     estimate (wind, noise, failures, battery and link watchdog: vehicle_faults.py, once per commander cycle too);
  6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
     "Landing detected");
- 7. events: the task's messages join the event stream.
+ 7. events: the task's messages join the event stream; a mission's RTL item asks the commander for Return.
 Commands (handle_command) and offboard inputs (offboard_input) act at once between steps, as PX4's commander acts
 on a command in its next cycle (~10 ms, reference 11.6). Nothing here reads the wall clock.
 """
@@ -106,6 +106,8 @@ class Vehicle:
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
         self._fence = FenceChecks(self.params)  # the navigator's geofence check (vehicle_fence.py)
         self.chain.executor.rtl_destination = self._rtl_destination
+        self.commander.mission_store = self._missions
+        self.chain.executor.attach_missions(self._missions)
 
     # ---- time ---------------------------------------------------------------------------------------------------
     @property
@@ -150,6 +152,9 @@ class Vehicle:
         if out.messages:  # the task said something this tick
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)
+        if c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL:
+            # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
+            handle_command(c, VehicleCommand(MavCmd.NAV_RETURN_TO_LAUNCH, from_external=False), now)
 
     def run_until(self, time_us: int) -> None:
         """Step until time_us is reached (no-op if already there)."""

@@ -19,6 +19,7 @@ from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
 from sitl_emu.flight.fault_failsafes import FaultFlags, FaultSettings
 from sitl_emu.flight.geofence import NO_BREACH, GeofenceResult
 from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
+from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.mode_intention import ModeIntention
 from sitl_emu.flight.offboard import OffboardSignal
 from sitl_emu.flight.stick_gestures import Gesture, GestureDetector, StickMotion
@@ -130,6 +131,7 @@ class Commander:
         self._last_reject_text_us: int | None = None
         self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle_faults.py)
         self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (flight/geofence_monitor.py)
+        self.mission_store: MissionStore | None = None  # the stored plans (the Vehicle's), for AUTO.MISSION's checks
 
     @property
     def settings(self) -> CommanderSettings:
@@ -219,7 +221,7 @@ class Commander:
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
                                   offboard_signal=self._offboard_available(t),
                                   manual_control=self.manual_control_valid(t),
-                                  position_lost=self.fault_flags.position_lost)
+                                  mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost)
 
     def _offboard_available(self, now_us: int) -> bool:
         """offboardCheck.cpp: a fresh signal, and for position or velocity setpoints a local position and velocity."""
@@ -227,6 +229,11 @@ class Commander:
             return False
         mode = self._offboard.mode
         return not (self.fault_flags.position_lost and mode is not None and (mode.position or mode.velocity))
+
+    @property
+    def mission_valid(self) -> bool:
+        """failsafe_flags.auto_mission_missing inverted: a valid mission is stored."""
+        return self.mission_store is not None and self.mission_store.mission_valid
 
     def can_run(self, nav_state: NavState) -> bool:
         return arming.can_run(nav_state, self.check_inputs())

@@ -172,8 +172,34 @@ def _set_home(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 
 
 def _mission_start(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
-    c.say(Severity.CRITICAL, "Mission start denied! No valid mission")
-    return _ack(cmd, MavResult.DENIED)
+    """Commander.cpp MISSION_START: a valid mission and a first item in -1..count-1 -> AUTO.MISSION and arm; the
+    navigator then starts at param1 (navigator_main.cpp: when >= 0)."""
+    store = c.mission_store
+    if store is None or not c.mission_valid:
+        c.say(Severity.CRITICAL, "Mission start denied! No valid mission")
+        return _ack(cmd, MavResult.DENIED)
+    first = cmd.param(1)
+    if not (isfinite(first) and -1 <= first < store.count(0)):
+        return _ack(cmd, MavResult.DENIED)
+    if not (c.change_mode(NavState.AUTO_MISSION) and c.arm(now_us, external=cmd.from_external, run_checks=True,
+                                                           reason="mission start")):
+        c.reject_mode_text(NavState.AUTO_MISSION, now_us)
+        return _ack(cmd, MavResult.TEMPORARILY_REJECTED)
+    if first >= 0:
+        store.set_current(int(first))
+    return _ack(cmd, MavResult.ACCEPTED)
+
+
+def _set_mission_current(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
+    """navigator_main.cpp DO_SET_MISSION_CURRENT: param1 the item (-1: keep), param2 0/1 (reset the jump counters:
+    not emulated); FAILED out of range or without a mission."""
+    p1, p2 = cmd.param(1), cmd.param(2)
+    if not (isfinite(p1) and p1 >= -1 and isfinite(p2) and p2 in (0.0, 1.0)):
+        return _ack(cmd, MavResult.DENIED)
+    store = c.mission_store
+    if store is None or not c.mission_valid or not (int(p1) == -1 or store.set_current(int(p1))):
+        return _ack(cmd, MavResult.FAILED)
+    return _ack(cmd, MavResult.ACCEPTED)
 
 
 def _termination(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
@@ -218,6 +244,7 @@ _HANDLERS: dict[int, _Handler] = {
     MavCmd.DO_REPOSITION: _reposition,
     MavCmd.DO_SET_HOME: _set_home,
     MavCmd.MISSION_START: _mission_start,
+    MavCmd.DO_SET_MISSION_CURRENT: _set_mission_current,
     MavCmd.DO_FLIGHTTERMINATION: _termination,
     MavCmd.DO_CHANGE_ALTITUDE: _change_altitude,
     MavCmd.PREFLIGHT_CALIBRATION: _calibration,

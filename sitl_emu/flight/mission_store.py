@@ -34,6 +34,9 @@ MAX_ITEMS = {PLAN_MISSION: 10_000, PLAN_FENCE: 64, PLAN_RALLY: 32}
 # MISSION_STATE (common.xml), what MISSION_CURRENT reports for the stored mission
 MISSION_STATE_NO_MISSION = 1
 MISSION_STATE_NOT_STARTED = 2
+MISSION_STATE_ACTIVE = 3
+MISSION_STATE_PAUSED = 4
+MISSION_STATE_COMPLETE = 5
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,6 +92,10 @@ class MissionStore:
     current_seq: int = 0
     transfer_owner: object | None = None  # the link (protocol handler) whose upload is running
     uploads: int = 0  # completed mission uploads (PX4 looks MIS_DIST_1WP etc. up from the first one)
+    # the navigator's mission_result (flight/tasks_mission.py publishes it): the last item reached, the end
+    seq_reached: int = -1
+    finished: bool = False
+    current_changes: int = 0  # MISSION_SET_CURRENT / MISSION_START requests, for the navigator to follow
 
     def plan(self, plan_type: int) -> Plan:
         return self.plans[plan_type]
@@ -103,6 +110,7 @@ class MissionStore:
         self.plans[plan_type] = plan
         if plan_type == PLAN_MISSION:
             self.current_seq = max(current_seq, 0)
+            self.seq_reached, self.finished = -1, False
         return plan
 
     def clear(self, plan_type: int) -> None:
@@ -114,6 +122,7 @@ class MissionStore:
         if not 0 <= seq < self.count(PLAN_MISSION):
             return False
         self.current_seq = seq
+        self.current_changes += 1
         return True
 
     def try_lock(self, owner: object) -> bool:
@@ -126,7 +135,21 @@ class MissionStore:
         if self.transfer_owner is owner:
             self.transfer_owner = None
 
-    def mission_state(self) -> int:
-        """MISSION_CURRENT.mission_state for a mission that is stored but not flown (the flying slice adds ACTIVE,
-        PAUSED and COMPLETE from the navigator's mission_result)."""
-        return MISSION_STATE_NOT_STARTED if self.count(PLAN_MISSION) else MISSION_STATE_NO_MISSION
+    @property
+    def mission_valid(self) -> bool:
+        """mission_result.valid: PX4 main's feasibility checks refuse none of the reference's plans (a first waypoint
+        beyond MIS_DIST_1WP still flies), so any stored mission is valid here."""
+        return self.count(PLAN_MISSION) > 0
+
+    def mission_state(self, mode_active: bool = False) -> int:
+        """MISSION_CURRENT.mission_state (mavlink_mission.cpp update_mission_state): COMPLETE once the navigator
+        finished it, ACTIVE in a mode that flies it, PAUSED outside one after an item was reached."""
+        if not self.count(PLAN_MISSION):
+            return MISSION_STATE_NO_MISSION
+        if self.finished:
+            return MISSION_STATE_COMPLETE
+        if mode_active:
+            return MISSION_STATE_ACTIVE
+        if self.seq_reached >= 0:
+            return MISSION_STATE_PAUSED
+        return MISSION_STATE_NOT_STARTED

@@ -22,16 +22,19 @@ from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.manual_control import CENTRED
+from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.stabilized import StabilizedMode
 from sitl_emu.flight.tasks import SetpointType
 from sitl_emu.flight.tasks_manual import ManualAltitudeTask, ManualPositionTask
+from sitl_emu.flight.tasks_mission import MissionFlight, MissionTask
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import AttitudeSetpoint, ManualControlSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
 
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
-                         NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL})
+                         NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
+                         NavState.AUTO_MISSION})
 _STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
 FlightTask = tasks.Task | ManualAltitudeTask
 
@@ -78,6 +81,18 @@ class ModeExecutor:
         self._last_us = 0  # when the task last ran
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[tasks.NavInput], tuple[Vec3, float] | None] | None = None
+        self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
+
+    def attach_missions(self, store: MissionStore) -> None:
+        """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
+        self.missions = MissionFlight(store)
+
+    def take_mode_request(self) -> NavState | None:
+        """A mode the running task asks the commander for (the mission's RTL item: Return), once."""
+        task = self.task
+        if isinstance(task, MissionTask) and task.wants_rtl:
+            return NavState.AUTO_RTL
+        return None
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -183,13 +198,29 @@ class ModeExecutor:
         elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
-            self.task = tasks.make_rtl(nav, self.params, self.rtl_destination(nav) if self.rtl_destination else None)
+            destination = self.rtl_destination(nav) if self.rtl_destination else None
+            self.task = tasks.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
+        elif nav_state is NavState.AUTO_MISSION:
+            self.task = self._make_mission(nav, ref)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
             self.task = ManualPositionTask(nav, self.params)
         elif nav_state is NavState.ALTCTL:
             self.task = ManualAltitudeTask(nav, self.params)
         else:
             self.task = tasks.make_land(nav, self.params)
+
+    def _mission_loiter(self, nav: tasks.NavInput) -> Vec3 | None:
+        """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus
+        NAV_LOITER_RAD: navigator_main.cpp is_established_on_loiter), for RTL's climb."""
+        task = self.task
+        if not isinstance(task, MissionTask):
+            return None
+        return task.loiter_point(nav)
+
+    def _make_mission(self, nav: tasks.NavInput, ref: GeoRef) -> tasks.Task:
+        if self.missions is None:
+            self.missions = MissionFlight(MissionStore())
+        return MissionTask(nav, self.params, self.missions, ref, ref.alt_amsl_m - nav.home_ned_m[2])
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None

@@ -3,14 +3,21 @@
 Written from the behaviour of PX4's `src/lib/motion_planning/VelocitySmoothing.cpp` (one axis: constant-jerk
 segments T1 (jerk up), T2 (constant acceleration), T3 (jerk down) that bring the velocity to a target),
 `PositionSmoothing.cpp` (a velocity target per axis derived from the distance to a waypoint, the time stretch that
-waits for a lagging vehicle) and `src/lib/mathlib/math/TrajMath.hpp` (speed from braking distance).
-Only the single-waypoint case the navigator tasks use is implemented (no L1 turns between waypoints).
+waits for a lagging vehicle), `src/lib/mathlib/math/TrajMath.hpp` (speed from braking distance, speed allowed in a
+turn) and `src/lib/motion_planning/TrajectoryConstraints.hpp` (the speed allowed at a waypoint from the angle to the
+next leg).
+
+Two entries: `update` flies to one waypoint (Hold, Takeoff, Land, RTL, reposition: PX4 passes previous = current =
+next there, which reduces its path case to this), `update_path` flies a mission leg with the previous and next
+waypoints: the speed at the waypoint is limited by the turn to the next leg, and while the trajectory turns it is
+pulled towards an L1-like crossing point on the line from the previous waypoint (PositionSmoothing::_getL1Point).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.control.qmath import constrain, isfinite
@@ -34,6 +41,51 @@ def braking_distance(speed: float, jerk: float, accel: float, accel_delay_max: f
 
 def _sign(x: float) -> int:
     return (x > 0.0) - (x < 0.0)
+
+
+def speed_in_turn(alpha: float, accel: float, radius: float) -> float:
+    """Speed at a waypoint whose legs meet at angle `alpha` (pi: straight on), turning on a circle tangent to both
+    legs at the acceptance radius (TrajMath.hpp computeMaxSpeedInWaypoint)."""
+    return math.sqrt(accel * radius * math.tan(alpha / 2.0))
+
+
+def _angle(a: tuple[float, float], b: tuple[float, float]) -> float:
+    """The angle between two 2D vectors (a zero vector counts as orthogonal, as unit_or_zero makes it)."""
+    na, nb = math.hypot(*a), math.hypot(*b)
+    if na <= _EPS or nb <= _EPS:
+        return math.pi / 2.0
+    return math.acos(max(-1.0, min(1.0, (a[0] * b[0] + a[1] * b[1]) / (na * nb))))
+
+
+@dataclass(frozen=True, slots=True)
+class _Limits:
+    """TrajectoryConstraints' VehicleDynamicLimits (the horizontal part)."""
+
+    accept_xy: float
+    accel: float
+    jerk: float
+    cruise: float
+    gain: float  # MPC_XY_TRAJ_P: the share of the acceleration used in turns
+
+
+def _start_speed(start: Vec3, target: Vec3, following: Vec3, exit_speed: float, lim: _Limits) -> float:
+    """Fastest speed at `start` that still makes the turn at `target` towards `following`
+    (TrajectoryConstraints.hpp computeStartXYSpeedFromWaypoints)."""
+    leg_next = math.hypot(target[0] - following[0], target[1] - following[1])
+    at_target = 0.0
+    if leg_next > 0.001 and leg_next >= lim.accept_xy:  # different points, the next outside the acceptance radius
+        alpha = _angle((target[0] - start[0], target[1] - start[1]),
+                       (target[0] - following[0], target[1] - following[1]))
+        turn = speed_in_turn(min(max(alpha, 0.0), math.pi - _EPS), lim.gain * lim.accel, lim.accept_xy)
+        at_target = min(turn, exit_speed, lim.cruise)
+    dist = math.hypot(start[0] - target[0], start[1] - target[1])
+    return min(lim.cruise, max_speed_from_distance(lim.jerk, lim.accel, dist, at_target))
+
+
+def xy_speed_through(pos: Vec3, target: Vec3, following: Vec3, lim: _Limits) -> float:
+    """computeXYSpeedFromWaypoints over (pos, target, following): backwards from a stop at `following`."""
+    exit_speed = _start_speed(target, following, following, 0.0, lim)
+    return _start_speed(pos, target, following, exit_speed, lim)
 
 
 def _evaluate_poly(j: float, a0: float, v0: float, x0: float, t: float) -> tuple[float, float, float, float]:
@@ -206,6 +258,11 @@ class PositionSmoother:
         self.cruise_speed_m_s = 5.0
         self.max_xy_error_m = 2.0
         self.max_z_error_m = 0.0  # 0 disables the vertical time stretch
+        # path flying (update_path): the waypoint's acceptance radii and MPC_XY_TRAJ_P
+        self.acceptance_xy_m = 0.0
+        self.acceptance_z_m = 0.0
+        self.traj_gain = 0.5
+        self._max_speed_previous = 0.0
 
     def reset(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
         for i, axis in enumerate(self.axes):
@@ -224,6 +281,75 @@ class PositionSmoother:
         if isfinite(vel_sp[0]) and isfinite(vel_sp[1]) and isfinite(vel_sp[2]):
             self._advance(vehicle_pos, vel_sp, dt_s)
         return vel_sp
+
+    def update_path(self, vehicle_pos: Vec3, previous: Vec3, target: Vec3, following: Vec3, dt_s: float) -> Vec3:
+        """One cycle along a path (all three waypoints finite; `following` = `target` when there is no next one).
+        Returns the unsmoothed velocity target (PositionSmoothing::_generateVelocitySetpoint, 3D case)."""
+        pos = self.position
+        turning = self._is_turning(target)
+        crossing = self._l1_point(previous, target) if turning else target
+        xy_speed = xy_speed_through(pos, target, following, self._limits())
+        if turning:
+            xy_speed = min(self._max_speed_previous, xy_speed)  # hold the speed through a turn
+        else:
+            self._max_speed_previous = xy_speed
+        dx, dy = crossing[0] - pos[0], crossing[1] - pos[1]
+        dist = math.hypot(dx, dy)
+        ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
+        vel_sp = (ux * xy_speed, uy * xy_speed, _sign(crossing[2] - pos[2]) * self._z_speed(pos, target, following))
+        self._advance(vehicle_pos, vel_sp, dt_s)
+        return vel_sp
+
+    @property
+    def position(self) -> Vec3:
+        ax, ay, az = self.axes
+        return (ax.x, ay.x, az.x)
+
+    def _limits(self) -> _Limits:
+        ax = self.axes[0]
+        return _Limits(self.acceptance_xy_m, ax.max_accel, ax.max_jerk, self.cruise_speed_m_s, self.traj_gain)
+
+    def _is_turning(self, target: Vec3) -> bool:
+        """The trajectory moves (> 0.2 m/s) more than ~10 degrees away from the target, outside its acceptance
+        radius (PositionSmoothing::_isTurning)."""
+        ax, ay = self.axes[0], self.axes[1]
+        speed = math.hypot(ax.v, ay.v)
+        tx, ty = target[0] - ax.x, target[1] - ay.x
+        dist = math.hypot(tx, ty)
+        if speed <= 0.2 or dist <= self.acceptance_xy_m:
+            return False
+        cos_align = (ax.v * tx + ay.v * ty) / (speed * dist) if dist > 0.0 else 0.0
+        return cos_align < 0.98
+
+    def _l1_point(self, previous: Vec3, target: Vec3) -> Vec3:
+        """Where a circle of radius max(acceptance, 5 m) around the trajectory meets the line previous -> target,
+        ahead of the closest point (PositionSmoothing::_getL1Point)."""
+        pos = self.position
+        leg = (target[0] - previous[0], target[1] - previous[1], target[2] - previous[2])
+        length = math.sqrt(leg[0] ** 2 + leg[1] ** 2 + leg[2] ** 2)
+        u = (leg[0] / length, leg[1] / length, leg[2] / length) if length > 1e-6 else (0.0, 0.0, 0.0)
+        along = sum((pos[i] - previous[i]) * u[i] for i in range(3))
+        closest = tuple(previous[i] + u[i] * along for i in range(3))
+        cross = math.sqrt(sum((closest[i] - pos[i]) ** 2 for i in range(3)))
+        l1 = max(self.acceptance_xy_m, 5.0)
+        ahead = math.sqrt(l1 * l1 - cross * cross) if l1 > cross else 0.0
+        return (closest[0] + ahead * u[0], closest[1] + ahead * u[1], closest[2] + ahead * u[2])
+
+    def _z_speed(self, pos: Vec3, target: Vec3, following: Vec3) -> float:
+        """PositionSmoothing::_getMaxZSpeed: arrive at the target's altitude at the speed the vertical turn allows
+        (0 when the next leg is level)."""
+        az = self.axes[2]
+        arrival = 0.0
+        if abs(target[2] - following[2]) > 0.001:
+            # PX4 pairs each point's horizontal distance from the origin with its altitude
+            start = (math.hypot(pos[0], pos[1]), pos[2])
+            tgt = (math.hypot(target[0], target[1]), target[2])
+            nxt = (math.hypot(following[0], following[1]), following[2])
+            alpha = _angle((tgt[0] - start[0], tgt[1] - start[1]), (tgt[0] - nxt[0], tgt[1] - nxt[1]))
+            turn = speed_in_turn(min(max(alpha, 0.0), math.pi - _EPS), az.max_accel, self.acceptance_z_m)
+            arrival = min(turn, az.max_vel)
+        reach = max_speed_from_distance(az.max_jerk, az.max_accel, abs(target[2] - pos[2]), arrival)
+        return min(az.max_vel, reach)
 
     def _velocity_target(self, target: Vec3, ff: Vec3) -> Vec3:
         out0, out1, out2 = ff

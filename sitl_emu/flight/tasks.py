@@ -150,10 +150,12 @@ def make_land(nav: NavInput, params: ParamRegistry) -> Task:
     return LandTask(nav, params)
 
 
-def make_rtl(nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None) -> Task:
+def make_rtl(nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
+             loiter_at_ned_m: Vec3 | None = None) -> Task:
     """Return: climb to the return altitude, fly home (or to `destination`: NED position and yaw, a rally point
-    flight/rally.py chose) at MPC_XY_CRUISE, land (RTL_LAND_DELAY: wait first)."""
-    return RtlTask(nav, params, destination)
+    flight/rally.py chose) at MPC_XY_CRUISE, land (RTL_LAND_DELAY: wait first); `loiter_at_ned_m`: climb there (the
+    loiter a finished mission left)."""
+    return RtlTask(nav, params, destination, loiter_at_ned_m)
 
 
 def make_reposition(nav: NavInput, params: ParamRegistry, target_ned_m: Vec3, yaw_rad: float,

@@ -116,6 +116,7 @@ class AutoSettings:
     rtl_land_delay: float
     rtl_min_dist: float
     rtl_cone_ang: float
+    xy_traj_p: float
 
     @classmethod
     def from_params(cls, params: ParamRegistry) -> AutoSettings:
@@ -138,6 +139,7 @@ _PARAM_NAMES: dict[str, tuple[str, float]] = {
     "takeoff_alt": ("MIS_TAKEOFF_ALT", 2.5), "rtl_return_alt": ("RTL_RETURN_ALT", 30.0),
     "rtl_descend_alt": ("RTL_DESCEND_ALT", 10.0), "rtl_land_delay": ("RTL_LAND_DELAY", 0.0),
     "rtl_min_dist": ("RTL_MIN_DIST", 10.0), "rtl_cone_ang": ("RTL_CONE_ANG", 45),
+    "xy_traj_p": ("MPC_XY_TRAJ_P", 0.5),
 }
 
 
@@ -151,12 +153,18 @@ def wrap_pi(angle: float) -> float:
 
 @dataclass(frozen=True, slots=True)
 class Waypoint:
-    """One navigator position setpoint (kind IDLE, TAKEOFF, POSITION or LAND); NaN = not given."""
+    """One navigator position setpoint (kind IDLE, TAKEOFF, POSITION or LAND); NaN = not given.
+
+    A mission leg also gives the triplet's previous and next waypoints (None: a single waypoint, as every other
+    task flies) and the setpoint's acceptance radius (NaN: NAV_ACC_RAD)."""
 
     kind: SetpointType
     target_ned_m: Vec3
     yaw_rad: float = NAN
     cruise_m_s: float = NAN
+    previous_ned_m: Vec3 | None = None
+    next_ned_m: Vec3 | None = None
+    acceptance_m: float = NAN
 
 
 class AutoCore:
@@ -181,7 +189,10 @@ class AutoCore:
         target, ff = wp.target_ned_m, _NO_FEEDFORWARD
         if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
-        vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
+        if wp.next_ned_m is not None and kind is SetpointType.POSITION:
+            vz = self._unsmoothed_vz = self._path_step(nav, wp, dt_s)
+        else:
+            vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
         yaw, yawspeed = self._limit_yaw_rate(nav, self._yaw_target(nav, wp), dt_s)
         self._kind_prev = kind
@@ -190,6 +201,19 @@ class AutoCore:
         if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
             out = self._hold_before_ramp(nav, out)
         return out
+
+    def _path_step(self, nav: NavInput, wp: Waypoint, dt_s: float) -> float:
+        """A mission leg: previous -> target -> next (FlightTaskAuto passes the triplet to PositionSmoothing)."""
+        sm, target = self.smoother, wp.target_ned_m
+        sm.acceptance_xy_m = self._acceptance(wp)
+        sm.acceptance_z_m = self.s.nav_mc_alt_rad
+        sm.traj_gain = self.s.xy_traj_p
+        previous = wp.previous_ned_m if wp.previous_ned_m is not None else target
+        following = wp.next_ned_m if wp.next_ned_m is not None else target
+        return sm.update_path(nav.pos_ned_m, previous, target, following, dt_s)[2]
+
+    def _acceptance(self, wp: Waypoint) -> float:
+        return wp.acceptance_m if isfinite(wp.acceptance_m) else self.s.nav_acc_rad
 
     def _idle(self, nav: NavInput) -> TrajectorySetpoint:
         self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), nav.pos_ned_m)
@@ -248,7 +272,7 @@ class AutoCore:
         # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
         dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
         dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
-        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self.s.nav_acc_rad:
+        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self._acceptance(wp):
             self._yaw_lock = math.atan2(dy, dx)
         if self._yaw_lock is None:
             self._yaw_lock = nav.yaw_rad

@@ -48,9 +48,15 @@ def _f32(x: float) -> float:
 
 
 class RtlTask(Task):
-    def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None) -> None:
+    def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
+                 loiter_at_ned_m: Vec3 | None = None) -> None:
+        """`destination`: where to return (rtl.cpp findRtlDestination: home, or a rally point chosen by
+        flight/rally.py), NED position and yaw. `loiter_at_ned_m`: the loiter the vehicle was established on when RTL
+        began (a finished mission's last setpoint): the climb keeps its centre (rtl_direct.cpp CLIMBING,
+        is_established_on_loiter); else the climb is centred where the vehicle is."""
         super().__init__(nav, params)
-        # the destination (rtl.cpp findRtlDestination: home, or a rally point chosen by flight/rally.py)
+        self._loiter_at = loiter_at_ned_m
+        self._yaw_err_rad = math.radians(float(params.get("MIS_YAW_ERR")) if "MIS_YAW_ERR" in params else 12.0)
         self._home: Vec3 = nav.home_ned_m if destination is None else destination[0]
         self._home_yaw = nav.home_yaw_rad if destination is None else destination[1]
         self._rtl_up_m = self._return_altitude_up(nav)
@@ -95,7 +101,8 @@ class RtlTask(Task):
         self._state = state
         s = self._settings
         if state is RtlState.CLIMB:
-            self._climb_xy = (nav.pos_ned_m[0], nav.pos_ned_m[1])
+            at = self._loiter_at if self._loiter_at is not None else nav.pos_ned_m
+            self._climb_xy = (at[0], at[1])
             self._climb_yaw = nav.yaw_rad
         elif state is RtlState.RETURN:
             self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN
@@ -105,6 +112,14 @@ class RtlTask(Task):
                 self._say(Severity.INFO, "RTL: completed, loitering")
         elif state is RtlState.LAND:
             self._say(Severity.INFO, "RTL: land at destination")
+
+    def _heading_reached(self, nav: NavInput) -> bool:
+        """mission_block.cpp: an item with a heading (the return leg near home faces home's heading) is reached only
+        once the heading is within MIS_YAW_ERR (MIS_YAW_TMT -1: no timeout)."""
+        if not math.isfinite(self._return_yaw):
+            return True
+        err = (self._return_yaw - nav.yaw_rad + math.pi) % math.tau - math.pi
+        return abs(err) < self._yaw_err_rad
 
     def _loiter_up_m(self) -> float:
         return min(-self._home[2] + self._settings.rtl_descend_alt, self._rtl_up_m)
@@ -135,7 +150,8 @@ class RtlTask(Task):
         st = self._state
         if st is RtlState.CLIMB and up >= self._rtl_up_m - s.nav_mc_alt_rad:
             self._enter(RtlState.RETURN, nav)
-        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad:
+        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad \
+                and self._heading_reached(nav):
             self._enter(RtlState.LAND if s.rtl_land_delay == 0.0 else RtlState.DESCEND, nav)
         elif st is RtlState.DESCEND and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
             self._enter(RtlState.HOLD, nav)

@@ -146,7 +146,8 @@ def item_message(mav: MAVLink, target: tuple[int, int], item: MissionItem, curre
 
 def mission_current_fields(store: MissionStore, nav_state: NavState) -> tuple[int, int, int, int]:
     """MISSION_CURRENT (seq, total, mission_state, mission_mode) as send_mission_current fills it: total UINT16_MAX
-    with no mission; a stored mission not yet flown is NOT_STARTED; mode 1 only in Mission, Takeoff or Land."""
+    with no mission; the state from the navigator's result (mission_store.mission_state); mode 1 (active) only in
+    Mission, Takeoff or Land, else 2 (suspended)."""
     count = store.count(PLAN_MISSION)
-    mode = 1 if nav_state in _MISSION_MODE_NAV_STATES else 2
-    return store.current_seq, count if count > 0 else UINT16_MAX, store.mission_state(), mode
+    active = nav_state in _MISSION_MODE_NAV_STATES
+    return store.current_seq, count if count > 0 else UINT16_MAX, store.mission_state(active), 1 if active else 2

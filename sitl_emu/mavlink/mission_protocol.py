@@ -60,6 +60,7 @@ log = logging.getLogger(__name__)
 MAV_COMP_ID_MISSIONPLANNER = 190
 RETRY_US = 250_000  # MAVLINK_MISSION_RETRY_TIMEOUT_DEFAULT
 TIMEOUT_US = 5_000_000  # MAVLINK_MISSION_PROTOCOL_TIMEOUT_DEFAULT
+REPEAT_US = 1_000_000  # the slow rate limiter of MavlinkMissionManager::send
 IDLE, GETLIST, SENDLIST = "idle", "getlist", "sendlist"
 
 
@@ -82,6 +83,10 @@ class MissionProtocol:
         self._marked_current = -1
         self._sent_us = 0
         self._recv_us = 0
+        self._seen: tuple[int, bool] | None = None  # (current item, finished) last reported
+        self._seen_reached = -1
+        self._reached_repeats = 0  # PX4 sends the last MISSION_ITEM_REACHED again with each 1 Hz report, 10 times
+        self._next_repeat_us = 0
         self._handlers: dict[str, Callable[[Any, LinkContext], None]] = {
             "MISSION_REQUEST_LIST": self._on_request_list, "MISSION_COUNT": self._on_count,
             "MISSION_CLEAR_ALL": self._on_clear_all, "MISSION_ITEM": self._on_item,
@@ -99,7 +104,8 @@ class MissionProtocol:
         self._handlers[kind](msg, ctx)
 
     def tick(self, ctx: LinkContext) -> None:
-        """Retries and the protocol timeout (MavlinkMissionManager::send)."""
+        """Mission progress, retries and the protocol timeout (MavlinkMissionManager::send)."""
+        self._report_progress(ctx)
         if self._state == IDLE:
             return
         now = ctx.now_us
@@ -110,6 +116,30 @@ class MissionProtocol:
         elif now - self._recv_us > TIMEOUT_US:
             _say(ctx, "Mission sync timeout")
             self._end(ctx)
+
+    def _report_progress(self, ctx: LinkContext) -> None:
+        """The navigator's mission_result as send() reports it: MISSION_CURRENT at once when the current item or the
+        finished flag changes, MISSION_ITEM_REACHED when another item is reached (only the latest is seen when two
+        are reached between two reads). The once-a-second MISSION_CURRENT is a telemetry stream here."""
+        store = _store(ctx)
+        seen = (store.current_seq, store.finished)
+        if self._seen is None:
+            self._seen = seen
+        elif seen != self._seen:
+            self._seen = seen
+            if store.count(PLAN_MISSION) > 0:
+                fields = mission_current_fields(store, ctx.vehicle.snapshot().nav_state)
+                ctx.send(ctx.mav.mission_current_encode(*fields))
+        if store.seq_reached != self._seen_reached:
+            self._seen_reached = store.seq_reached
+            self._reached_repeats = 0
+            if store.count(PLAN_MISSION) > 0 and store.seq_reached >= 0:
+                ctx.send(ctx.mav.mission_item_reached_encode(store.seq_reached))
+                self._reached_repeats, self._next_repeat_us = 10, ctx.now_us + REPEAT_US
+        elif self._reached_repeats and ctx.now_us >= self._next_repeat_us and store.count(PLAN_MISSION) > 0:
+            ctx.send(ctx.mav.mission_item_reached_encode(self._seen_reached))
+            self._reached_repeats -= 1
+            self._next_repeat_us = ctx.now_us + REPEAT_US
 
     # ---- upload ---------------------------------------------------------------------------------------------------
     def _on_count(self, msg: Any, ctx: LinkContext) -> None:
@@ -294,9 +324,8 @@ class MissionProtocol:
         if not store.set_current(msg.seq):
             _say(ctx, "WPM: WP CURR CMD: Not in list")
             return
-        # the navigator's mission_result changes: every link reports the new current item at once
-        fields = mission_current_fields(store, ctx.vehicle.snapshot().nav_state)
-        ctx.broadcast(ctx.mav.mission_current_encode(*fields))
+        # the navigator's mission_result changes: every link reports the new current item at its next pass
+        # (_report_progress)
 
     # ---- helpers ----------------------------------------------------------------------------------------------------
     def _end(self, ctx: LinkContext) -> None:

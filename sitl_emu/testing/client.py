@@ -54,6 +54,9 @@ class Observed:
     acks: list[tuple[int, int]] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
     texts: list[str] = field(default_factory=list)
+    mission: list[Any] = field(default_factory=list)  # mission protocol answers (testing/mission_client.py)
+    reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED seqs as they change
+    mission_current: Any = None  # the last MISSION_CURRENT
 
 
 class FlightClient:
@@ -121,6 +124,12 @@ class FlightClient:
             self.seen.acks.append((msg.command, msg.result))
         elif kind == "STATUSTEXT":
             self.seen.texts.append(msg.text)
+        elif kind in ("MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT"):
+            self.seen.mission.append(msg)
+        elif kind == "MISSION_ITEM_REACHED" and (not self.seen.reached or self.seen.reached[-1] != msg.seq):
+            self.seen.reached.append(msg.seq)  # PX4 repeats the last one (1 Hz, 10 times): kept once
+        elif kind == "MISSION_CURRENT":
+            self.seen.mission_current = msg
 
     def _on_heartbeat(self, msg: Any) -> None:
         if self.seen.first_heartbeat_s is None:

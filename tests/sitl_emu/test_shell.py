@@ -236,3 +236,29 @@ def test_a_failing_command_reports_instead_of_raising(vehicle):
     vehicle.on_command = boom
     out = Shell(vehicle).execute("commander arm")
     assert out == "ERROR [commander] internal error: vehicle exploded\nCommand 'commander' failed, returned 1.\n"
+
+
+def test_commander_mode_auto_mission_sends_set_mode(vehicle):
+    Shell(vehicle).execute("commander mode auto:mission")
+    cmd = _only_command(vehicle)
+    assert (cmd.command, cmd.param(1), cmd.param(2), cmd.param(3)) == (176, 1.0, 4.0, 4.0)
+
+
+def test_mission_summary(vehicle):
+    from sitl_emu.flight.mission_store import PLAN_MISSION, MissionItem
+
+    shell = Shell(vehicle)
+    assert shell.execute("mission") == ("INFO  [mission] mission: none\n"
+                                        "INFO  [mission] fence: 0 items, rally: 0 points\n")
+    store = vehicle.mission_store()
+    store.replace(PLAN_MISSION, (MissionItem(0, 6, 22, 1, 0, 0, 0, math.nan, 473977430, 85455939, 5.0),
+                                 MissionItem(1, 2, 20, 1, 0, 0, 0, 0, 0, 0, 0.0)))
+    store.current_seq, store.seq_reached = 1, 0
+    assert shell.execute("mission").splitlines() == [
+        "INFO  [mission] mission: 2 items, current 1, state PAUSED, last reached 0",
+        "INFO  [mission]   0 TAKEOFF 47.3977430 8.5455939 5.0 m rel",
+        "INFO  [mission] > 1 RETURN_TO_LAUNCH 0 0",
+        "INFO  [mission] fence: 0 items, rally: 0 points",
+    ]
+    assert "mission" in shell.execute("help")
+    assert shell.execute("mission clear").startswith("Usage: mission")

@@ -265,8 +265,11 @@ def test_unanswered_count_is_repeated_then_times_out(setup):
 def test_set_current(setup):
     proto, ctx, client = setup
     upload(proto, ctx, client, [item(client, 0), item(client, 1)])
+    proto.tick(ctx)
+    ctx.take()
     proto.handle(client.msg("MISSION_SET_CURRENT", 1, 1, 1), ctx)
-    (current,) = ctx.broadcasts
+    proto.tick(ctx)  # the new current item is reported at the link's next pass
+    (current,) = ctx.take("MISSION_CURRENT")
     assert (current.seq, current.total) == (1, 2)
     assert [m.current for m in download(proto, ctx, client)] == [0, 1]
     proto.handle(client.msg("MISSION_SET_CURRENT", 1, 1, 2), ctx)
@@ -325,3 +328,22 @@ def test_the_largest_mission_is_stored_and_one_more_item_is_no_space(setup):
         proto.handle(wp, ctx)
     assert [m.type for m in ctx.take()] == [MAV_MISSION_ACCEPTED]
     assert ctx.vehicle.mission_store().count(0) == limit == 10_000
+
+
+def test_progress_current_on_change_and_reached_repeated_ten_times(setup):
+    """MavlinkMissionManager::send: MISSION_CURRENT when the navigator's current item changes, MISSION_ITEM_REACHED
+    at once and then again once a second, 10 times."""
+    proto, ctx, client = setup
+    upload(proto, ctx, client, [item(client, 0), item(client, 1)])
+    proto.tick(ctx)
+    ctx.take()
+    store = ctx.vehicle.mission_store()
+    store.current_seq, store.seq_reached = 1, 0
+    proto.tick(ctx)
+    assert [(m.get_type(), m.seq) for m in ctx.take()] == [("MISSION_CURRENT", 1), ("MISSION_ITEM_REACHED", 0)]
+    later = []
+    for _ in range(15 * 250):
+        ctx.advance(4000)
+        proto.tick(ctx)
+        later += [(m.get_type(), m.seq) for m in ctx.take()]
+    assert later == [("MISSION_ITEM_REACHED", 0)] * 10

@@ -1,0 +1,210 @@
+"""AUTO.MISSION item by item on a Vehicle (no MAVLink): pausing and resuming, jumping with MISSION_SET_CURRENT, and
+each navigator item PX4 flies (after src/modules/navigator/mission_base.cpp, mission.cpp, mission_block.cpp)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import pytest
+
+from sitl_emu.flight.mission_store import (
+    MISSION_STATE_ACTIVE,
+    MISSION_STATE_COMPLETE,
+    MISSION_STATE_PAUSED,
+    PLAN_MISSION,
+    MissionItem,
+)
+from sitl_emu.geo import ned_to_global
+from sitl_emu.px4 import MavCmd, MavResult, NavState
+from sitl_emu.types import VehicleCommand
+from sitl_emu.vehicle import Vehicle
+
+NAN = math.nan
+WP, LOITER_UNLIM, LOITER_TIME, LAND, TAKEOFF, DELAY = 16, 17, 19, 21, 22, 93
+DO_JUMP, DO_CHANGE_SPEED, ROI_LOCATION, ROI_NONE = 177, 178, 195, 197
+REL, AMSL, MISSION_FRAME = 6, 5, 2
+
+
+class Flight:
+    """A vehicle with a stored mission; records the current item and the items reached, per time."""
+
+    def __init__(self, items: list[tuple[int, float, float, float, tuple[float, ...], int]]) -> None:
+        self.v = Vehicle()
+        self.store = self.v.mission_store()
+        stored = []
+        for seq, (cmd, n, e, alt, params, frame) in enumerate(items):
+            lat, lon, _ = ned_to_global(self.v.ref, (n, e, 0.0))
+            p = (*params, 0.0, 0.0, 0.0, NAN)[:4]
+            x, y = (round(lat * 1e7), round(lon * 1e7)) if frame != MISSION_FRAME else (0, 0)
+            stored.append(MissionItem(seq, frame, cmd, 1, *p, x, y, alt))
+        self.store.replace(PLAN_MISSION, tuple(stored))
+        self.currents: list[int] = []
+        self.reached: list[tuple[int, float]] = []
+        self.texts: list[str] = []
+        self._seen = self.v.last_event_seq
+
+    def command(self, cmd: int, *params: float) -> int:
+        ack = self.v.handle_command(VehicleCommand(cmd, (*params, *([NAN] * (7 - len(params))))))
+        assert ack is not None
+        return ack.result
+
+    def start(self) -> None:
+        self.v.run_for(2.5)
+        assert self.command(MavCmd.COMPONENT_ARM_DISARM, 1, 0) == MavResult.ACCEPTED
+        self.v.run_for(1.0)
+        assert self.command(MavCmd.MISSION_START, 0, 0) == MavResult.ACCEPTED
+
+    def run_until(self, done: Callable[[], bool], timeout_s: float = 60.0) -> float:
+        """Step until done() (asserts it happens); returns the time (s)."""
+        end = self.v.time_us + timeout_s * 1e6
+        while self.v.time_us < end:
+            self.v.step()
+            self._record()
+            if done():
+                return self.v.time_us * 1e-6
+        raise AssertionError(f"not done within {timeout_s} s: currents {self.currents}, reached {self.reached}")
+
+    def _record(self) -> None:
+        if not self.currents or self.currents[-1] != self.store.current_seq:
+            self.currents.append(self.store.current_seq)
+        if self.store.seq_reached >= 0 and (not self.reached or self.reached[-1][0] != self.store.seq_reached):
+            self.reached.append((self.store.seq_reached, self.v.time_us * 1e-6))
+        for e in self.v.events_after(self._seen):
+            self.texts.append(e.text)
+            self._seen = e.seq
+
+    def at(self, n: float, e: float) -> float:
+        p = self.v.snapshot().pos_ned_m
+        return math.hypot(p[0] - n, p[1] - e)
+
+    @property
+    def speed(self) -> float:
+        vel = self.v.snapshot().vel_ned_m_s
+        return math.hypot(vel[0], vel[1])
+
+
+def wp(n: float, e: float, alt: float = 5.0, *params: float, cmd: int = WP, frame: int = REL) -> tuple:
+    return (cmd, n, e, alt, params, frame)
+
+
+def do(cmd: int, *params: float) -> tuple:
+    return (cmd, 0.0, 0.0, 0.0, params, MISSION_FRAME)
+
+
+TAKEOFF_ITEM = wp(0, 0, 5.0, cmd=TAKEOFF)
+
+
+def test_hold_pauses_and_auto_mission_resumes_at_the_current_item() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(25, 0), wp(25, 25), wp(0, 25)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2)
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 3) == MavResult.ACCEPTED  # AUTO.LOITER
+    f.run_until(lambda: f.speed < 0.2, 10.0)
+    assert f.store.mission_state(False) == MISSION_STATE_PAUSED and f.store.current_seq == 2
+    here = f.v.snapshot().pos_ned_m
+    f.v.run_for(2.0)
+    assert f.at(here[0], here[1]) < 0.3  # holds
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 4) == MavResult.ACCEPTED  # AUTO.MISSION again
+    assert f.store.mission_state(True) == MISSION_STATE_ACTIVE
+    f.run_until(lambda: f.store.finished)
+    assert [s for s, _ in f.reached] == [0, 1, 2, 3] and f.texts.count("Executing Mission") == 2
+    f.v.run_for(6.0)  # reached 10 m before (NAV_ACC_RAD); the end loiters at the last waypoint
+    assert f.store.mission_state(True) == MISSION_STATE_COMPLETE and f.at(0, 25) < 1.0
+    assert "Mission finished, loitering" in f.texts
+
+
+def test_mission_set_current_while_flying_turns_to_that_item() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(30, 0), wp(30, 30), wp(0, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1)
+    f.v.run_for(2.0)
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 7, 0) == MavResult.FAILED  # no item 7
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 3, 0) == MavResult.ACCEPTED  # as MISSION_SET_CURRENT 3
+    f.run_until(lambda: f.store.finished)
+    assert f.currents == [0, 1, 3] and [s for s, _ in f.reached] == [0, 3]
+
+
+def test_waypoint_hold_time_and_loiter_time_wait_there() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(8, 0, 5.0, 3.0), wp(0, 0, 5.0, 4.0, cmd=LOITER_TIME), wp(0, 8)])
+    f.start()
+    f.run_until(lambda: f.store.seq_reached == 3)
+    t = dict(f.reached)
+    assert t[1] - t[0] >= 3.0 and 4.0 <= t[2] - t[1] < 9.0
+
+
+def test_loiter_unlimited_is_never_reached() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(10, 0, cmd=LOITER_UNLIM), wp(0, 0)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1)
+    f.v.run_for(15.0)
+    assert f.store.current_seq == 1 and f.at(10, 0) < 0.5 and f.speed < 0.2
+
+
+def test_land_item_flies_there_lands_and_disarms() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(15, 0), wp(15, 10, 0.0, cmd=LAND)])
+    f.start()
+    f.run_until(lambda: not f.v.commander.armed, 90.0)
+    assert f.at(15, 10) < 1.0
+    assert f.texts.index("Landing detected") < f.texts.index("Mission finished, landed") \
+        < f.texts.index("Disarmed by landing")
+
+
+def test_delay_holds_before_the_next_item() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(6, 0), do(DELAY, 5.0), wp(0, 0)])
+    f.start()
+    f.run_until(lambda: f.store.seq_reached == 3)
+    t = dict(f.reached)
+    assert t[2] - t[1] == pytest.approx(5.0, abs=0.1)
+
+
+def test_change_speed_limits_the_cruise_speed() -> None:
+    f = Flight([TAKEOFF_ITEM, do(DO_CHANGE_SPEED, 1, 2.0, -1), wp(40, 0)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2)
+    peak = 0.0
+    while not f.store.finished:
+        f.run_until(lambda: True)
+        peak = max(peak, f.speed)
+    assert 1.8 < peak < 2.2
+
+
+def test_do_jump_repeats_the_items_its_count_says() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(6, 0), wp(6, 6), do(DO_JUMP, 1, 1), wp(0, 6)])
+    f.start()
+    f.run_until(lambda: f.store.finished, 120.0)
+    assert f.currents == [0, 1, 2, 1, 2, 4]
+
+
+def test_roi_location_turns_the_vehicle_towards_it_until_roi_none() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(0, -40, 5.0, cmd=ROI_LOCATION), wp(30, 0), do(ROI_NONE), wp(30, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2)
+    f.v.run_for(4.0)
+    p, yaw = f.v.snapshot().pos_ned_m, f.v.snapshot().euler_rad[2]
+    assert abs(math.remainder(yaw - math.atan2(-40 - p[1], -p[0]), math.tau)) < 0.15
+    f.run_until(lambda: f.store.current_seq == 4)
+    f.v.run_for(4.0)
+    assert abs(math.remainder(f.v.snapshot().euler_rad[2] - math.pi / 2, math.tau)) < 0.15  # faces the waypoint
+
+
+def test_amsl_altitude_frame() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(10, 0, 488.0 + 9.0, frame=AMSL)])
+    f.start()
+    f.run_until(lambda: f.store.finished)
+    f.v.run_for(5.0)
+    assert -f.v.snapshot().pos_ned_m[2] == pytest.approx(9.0, abs=0.5)
+
+
+def test_auto_mission_needs_a_mission() -> None:
+    """Without a mission MISSION_START is denied; AUTO.MISSION can be chosen while disarmed (as any mode), but
+    arming in it fails the mode check (modeCheck.cpp)."""
+    f = Flight([])
+    f.v.run_for(2.5)
+    assert f.command(MavCmd.MISSION_START, 0, 0) == MavResult.DENIED
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 4) == MavResult.ACCEPTED
+    assert f.v.commander.nav_state is NavState.AUTO_MISSION
+    assert f.command(MavCmd.COMPONENT_ARM_DISARM, 1, 0) == MavResult.TEMPORARILY_REJECTED
+    f.run_until(lambda: True)
+    assert f.texts[-3:] == ["Mission start denied! No valid mission", "Preflight Fail: No valid mission available",
+                            "Arming denied: Resolve system health failures first"]
