@@ -13,7 +13,8 @@ Written from src/modules/flight_mode_manager/tasks/Orbit/FlightTaskOrbit.{hpp,cp
   centre's altitude with the position smoothing (MPC_XY_CRUISE), facing the centre; on it, the horizontal velocity
   is tangential (slew-limited by MPC_ACC_HOR from 0) plus a radial correction, the altitude is the manual altitude
   task's (throttle), the yaw per the behaviour, smoothed with MPC_YAWRAUTO_MAX / MPC_YAWRAUTO_ACC;
-- the sticks adjust radius (pitch; roll when facing the tangent) and velocity (roll; pitch when tangent);
+- the sticks adjust radius (pitch; roll when facing the tangent) and velocity (roll, the v1.15/v1.16 sign: right
+  slows a clockwise orbit; pitch when tangent);
 - every update publishes orbit_status (ORBIT_EXECUTION_STATUS): radius signed by the direction, centre, altitude.
 """
 
@@ -185,7 +186,7 @@ class OrbitTask(ManualAltitudeTask):
             velocity += sign * pitch * dt_s * o.acc_hor
         else:
             radius -= pitch * dt_s * o.xy_cruise
-            velocity += roll * dt_s * o.acc_hor
+            velocity -= roll * dt_s * o.acc_hor  # V: PX4 v1.15/v1.16; main (Dec 2025, 8c532db6b3) adds the roll
         self.radius_m, self.velocity_m_s = sanitize(radius, velocity, o)
 
     def _approach_setpoint(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
