@@ -180,7 +180,7 @@ def test_follow_a_moving_target_then_lose_its_stream(flying):
     c.spin(10.0)  # no more FOLLOW_TARGET: after 3 s the estimate stops moving, the vehicle settles
     s = v.snapshot()
     assert math.hypot(*s.vel_ned_m_s[:2]) < 0.3  # station kept, not drifting on
-    # it did not chase a target it no longer hears: the estimate coasts 3 s (6 m) before it stops, the vehicle 6 m behind
+    # it did not chase a target it no longer hears: the estimate coasts 3 s (6 m) before it stops, 6 m behind it
     assert s.pos_ned_m[1] < 2.0 * 15.8 + 3.0
     assert c.custom_modes[-1] == custom_mode(NavState.AUTO_FOLLOW_TARGET) and s.armed  # PX4 stays in the mode
 
