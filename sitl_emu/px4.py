@@ -91,6 +91,7 @@ class MavCmd(IntEnum):
     NAV_RETURN_TO_LAUNCH = 20
     NAV_LAND = 21
     NAV_TAKEOFF = 22
+    DO_ORBIT = 34
     DO_SET_MODE = 176
     DO_SET_HOME = 179
     DO_FLIGHTTERMINATION = 185

@@ -123,6 +123,31 @@ class HomePosition:
 
 
 @dataclass(frozen=True, slots=True)
+class OrbitStatus:
+    """PX4's orbit_status while the orbit flight task runs (ORBIT_EXECUTION_STATUS): the signed radius (positive
+    clockwise), the centre and the altitude (AMSL) of the altitude setpoint."""
+
+    time_us: int
+    radius_m: float
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+    yaw_behaviour: int
+
+
+@dataclass(frozen=True, slots=True)
+class FollowTargetSample:
+    """FOLLOW_TARGET as PX4's follow_target topic holds it: where the target is (WGS84, AMSL) and its NED velocity,
+    stamped with the vehicle's time of receipt."""
+
+    time_us: int
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+    vel_ned_m_s: Vec3
+
+
+@dataclass(frozen=True, slots=True)
 class VehicleSnapshot:
     """Everything telemetry needs, at one instant of simulated time."""
 
@@ -169,3 +194,4 @@ class VehicleSnapshot:
     manual_control: bool = False  # a manual input (MAVLink joystick) is present: SYS_STATUS's RC receiver
     battery_warning: int = 0  # battery_status_s::WARNING_* (0 none, 1 low, 2 critical, 3 emergency)
     gps_fix_type: int = 3  # SIH's GPS: 3D fix; 0 while a GPS failure is injected
+    orbit: OrbitStatus | None = None  # while the orbit flight task runs (ORBIT_EXECUTION_STATUS)

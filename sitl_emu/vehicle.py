@@ -28,6 +28,7 @@ from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.commands import handle_command
+from sitl_emu.flight.follow_estimator import TargetFix
 from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.tasks_core import NavInput, SetpointType
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
@@ -39,6 +40,7 @@ from sitl_emu.px4 import AUTO_MODES, LandedState, MavCmd, NavState, Severity
 from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
+    FollowTargetSample,
     HomePosition,
     ManualControlSetpoint,
     OffboardControlMode,
@@ -210,6 +212,11 @@ class Vehicle:
         self._snap = None
         self.commander.manual_control_signal(self._time_us, setpoint)
 
+    def follow_target_input(self, sample: FollowTargetSample) -> None:
+        """A FOLLOW_TARGET from the ground station (PX4's follow_target topic), for Follow Target's estimator."""
+        pos = global_to_ned(self.ref, sample.lat_deg, sample.lon_deg, sample.alt_amsl_m)
+        self.chain.executor.follow_target(TargetFix(sample.time_us, pos, sample.vel_ned_m_s))
+
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         """Log a text from outside the core (e.g. the MAVLink receiver) into the same event stream."""
         self._emit(severity, module, text, is_event, True)
@@ -284,7 +291,7 @@ class Vehicle:
             home=c.home, local_setpoint=local_sp, attitude_setpoint_q_wxyz=q_sp, rates_setpoint_rad_s=rates_sp,
             thrust_setpoint=thrust, motors=self._state.motors, extras={"system_status": float(c.system_status())},
             motor_commands=self._motor_commands, offboard_control_last=offboard_last,
-            manual_control=c.manual_control_valid(self._time_us),
+            manual_control=c.manual_control_valid(self._time_us), orbit=self.chain.executor.orbit_status(ref),
             battery_voltage_v=self.faults.battery.voltage_v, battery_remaining=self.faults.battery.remaining,
             battery_warning=self.faults.battery.warning, gps_fix_type=self.faults.gps_fix_type,
         )

@@ -76,6 +76,7 @@ class NavCommandKind(Enum):
     TAKEOFF = "takeoff"
     REPOSITION = "reposition"
     CHANGE_ALTITUDE = "change_altitude"
+    ORBIT = "orbit"  # DO_ORBIT: the orbit flight task applies it (flight/tasks_orbit.py)
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,6 +89,8 @@ class NavCommand:
     alt_amsl_m: float = NAN
     yaw_rad: float = NAN
     speed_m_s: float = NAN
+    radius_m: float = NAN  # DO_ORBIT param1 (the sign is the direction); speed_m_s is its param2
+    yaw_behaviour: float = NAN  # DO_ORBIT param3 (ORBIT_YAW_BEHAVIOUR)
 
 
 def _nowhere() -> HomePosition | None:
@@ -185,6 +188,8 @@ class Commander:
         Position cannot run); during a failsafe action the switch ends it too."""
         if not self.armed or not (self.nav_state in AUTO_MODES or self.nav_state is NavState.OFFBOARD):
             return
+        if self.nav_state is NavState.AUTO_FOLLOW_TARGET:
+            return  # control_mode.cpp: Follow Target is not flag_control_auto_enabled; its sticks adjust the follow
         if self._failsafe.manual_loss.hold_s(self.now_us) > 0 or not self._failsafe.geofence.sticks_may_take_over(
                 self.now_us):
             return  # no stick takeover during the Hold before a failsafe action (framework.cpp)

@@ -157,6 +157,18 @@ def _change_altitude(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandA
     return _ack(cmd, MavResult.ACCEPTED)
 
 
+def _orbit(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
+    """Commander.cpp VEHICLE_CMD_DO_ORBIT (multicopter): the user's mode becomes Orbit, nothing more; the orbit flight
+    task applies the parameters (and says "Orbit radius limit exceeded" itself, after this ACCEPTED)."""
+    if not c.change_mode(NavState.ORBIT):
+        c.say(Severity.CRITICAL, "Orbit command rejected", is_event=False)
+        return _ack(cmd, MavResult.TEMPORARILY_REJECTED)
+    # param1 radius (sign: direction), param2 velocity, param3 yaw behaviour, param5/6 centre, param7 altitude AMSL
+    c.nav_commands.append(NavCommand(NavCommandKind.ORBIT, cmd.param(5), cmd.param(6), cmd.param(7),
+                                     speed_m_s=cmd.param(2), radius_m=cmd.param(1), yaw_behaviour=cmd.param(3)))
+    return _ack(cmd, MavResult.ACCEPTED)
+
+
 # ---- the rest --------------------------------------------------------------------------------------------------
 def _set_home(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
     if cmd.param(1) > 0.5:
@@ -242,6 +254,7 @@ _HANDLERS: dict[int, _Handler] = {
     MavCmd.NAV_LAND: _land,
     MavCmd.NAV_RETURN_TO_LAUNCH: _rtl,
     MavCmd.DO_REPOSITION: _reposition,
+    MavCmd.DO_ORBIT: _orbit,
     MavCmd.DO_SET_HOME: _set_home,
     MavCmd.MISSION_START: _mission_start,
     MavCmd.DO_SET_MISSION_CURRENT: _set_mission_current,

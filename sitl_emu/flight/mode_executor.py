@@ -19,24 +19,33 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight import tasks
+from sitl_emu.flight import tasks, tasks_orbit
 from sitl_emu.flight.commander import NavCommand, NavCommandKind
+from sitl_emu.flight.follow_estimator import TargetFix
 from sitl_emu.flight.manual_control import CENTRED
 from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.stabilized import StabilizedMode
 from sitl_emu.flight.tasks import SetpointType
+from sitl_emu.flight.tasks_follow import FollowTargetTask
 from sitl_emu.flight.tasks_manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight.tasks_mission import MissionFlight, MissionTask
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
-from sitl_emu.types import AttitudeSetpoint, ManualControlSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3
+from sitl_emu.types import (
+    AttitudeSetpoint,
+    ManualControlSetpoint,
+    OffboardControlMode,
+    OrbitStatus,
+    TrajectorySetpoint,
+    Vec3,
+)
 
 _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
                          NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
-                         NavState.AUTO_MISSION})
+                         NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
 _STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
-FlightTask = tasks.Task | ManualAltitudeTask
+FlightTask = tasks.Task | ManualAltitudeTask | tasks_orbit.FailedOrbitHold | FollowTargetTask
 
 
 @dataclass(slots=True)
@@ -93,6 +102,7 @@ class ModeExecutor:
         if isinstance(task, MissionTask) and task.wants_rtl:
             return NavState.AUTO_RTL
         return None
+        self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
@@ -102,6 +112,12 @@ class ModeExecutor:
         if attitude is not None:
             self._offboard_att = attitude
         self._offboard_out = None
+
+    def follow_target(self, fix: TargetFix) -> None:
+        """A FOLLOW_TARGET (in the local frame): the follow-target estimator reads the latest when it runs."""
+        self._target_fix = fix
+        if isinstance(self.task, FollowTargetTask):
+            self.task.fix = fix
 
     def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
                commands: list[NavCommand], ref: GeoRef, dt_s: float,
@@ -141,7 +157,7 @@ class ModeExecutor:
             if now_us - self._last_us < task.period_us:
                 return held
             dt = (now_us - self._last_us) * 1e-6
-        if isinstance(task, ManualAltitudeTask):
+        if isinstance(task, ManualAltitudeTask | FollowTargetTask):
             task.sticks = sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
@@ -174,6 +190,9 @@ class ModeExecutor:
         new_takeoff = self._pending_takeoff is not None and nav_state is NavState.AUTO_TAKEOFF
         if nav_state is self._task_mode and command is None and not new_takeoff:
             return False  # the running task still fits
+        if nav_state is NavState.ORBIT and self._task_mode is NavState.ORBIT and command is not None:
+            self.task = self._orbit(nav_fn(), command, ref)  # the running orbit takes the new parameters
+            return True
         self._start_task(nav_state, nav_fn(), command, ref)
         return True
 
@@ -206,6 +225,11 @@ class ModeExecutor:
             self.task = ManualPositionTask(nav, self.params)
         elif nav_state is NavState.ALTCTL:
             self.task = ManualAltitudeTask(nav, self.params)
+        elif nav_state is NavState.ORBIT:
+            self.task = self._orbit(nav, command, ref)
+        elif nav_state is NavState.AUTO_FOLLOW_TARGET:
+            self.task = follow = FollowTargetTask(nav, self.params)
+            follow.fix = self._target_fix
         else:
             self.task = tasks.make_land(nav, self.params)
 
@@ -221,6 +245,17 @@ class ModeExecutor:
         if self.missions is None:
             self.missions = MissionFlight(MissionStore())
         return MissionTask(nav, self.params, self.missions, ref, ref.alt_amsl_m - nav.home_ned_m[2])
+    def _orbit(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> FlightTask:
+        """The orbit flight task with a DO_ORBIT applied (tasks_orbit.apply_orbit)."""
+        task = self.task if isinstance(self.task, tasks_orbit.OrbitFlight) else None
+        orbit = command if command is not None and command.kind is NavCommandKind.ORBIT else None
+        return tasks_orbit.apply_orbit(task if self._task_mode is NavState.ORBIT else None, orbit, nav, self.params,
+                                       ref)
+
+    def orbit_status(self, ref: GeoRef) -> OrbitStatus | None:
+        """orbit_status while the orbit flight task runs (ORBIT_EXECUTION_STATUS), else None."""
+        task = self.task
+        return task.status(ref) if isinstance(task, tasks_orbit.OrbitTask) else None
 
     def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
         alt_up: float | None = None

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 from sitl_emu.mavlink import setpoints
 from sitl_emu.mavlink.link_commands import ANY_COMPONENT, CommandHandler
 from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
-from sitl_emu.types import ManualControlSetpoint, VehicleCommand
+from sitl_emu.types import FollowTargetSample, ManualControlSetpoint, VehicleCommand
 
 if TYPE_CHECKING:
     from typing import TypeAlias
@@ -58,6 +58,7 @@ class Receiver:
             "SET_POSITION_TARGET_GLOBAL_INT": self._global_int,
             "SET_ATTITUDE_TARGET": self._attitude_target,
             "MANUAL_CONTROL": self._manual_control,
+            "FOLLOW_TARGET": self._follow_target,
             "PING": self._ping,
             "TIMESYNC": self._timesync,
         }
@@ -142,6 +143,20 @@ class Receiver:
         if msg.target in (0, ctx.sysid):
             ctx.vehicle.manual_control_input(manual_setpoint(msg.x, msg.y, msg.z, msg.r, msg.buttons))
             ctx.node.invalidate_snapshot()
+
+    # --- follow target ----------------------------------------------------------------------------------------
+    @staticmethod
+    def _follow_target(msg: dialect.MAVLink_follow_target_message, ctx: EndpointContext) -> None:
+        """handle_message_follow_target: from anyone (no target fields), stamped on receipt, lat/lon degE7, alt
+        AMSL, vel NED. SAFER THAN PX4: a fix off the globe (|lat| > 90 deg, |lon| > 180 deg) is dropped; PX4 would
+        project it somewhere on Earth and fly there. NaN altitude or velocity is passed on: the estimator refuses it
+        as PX4's does."""
+        lat, lon = msg.lat * 1e-7, msg.lon * 1e-7
+        if abs(lat) > 90.0 or abs(lon) > 180.0:
+            return
+        vel = (float(msg.vel[0]), float(msg.vel[1]), float(msg.vel[2]))
+        ctx.vehicle.follow_target_input(FollowTargetSample(ctx.now_us, lat, lon, float(msg.alt), vel))
+        ctx.node.invalidate_snapshot()
 
     def _apply(self, decoded: setpoints.Decoded, ctx: EndpointContext) -> None:
         if decoded.mode is None:

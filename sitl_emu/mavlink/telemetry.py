@@ -70,6 +70,7 @@ BUILDERS: dict[int, tm.Builder] = {
     290: ta.esc_info,
     291: ta.esc_status,
     331: tm.odometry,
+    360: tm.orbit_execution_status,  # sends only while orbiting
     380: th.time_estimate_to_target,
     436: tm.current_mode,
     441: ts.gnss_integrity,
@@ -87,13 +88,13 @@ ON_REQUEST: dict[int, tm.Builder] = {
 ONBOARD_RATES_HZ: dict[int, float] = {
     111: 10, 32: 30, 30: 100, 141: 10, 132: 10, 290: 10, 291: 10, 331: 30, 31: 50, 83: 10, 147: 0.5, 436: 0.5,
     230: 1, 514: 1, 245: 5, 33: 50, 441: 1, 24: 8, 242: 0.5, 12901: 1, 12904: 1, 4: 1, 85: 10, 36: 10, 1: 5, 2: 1,
-    380: 1, 74: 10, 241: 0.5, 8: 1, 105: 50, 29: 1, 42: 1,
+    380: 1, 74: 10, 241: 0.5, 8: 1, 105: 50, 29: 1, 42: 1, 360: 5,
 }
 # MAVLINK_MODE_NORMAL with the SITL GCS-link overrides (px4-rc.mavlink: 50 Hz for position/attitude streams)
 NORMAL_RATES_HZ: dict[int, float] = {
     141: 1, 30: 50, 31: 50, 83: 50, 147: 0.5, 436: 0.5, 132: 0.5, 290: 1, 291: 1, 230: 0.5, 514: 0.5, 245: 1,
     33: 50, 441: 1, 24: 5, 242: 0.5, 32: 50, 12901: 1, 12904: 1, 4: 0.1, 85: 50, 36: 50, 1: 1, 380: 1, 74: 4,
-    241: 0.1, 8: 1, 29: 1, 42: 1,
+    241: 0.1, 8: 1, 29: 1, 42: 1, 360: 2,
 }
 # A stream sends only when its source topic has news: a topic slower than the stream sets the pace. PX4's navigator
 # publishes rtl_time_estimate every 2 s, so TIME_ESTIMATE_TO_TARGET (1 Hz configured) goes out at 0.5 Hz.

@@ -216,6 +216,21 @@ def current_mode(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
                                        px4.custom_mode(snap.user_intended_nav_state))
 
 
+def orbit_execution_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+    """ORBIT_EXECUTION_STATUS.hpp: only while the orbit task publishes orbit_status; frame 0 (MAV_FRAME_GLOBAL),
+    x/y the centre in degE7 (the double times 1e7 stored in an int32: truncated), z the altitude AMSL."""
+    o = snap.orbit
+    if o is None:
+        return None
+    return ctx.encoder.orbit_execution_status_encode(o.time_us, o.radius_m, 0, _trunc_e7(o.lat_deg),
+                                                     _trunc_e7(o.lon_deg), o.alt_amsl_m)
+
+
+def _trunc_e7(deg: float) -> int:
+    x = deg * 1e7
+    return max(min(int(x), 2147483647), -2147483648) if math.isfinite(x) else 0
+
+
 def rotate_ned_to_body(q_wxyz: tuple[float, float, float, float], v: tuple[float, float, float]
                        ) -> tuple[float, float, float]:
     """v expressed in the body frame: R(q)^T v, with q rotating body to NED."""

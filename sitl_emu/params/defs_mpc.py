@@ -75,4 +75,17 @@ _HTE: list[ParamDef] = [
     real("HTE_THR_RANGE", 0.2, 0.01, 0.4, "normalized_thrust"),
 ]
 
-PARAMS: list[ParamDef] = [*_LIMITS, *_AUTO, *_MANUAL, *_CONTROL, *_TAKEOFF_LAND, *_HTE]
+# The flight tasks Orbit and Follow Target (src/modules/flight_mode_manager/tasks/Orbit/flight_task_orbit_params.yaml,
+# tasks/AutoFollowTarget/follow_target_params.yaml); they run in flight_mode_manager, beside the position controller.
+_FLIGHT_TASKS: list[ParamDef] = [
+    real("MC_ORBIT_RAD_MAX", 1000.0, 1.0, 10000.0, "m"),
+    integer("MC_ORBIT_YAW_MOD", 0, 0, 4),
+    real("FLW_TGT_RS", 0.1, 0.0, 1.0),
+    real("FLW_TGT_HT", 8.0, 8.0, unit="m"),
+    real("FLW_TGT_DST", 8.0, 1.0, unit="m"),
+    real("FLW_TGT_FA", 180.0, -180.0, 180.0),
+    integer("FLW_TGT_ALT_M", 0, 0, 2),
+    real("FLW_TGT_MAX_VEL", 5.0, 0.0, 20.0),
+]
+
+PARAMS: list[ParamDef] = [*_LIMITS, *_AUTO, *_MANUAL, *_CONTROL, *_TAKEOFF_LAND, *_HTE, *_FLIGHT_TASKS]
