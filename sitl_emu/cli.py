@@ -35,6 +35,7 @@ from sitl_emu.cli_options import (
     parse_home,
 )
 from sitl_emu.console import attach_console
+from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
 from sitl_emu.mavlink.link import PortInUseError
 from sitl_emu.runtime.node import LinkSettings
 from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
@@ -190,9 +191,14 @@ def main(verbose: int) -> None:
 @click.option("--seed", type=WholeRange(0, SEED_MAX), default=0, show_default=True,
               help="Random seed for the sensor noise: the same seed, parameters and inputs fly the same trajectory.")
 @click.option("--no-console", is_flag=True, help="Do not start the pxh> console even on a terminal.")
+@click.option("--log-dir", type=click.Path(path_type=Path), default=DEFAULT_LOG_DIR, show_default=True,
+              help="Write a ULog file per flight, from arming to disarming, as PX4 SITL does (DIR/YYYY-MM-DD/"
+                   "HH_MM_SS.ulg, the vehicle's UTC time; DIR-N for instance N of a --count), and serve them to "
+                   "ground stations' log download.")
+@click.option("--no-log", is_flag=True, help="Write no flight logs.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
-          params_reset: bool, seed: int, no_console: bool) -> None:
+          params_reset: bool, seed: int, no_console: bool, log_dir: Path, no_log: bool) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         check_host(bind_host, "--bind")
@@ -216,9 +222,11 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             return built
 
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
-                            epoch_unix_us=int(time.time() * 1e6))
+                            epoch_unix_us=int(time.time() * 1e6),
+                            handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
     except (UsageProblem, PortInUseError) as err:
         raise UserError(str(err)) from None
+    loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
     for node in nodes:
@@ -227,6 +235,8 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
     console = attach_console([node.vehicle for node in nodes], runner, not no_console)
     _run_until_signalled(runner, console)
+    for logger in loggers:
+        logger.close()  # a flight cut short keeps its log up to here
     for node in nodes:
         node.close()
     _save_all(stores)
