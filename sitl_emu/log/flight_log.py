@@ -71,7 +71,7 @@ class _Schedule:
 class FlightLogger:
     """Writes vehicle `node.vehicle`'s flights under `directory` (module docstring)."""
 
-    def __init__(self, node: Any, directory: str | os.PathLike[str], *, opener: Opener = _open_file) -> None:
+    def __init__(self, node: Any, directory: str | os.PathLike[str], *, opener: Opener | None = None) -> None:
         self.node = node
         self.directory = Path(directory)
         self.opener = opener
@@ -126,7 +126,7 @@ class FlightLogger:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             path = self._free_name(path)
-            self._file = self.opener(path)
+            self._file = (self.opener or _open_file)(path)
         except OSError as err:
             self.path = path
             self._fail(err)
