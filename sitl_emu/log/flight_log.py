@@ -29,7 +29,6 @@ from typing import IO, Any
 from sitl_emu.log import ulog_writer as ulog
 from sitl_emu.log.info import parameter_messages, version_infos
 from sitl_emu.log.topics import Inputs, Topic, default_topics
-from sitl_emu.mavlink.telemetry_actuators import servo_outputs
 from sitl_emu.params import ParamType
 from sitl_emu.px4 import Severity
 from sitl_emu.types import VehicleSnapshot
@@ -85,7 +84,8 @@ class FlightLogger:
         self._params: dict[str, float] = {}
         self._param_version = -1
         self._next_sync_us = 0
-        self._schedules: list[_Schedule] = []
+        self._plan: list[tuple[int, Topic, _Schedule]] = []  # msg_id, topic, when it is next due
+        self._sysid = 0
 
     @property
     def writing(self) -> bool:
@@ -135,7 +135,8 @@ class FlightLogger:
         self.files.append(path)
         self.node.vehicle.report(Severity.INFO, "logger", f"[logger] {shown_path(path)}")
         self._write(self._preamble(snap))
-        self._schedules = [_Schedule() for _ in self.topics]
+        self._plan = [(msg_id, topic, _Schedule()) for msg_id, topic in enumerate(self.topics)]
+        self._sysid = int(self.node.vehicle.sysid)
         self._next_sync_us = snap.time_us
         arming_events = self.node.vehicle.events_after(self._event_seq)
         self._log_texts([e for e in arming_events if e.time_us >= snap.time_us - ARMING_TEXTS_US])
@@ -169,17 +170,17 @@ class FlightLogger:
         if vehicle.params.version != self._param_version:
             out.append(self._changed_params())
         now = snap.time_us
-        inputs: Inputs | None = None
-        for msg_id, (topic, sched) in enumerate(zip(self.topics, self._schedules, strict=True)):
-            state = topic.state(snap) if topic.state is not None else None
-            if now < sched.next_us and (topic.state is None or state == sched.state):
+        inputs = Inputs(snap, self._sysid, vehicle)
+        for msg_id, topic, sched in self._plan:
+            state = topic.state
+            if now < sched.next_us and (state is None or state(snap) == sched.state):
                 continue
-            if inputs is None:
-                inputs = self._inputs(snap)
+            if state is not None:
+                sched.state = state(snap)
+            sched.next_us = sched.next_us + topic.interval_us
+            if sched.next_us <= now:  # (after a pause, a change, or an interval shorter than a tick)
+                sched.next_us = now + topic.interval_us
             values = topic.values(inputs)
-            sched.state = state
-            sched.next_us = sched.next_us + topic.interval_us if sched.next_us + topic.interval_us > now \
-                else now + topic.interval_us
             if values is not None:
                 out.append(ulog.data(msg_id, topic.format.pack(values)))
         if now >= self._next_sync_us:
@@ -187,12 +188,6 @@ class FlightLogger:
             self._next_sync_us = now + SYNC_INTERVAL_US
         if out:
             self._write(b"".join(out))
-
-    def _inputs(self, snap: VehicleSnapshot) -> Inputs:
-        vehicle = self.node.vehicle
-        manual = vehicle.commander.manual
-        sticks = manual.setpoint if snap.manual_control else None
-        return Inputs(snap, int(vehicle.sysid), sticks, servo_outputs(snap))
 
     def _log_texts(self, events: list[Any], write: bool = True) -> bytes:
         """'L' messages for the STATUSTEXTs among `events` (level: their MAVLink severity, as PX4's log_message)."""

@@ -19,9 +19,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from sitl_emu.log.ulog_writer import MessageFormat
+from sitl_emu.mavlink.telemetry_actuators import servo_outputs
 from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
 
@@ -39,19 +40,17 @@ PWM_OUTPUTS = 16
 Values = dict[str, Any]
 
 
-@dataclass(frozen=True, slots=True)
-class Inputs:
-    """What a topic's values are made of: the snapshot and the few things the snapshot lacks."""
+class Inputs(NamedTuple):
+    """What a topic's values are made of: the snapshot, and the vehicle for the few things the snapshot lacks."""
 
     snap: VehicleSnapshot
     sysid: int
-    manual: ManualControlSetpoint | None  # the last sticks while manual control is valid
-    pwm: tuple[int, ...]  # the 16 actuator_outputs (mavlink/telemetry_actuators.servo_outputs)
+    vehicle: Any
 
 
 @dataclass(frozen=True, slots=True)
 class Topic:
-    format: MessageFormat
+    format: MessageFormat  # with the topic's constant fields as its defaults
     interval_us: int  # at most one message per interval (0: every tick)
     values: Callable[[Inputs], Values | None]  # None: nothing published now
     state: Callable[[VehicleSnapshot], Hashable] | None = None  # a change is written at once
@@ -83,10 +82,9 @@ def _local_position(i: Inputs) -> Values:
         "timestamp": s.time_us, "timestamp_sample": s.time_us,
         "ref_lat": s.ref_lat_deg, "ref_lon": s.ref_lon_deg, "x": x, "y": y, "z": z, "vx": vx, "vy": vy, "vz": vz,
         "z_deriv": vz, "ax": ax, "ay": ay, "az": az, "heading": s.euler_rad[2], "ref_alt": s.ref_alt_amsl_m,
-        "dist_bottom": -z, "eph": 0.3 if ok else 1e3, "epv": 0.4 if ok else 1e3, "evh": 0.1, "evv": 0.1,
-        "vxy_max": math.inf, "vz_max": math.inf, "hagl_min": math.inf, "hagl_max_z": math.inf,
-        "hagl_max_xy": math.inf, "xy_valid": ok, "z_valid": ok, "v_xy_valid": ok, "v_z_valid": ok,
-        "heading_good_for_control": ok, "xy_global": ok, "z_global": ok, "dist_bottom_valid": ok,
+        "dist_bottom": -z, "eph": 0.3 if ok else 1e3, "epv": 0.4 if ok else 1e3, "xy_valid": ok, "z_valid": ok,
+        "v_xy_valid": ok, "v_z_valid": ok, "heading_good_for_control": ok, "xy_global": ok, "z_global": ok,
+        "dist_bottom_valid": ok,
     }
 
 
@@ -95,8 +93,7 @@ def _global_position(i: Inputs) -> Values | None:
     if not s.position_valid:
         return None
     return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "lat": s.lat_deg, "lon": s.lon_deg,
-            "alt": s.alt_amsl_m, "alt_ellipsoid": s.alt_amsl_m, "eph": 0.3, "epv": 0.4, "lat_lon_valid": True,
-            "alt_valid": True}
+            "alt": s.alt_amsl_m, "alt_ellipsoid": s.alt_amsl_m}
 
 
 def _local_setpoint(i: Inputs) -> Values | None:
@@ -144,25 +141,23 @@ def _actuator_motors(i: Inputs) -> Values:
 
 
 def _actuator_outputs(i: Inputs) -> Values:
-    return {"timestamp": i.snap.time_us, "noutputs": PWM_OUTPUTS, "output": [float(v) for v in i.pwm]}
+    return {"timestamp": i.snap.time_us, "output": [float(v) for v in servo_outputs(i.snap)]}
 
 
 def _battery(i: Inputs) -> Values:
     s = i.snap
     cells = (s.battery_voltage_v / BATTERY_CELLS,) * BATTERY_CELLS + (0.0,) * (14 - BATTERY_CELLS)
     return {"timestamp": s.time_us, "voltage_v": s.battery_voltage_v, "remaining": s.battery_remaining,
-            "scale": 1.0, "time_remaining_s": NAN, "temperature": NAN, "voltage_cell_v": cells,
-            "connected": True, "cell_count": BATTERY_CELLS, "id": 1}
+            "voltage_cell_v": cells}
 
 
 def _status(i: Inputs) -> Values:
     s = i.snap
     return {"timestamp": s.time_us, "arming_state": ARMING_STATE_ARMED if s.armed else ARMING_STATE_DISARMED,
             "nav_state_user_intention": int(s.user_intended_nav_state), "nav_state": int(s.nav_state),
-            "nav_state_display": int(s.nav_state), "vehicle_type": VEHICLE_TYPE_ROTARY_WING,
-            "failsafe": s.failsafe, "system_type": MAV_TYPE_QUADROTOR, "system_id": i.sysid, "component_id": 1,
+            "nav_state_display": int(s.nav_state), "failsafe": s.failsafe, "system_id": i.sysid,
             "accepts_offboard_setpoints": s.nav_state is NavState.OFFBOARD,
-            "pre_flight_checks_pass": s.pre_flight_checks_pass, "power_input_valid": True}
+            "pre_flight_checks_pass": s.pre_flight_checks_pass}
 
 
 def _status_state(s: VehicleSnapshot) -> Hashable:
@@ -183,16 +178,17 @@ def _home(i: Inputs) -> Values | None:
         return None
     x, y, z = h.pos_ned_m
     return {"timestamp": s.time_us, "lat": h.lat_deg, "lon": h.lon_deg, "alt": h.alt_amsl_m, "x": x, "y": y, "z": z,
-            "yaw": h.yaw_rad, "valid_alt": True, "valid_hpos": True, "valid_lpos": True}
+            "yaw": h.yaw_rad}
 
 
 def _manual(i: Inputs) -> Values | None:
-    m = i.manual
-    if m is None:
+    """The last sticks while manual control is valid (the commander's COM_RC_LOSS_T watchdog)."""
+    if not i.snap.manual_control:
         return None
+    m: ManualControlSetpoint = i.vehicle.commander.manual.setpoint
     t = i.snap.time_us
     return {"timestamp": t, "timestamp_sample": t, "roll": m.roll, "pitch": m.pitch, "yaw": m.yaw,
-            "throttle": m.throttle, "buttons": m.buttons, "valid": True, "data_source": SOURCE_MAVLINK_0}
+            "throttle": m.throttle, "buttons": m.buttons}
 
 
 def _offboard_mode(i: Inputs) -> Values | None:
@@ -296,7 +292,26 @@ _TABLE: dict[str, tuple[int, Callable[[Inputs], Values | None], Callable[[Vehicl
 }
 
 
+# fields that never change, set once as the format's defaults
+CONSTANTS: dict[str, Values] = {
+    "vehicle_local_position": {"evh": 0.1, "evv": 0.1, "vxy_max": math.inf, "vz_max": math.inf,
+                               "hagl_min": math.inf, "hagl_max_z": math.inf, "hagl_max_xy": math.inf},
+    "vehicle_global_position": {"eph": 0.3, "epv": 0.4, "lat_lon_valid": True, "alt_valid": True},
+    "actuator_outputs": {"noutputs": PWM_OUTPUTS},
+    "battery_status": {"scale": 1.0, "time_remaining_s": NAN, "temperature": NAN, "connected": True,
+                       "cell_count": BATTERY_CELLS, "id": 1},
+    "vehicle_status": {"vehicle_type": VEHICLE_TYPE_ROTARY_WING, "system_type": MAV_TYPE_QUADROTOR,
+                       "component_id": 1, "power_input_valid": True},
+    "home_position": {"valid_alt": True, "valid_hpos": True, "valid_lpos": True},
+    "manual_control_setpoint": {"valid": True, "data_source": SOURCE_MAVLINK_0},
+}
+
+
 def default_topics() -> list[Topic]:
     """Every topic a flight log holds, in a fixed order (their msg_ids)."""
-    return [Topic(MessageFormat(name, SPECS[name]), interval, values, state)
-            for name, (interval, values, state) in _TABLE.items()]
+    topics = []
+    for name, (interval, values, state) in _TABLE.items():
+        fmt = MessageFormat(name, SPECS[name])
+        fmt.set_defaults(CONSTANTS.get(name, {}))
+        topics.append(Topic(fmt, interval, values, state))
+    return topics

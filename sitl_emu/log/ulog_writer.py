@@ -101,7 +101,14 @@ class MessageFormat:
         parts = [f"{f.ctype}[{f.count}] {f.name};" if f.count else f"{f.ctype} {f.name};" for f in self.fields]
         return f"{self.name}:" + "".join(parts)
 
+    def set_defaults(self, values: Mapping[str, Any]) -> None:
+        """Values every message has unless `pack` is given others (fields that never change)."""
+        self._defaults = self._filled(values)
+
     def pack(self, values: Mapping[str, Any]) -> bytes:
+        return self._struct.pack(*self._filled(values))
+
+    def _filled(self, values: Mapping[str, Any]) -> list[Any]:
         out = self._defaults.copy()
         slots = self._slots
         for name, value in values.items():
@@ -110,7 +117,7 @@ class MessageFormat:
                 out[index:index + count] = value
             else:
                 out[index] = value
-        return self._struct.pack(*out)
+        return out
 
 
 def message(kind: bytes, body: bytes) -> bytes:

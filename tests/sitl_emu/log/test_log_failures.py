@@ -45,7 +45,7 @@ def test_an_unwritable_log_directory_is_one_warning_and_the_flight_goes_on(tmp_p
 def test_a_full_disk_ends_the_log_with_one_warning_and_the_next_flight_logs_again(tmp_path, caplog, monkeypatch):
     def full_disk(path: Path):
         path.write_bytes(b"")  # the name is taken, the data never lands (/dev/full: ENOSPC on every write)
-        return open("/dev/full", "wb", buffering=BUFFER_BYTES)  # noqa: SIM115 -- the logger closes it
+        return open("/dev/full", "wb", buffering=BUFFER_BYTES)  # the logger closes it
 
     if not Path("/dev/full").exists():
         pytest.skip("needs /dev/full to simulate a full disk")
