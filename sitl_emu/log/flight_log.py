@@ -36,7 +36,6 @@ from sitl_emu.types import VehicleSnapshot
 log = logging.getLogger(__name__)
 
 SYNC_INTERVAL_US = 500_000  # logger.cpp: "Add sync magic" every 500 ms
-ARMING_TEXTS_US = 100_000  # texts of the arming moment (log_message is queued) go in the new log too
 BUFFER_BYTES = 64 * 1024
 Opener = Callable[[Path], IO[bytes]]
 
@@ -101,8 +100,9 @@ class FlightLogger:
         if not armed:
             self._failed = False
             if self._file is not None:
-                self._record(self.node.snapshot())
+                self._record(self.node.snapshot())  # the disarmed state and its texts end the log
                 self.close()
+            self._event_seq = vehicle.last_event_seq  # texts from here on: those of the arming go in the new log
             return
         if self._file is None and not self._failed:
             self._start(self.node.snapshot())
@@ -138,8 +138,7 @@ class FlightLogger:
         self._plan = [(msg_id, topic, _Schedule()) for msg_id, topic in enumerate(self.topics)]
         self._sysid = int(self.node.vehicle.sysid)
         self._next_sync_us = snap.time_us
-        arming_events = self.node.vehicle.events_after(self._event_seq)
-        self._log_texts([e for e in arming_events if e.time_us >= snap.time_us - ARMING_TEXTS_US])
+        self._log_texts(self.node.vehicle.events_after(self._event_seq))  # the arming's texts and "[logger] ..."
 
     @staticmethod
     def _free_name(path: Path) -> Path:
