@@ -46,7 +46,8 @@ def test_mavsdk_log_files_lists_and_downloads_a_log_byte_for_byte(tmp_path):
     shutil.copyfile(written, served_copy)
     with serve(work, tmp_path / "serve.log", SPEED) as ports:
         out = tmp_path / "downloaded.ulg"
-        asyncio.run(asyncio.wait_for(_download(mavsdk_asyncio, ports.api_remote, out, written.stat().st_size), timeout=200))
+        download = _download(mavsdk_asyncio, ports.api_remote, out, written.stat().st_size)
+        asyncio.run(asyncio.wait_for(download, timeout=200))
     assert out.read_bytes() == written.read_bytes()
 
 
