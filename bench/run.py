@@ -5,7 +5,8 @@ Figures (targets from issue 4 in brackets):
   runner      the runners' own cost: a stub vehicle (no physics) at real time, % of one core and CPU per tick; the
               swarm runner's CPU per vehicle-tick with 100 stub vehicles (bench/runner.py)
   serve       `sitl-emu serve` at real time, hovering, default streams on both links: % of one core [<= 3], with
-              the default batching, waking every tick, and --batch-ms 20
+              the default batching (and the flight's ULog log, and --no-log), waking every tick, and --batch-ms 20;
+              the log's size per minute of flight
   startup     wall time from process start to the first HEARTBEAT [< 0.5 s] and to health all good
   flight      reference loopback flight (arm, takeoff, OFFBOARD square, land) by a scripted pymavlink client:
               in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
@@ -24,6 +25,7 @@ import platform
 import re
 import subprocess
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -82,14 +84,20 @@ def bench_runner(quick: bool) -> None:
 
 def bench_serve(quick: bool) -> None:
     seconds = 5.0 if quick else 30.0
-    share = serve.hover_cpu_share(seconds)
-    say(f"serve at real time: {share:.1f} % of one core (hovering {seconds:.0f} s, default streams on both links, "
-        f"default --batch-ms {DEFAULT_BATCH_MS:g}; target <= 3)")
-    every_tick = serve.hover_cpu_share(seconds, ("--batch-ms", "0"))
-    say(f"serve at real time --batch-ms 0: {every_tick:.1f} % of one core (same, waking for every 4 ms tick as PX4 "
-        "SITL does)")
-    batched = serve.hover_cpu_share(seconds, ("--batch-ms", "20"))
-    say(f"serve at real time --batch-ms 20: {batched:.1f} % of one core (same, waking every 20 ms)")
+    with tempfile.TemporaryDirectory() as logs:
+        logging_on = ("--log-dir", logs)  # the default: a ULog of the flight (here not in the repository's log/)
+        share = serve.hover_cpu_share(seconds, logging_on)
+        say(f"serve at real time: {share:.1f} % of one core (hovering {seconds:.0f} s, default streams on both links, "
+            f"default --batch-ms {DEFAULT_BATCH_MS:g}, logging the flight; target <= 3)")
+        say(serve.log_size_line(Path(logs)))
+    unlogged = serve.hover_cpu_share(seconds, ("--no-log",))
+    say(f"serve at real time --no-log: {unlogged:.1f} % of one core (same, writing no ULog)")
+    with tempfile.TemporaryDirectory() as logs:
+        every_tick = serve.hover_cpu_share(seconds, ("--batch-ms", "0", "--log-dir", logs))
+        say(f"serve at real time --batch-ms 0: {every_tick:.1f} % of one core (same, waking for every 4 ms tick as "
+            "PX4 SITL does)")
+        batched = serve.hover_cpu_share(seconds, ("--batch-ms", "20", "--log-dir", logs))
+        say(f"serve at real time --batch-ms 20: {batched:.1f} % of one core (same, waking every 20 ms)")
 
 
 def bench_startup(quick: bool) -> None:

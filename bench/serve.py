@@ -158,3 +158,19 @@ def fastest_flight(speeds: list[float], reference: FlightResult) -> list[tuple[f
         if not ok:
             break
     return attempts
+
+
+def log_size_line(log_dir: Path) -> str:
+    """The size per minute of flight of the one ULog in `log_dir` (its duration read with pyulog, if installed)."""
+    files = sorted(log_dir.glob("*/*.ulg"))
+    if len(files) != 1:
+        return f"serve log: expected one .ulg in {log_dir}, found {len(files)}"
+    try:
+        from pyulog import ULog
+    except ImportError:
+        return "serve log: install pyulog (the test extra) to measure the log's size per minute"
+    log = ULog(str(files[0]))
+    minutes = (log.last_timestamp - log.start_timestamp) / 60e6
+    size = files[0].stat().st_size
+    return (f"serve log: {size / 1e6 / minutes:.2f} MB per minute of flight ({size / 1e6:.2f} MB over "
+            f"{minutes * 60:.0f} s)")

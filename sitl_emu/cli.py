@@ -36,6 +36,7 @@ from sitl_emu.cli_options import (
     parse_home,
 )
 from sitl_emu.console import attach_console
+from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
 from sitl_emu.mavlink.link import PortInUseError
 from sitl_emu.runtime.node import LinkSettings
 from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
@@ -210,9 +211,14 @@ def main(verbose: int) -> None:
               help="Wind: SPEED m/s blowing FROM degrees (5@270: 5 m/s from the west), optionally Dryden "
                    "turbulence: light, moderate, severe or the 20 ft wind speed W20 in m/s (5@270,light). Seeded "
                    "by --seed; SIH_WIND_N/E add to it.")
+@click.option("--log-dir", type=click.Path(path_type=Path), default=DEFAULT_LOG_DIR, show_default=True,
+              help="Write a ULog file per flight, from arming to disarming, as PX4 SITL does (DIR/YYYY-MM-DD/"
+                   "HH_MM_SS.ulg, the vehicle's UTC time; DIR-N for instance N of a --count), and serve them to "
+                   "ground stations' log download.")
+@click.option("--no-log", is_flag=True, help="Write no flight logs.")
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
-          params_reset: bool, seed: int, no_console: bool, wind_text: str | None) -> None:
+          params_reset: bool, seed: int, no_console: bool, wind_text: str | None, log_dir: Path, no_log: bool) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         check_host(bind_host, "--bind")
@@ -237,9 +243,11 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             return built
 
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
-                            epoch_unix_us=int(time.time() * 1e6))
+                            epoch_unix_us=int(time.time() * 1e6),
+                            handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
     except (UsageProblem, PortInUseError) as err:
         raise UserError(str(err)) from None
+    loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
     for node in nodes:
@@ -248,6 +256,8 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
     console = attach_console([node.vehicle for node in nodes], runner, not no_console)
     _run_until_signalled(runner, console)
+    for logger in loggers:
+        logger.close()  # a flight cut short keeps its log up to here
     for node in nodes:
         node.close()
     _save_all(stores)

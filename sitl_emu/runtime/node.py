@@ -10,7 +10,7 @@ listens on 14557+i (the project's default; PX4 today uses 14580+i) and sends to 
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -69,6 +69,8 @@ class VehicleNode:
         self._snapshot_time_us = -1
         self._last_now_us = -1
         self.io_budget = IO_BUDGET_DATAGRAMS  # datagrams read per link per step_io (the swarm runner lowers it)
+        # called with now_us at the start of every step_io, e.g. the flight logger (sitl_emu/log/flight_log.py)
+        self.tick_hooks: list[Callable[[int], None]] = []
 
     @property
     def sysid(self) -> int:
@@ -99,6 +101,9 @@ class VehicleNode:
             for ep in self.endpoints:
                 ep.restart()
         self._last_now_us = now_us
+        if self.tick_hooks:
+            for hook in self.tick_hooks:
+                hook(now_us)
         received = 0
         if readable:
             if readable & READ_API:

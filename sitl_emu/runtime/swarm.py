@@ -43,8 +43,12 @@ def instance_home(home: tuple[float, float, float], index: int, spacing_m: float
 
 def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory, *, first_instance: int = 0,
                 home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
-                epoch_unix_us: int = 0, handler_classes: Sequence[type] | None = None) -> list[VehicleNode]:
-    """`count` nodes for instances first_instance.., ports offset per instance; closes them all if one fails."""
+                epoch_unix_us: int = 0, handler_classes: Sequence[type] | None = None,
+                handlers_for: Callable[[int], Sequence[type]] | None = None) -> list[VehicleNode]:
+    """`count` nodes for instances first_instance.., ports offset per instance; closes them all if one fails.
+
+    `handlers_for(instance)`, if given, gives each node its own protocol handlers (e.g. its own log directory).
+    """
     if count < 1:
         raise ValueError("count must be at least 1")
     nodes: list[VehicleNode] = []
@@ -52,7 +56,8 @@ def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory
         for i in range(count):
             instance = first_instance + i
             vehicle = make_vehicle(instance, instance_home(home, i, spacing_m))
-            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, handler_classes))
+            classes = handlers_for(instance) if handlers_for is not None else handler_classes
+            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, classes))
     except BaseException:
         for node in nodes:
             node.close()

@@ -20,10 +20,11 @@ other's vehicles. Pass `api_remote=("127.0.0.1", 14540)` to send to where PX4 SI
 
 from __future__ import annotations
 
+import os
 import socket
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -89,7 +90,10 @@ class Sim:
                  home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
                  api_remote: Address | None = None, gcs_remote: Address | None = None,
                  bind_host: str = "127.0.0.1", vehicle_options: Mapping[str, Any] | None = None,
-                 wind: WindSettings | None = None, estimate_noise: EstimateNoiseSettings | None = None) -> None:
+                 wind: WindSettings | None = None, estimate_noise: EstimateNoiseSettings | None = None,
+                 log_dir: str | os.PathLike[str] | None = None) -> None:
+        """`log_dir`: write a ULog per flight there (vehicle i > 0 in `<log_dir>-<i>`) and serve them over
+        LOG_REQUEST_*, as `sitl-emu serve --log-dir` (sitl_emu/log/); `self.loggers` are the loggers."""
         self._sink = _sink_socket(bind_host)
         sink: Address = self._sink.getsockname()
         self._param_values = dict(params or {})
@@ -100,12 +104,24 @@ class Sim:
         if estimate_noise is not None:  # sitl_emu/disturbance/estimate.py: white noise and bias walk on the estimate
             self._vehicle_options["estimate_noise"] = estimate_noise
         settings = LinkSettings(bind_host, 0, api_remote or sink, 0, gcs_remote or sink)
+        handlers_for = None
+        if log_dir is not None:
+            from sitl_emu.log.serving import handler_classes, instance_log_dir
+
+            def handlers_for(instance: int) -> Sequence[type]:
+                return handler_classes(instance_log_dir(log_dir, instance))
         try:
             self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,
-                                                        spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6))
+                                                        spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6),
+                                                        handlers_for=handlers_for)
         except BaseException:
             self._sink.close()
             raise
+        self.loggers: list[Any] = []  # sitl_emu.log.flight_log.FlightLogger, one per vehicle, with log_dir
+        if log_dir is not None:
+            from sitl_emu.log.serving import attach_logger, instance_log_dir
+
+            self.loggers = [attach_logger(node, instance_log_dir(log_dir, i)) for i, node in enumerate(self.nodes)]
         if api_remote is None:  # every instance shares the sink (for_instance offset the port)
             for node in self.nodes:
                 node.api.link.remote = sink
@@ -193,6 +209,8 @@ class Sim:
     # --- lifetime ----------------------------------------------------------------------------------------------
     def close(self) -> None:
         self.stop()
+        for logger in self.loggers:
+            logger.close()
         self._watch.close()
         for node in self.nodes:
             node.close()

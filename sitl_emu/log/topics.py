@@ -1,0 +1,317 @@
+"""The uORB topics a flight log holds: PX4's names, fields and logging rates, their values from the vehicle snapshot.
+
+Field lists (names, C types, order and padding) are those of a ULog written by PX4 SITL+SIH (the shape of PX4's
+msg/*.msg once its message generator has sorted the fields by size; ../shared/reference/px4-ulog-topics.txt),
+manual_control_setpoint's from msg/versioned/ManualControlSetpoint.msg. Fields sitl_emu does not model stay zero,
+as in PX4's zero-initialised structs.
+
+Rates: src/modules/logger/logged_topics.cpp add_default_topics() gives each topic its least interval (ms); PX4 SITL
+runs SDLOG_PROFILE 131 (ROMFS/px4fmu_common/init.d-posix/rcS: default + estimator replay + vision), whose replay set
+logs vehicle_attitude, vehicle_local_position and vehicle_global_position at every update and
+vehicle_angular_velocity every 10 ms. Every update here means PX4's publication rate: vehicle_attitude every 4 ms
+tick, the local and global position at the EKF's ~125 Hz (8 ms; the reference log: 124.9 and 120.6 Hz).
+Topics PX4 publishes on change (vehicle_status, vehicle_land_detected, home_position, offboard_control_mode) are
+written when their state changes and at PX4's publication period.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+from sitl_emu.log.ulog_writer import MessageFormat
+from sitl_emu.mavlink.telemetry_actuators import servo_outputs
+from sitl_emu.px4 import LandedState, NavState
+from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
+
+NAN = math.nan
+NAN3 = (NAN, NAN, NAN)
+ARMING_STATE_DISARMED = 1  # msg/VehicleStatus.msg
+ARMING_STATE_ARMED = 2
+VEHICLE_TYPE_ROTARY_WING = 1
+MAV_TYPE_QUADROTOR = 2
+BATTERY_CELLS = 4  # BAT1_N_CELLS in PX4 SITL
+SOURCE_MAVLINK_0 = 2  # manual_control_setpoint.data_source of a MAVLink joystick on mavlink instance 0
+ACTUATOR_CONTROLS = 12  # actuator_motors.control
+PWM_OUTPUTS = 16
+
+Values = dict[str, Any]
+
+
+class Inputs(NamedTuple):
+    """What a topic's values are made of: the snapshot, and the vehicle for the few things the snapshot lacks."""
+
+    snap: VehicleSnapshot
+    sysid: int
+    vehicle: Any
+
+
+@dataclass(frozen=True, slots=True)
+class Topic:
+    format: MessageFormat  # with the topic's constant fields as its defaults
+    interval_us: int  # at most one message per interval (0: every tick)
+    values: Callable[[Inputs], Values | None]  # None: nothing published now
+    state: Callable[[VehicleSnapshot], Hashable] | None = None  # a change is written at once
+
+    @property
+    def name(self) -> str:
+        return self.format.name
+
+
+def _thrust_body(snap: VehicleSnapshot) -> tuple[float, float, float]:
+    return (0.0, 0.0, -snap.thrust_setpoint)
+
+
+def _attitude(i: Inputs) -> Values:
+    s = i.snap
+    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "q": s.q_wxyz}
+
+
+def _angular_velocity(i: Inputs) -> Values:
+    s = i.snap
+    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "xyz": s.rates_frd_rad_s}
+
+
+def _local_position(i: Inputs) -> Values:
+    s = i.snap
+    (x, y, z), (vx, vy, vz), (ax, ay, az) = s.pos_ned_m, s.vel_ned_m_s, s.acc_ned_m_s2
+    ok = s.position_valid
+    return {
+        "timestamp": s.time_us, "timestamp_sample": s.time_us,
+        "ref_lat": s.ref_lat_deg, "ref_lon": s.ref_lon_deg, "x": x, "y": y, "z": z, "vx": vx, "vy": vy, "vz": vz,
+        "z_deriv": vz, "ax": ax, "ay": ay, "az": az, "heading": s.euler_rad[2], "ref_alt": s.ref_alt_amsl_m,
+        "dist_bottom": -z, "eph": 0.3 if ok else 1e3, "epv": 0.4 if ok else 1e3, "xy_valid": ok, "z_valid": ok,
+        "v_xy_valid": ok, "v_z_valid": ok, "heading_good_for_control": ok, "xy_global": ok, "z_global": ok,
+        "dist_bottom_valid": ok,
+    }
+
+
+def _global_position(i: Inputs) -> Values | None:
+    s = i.snap
+    if not s.position_valid:
+        return None
+    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "lat": s.lat_deg, "lon": s.lon_deg,
+            "alt": s.alt_amsl_m, "alt_ellipsoid": s.alt_amsl_m}
+
+
+def _local_setpoint(i: Inputs) -> Values | None:
+    s, sp = i.snap, i.snap.local_setpoint
+    if sp is None:
+        return None
+    (x, y, z), (vx, vy, vz) = sp.position_ned_m, sp.velocity_ned_m_s
+    return {"timestamp": s.time_us, "x": x, "y": y, "z": z, "vx": vx, "vy": vy, "vz": vz,
+            "acceleration": sp.acceleration_ned_m_s2, "thrust": _thrust_body(s), "yaw": sp.yaw_rad,
+            "yawspeed": sp.yawspeed_rad_s}
+
+
+def _trajectory_setpoint(i: Inputs) -> Values | None:
+    s, sp = i.snap, i.snap.local_setpoint
+    if sp is None:
+        return None
+    return {"timestamp": s.time_us, "position": sp.position_ned_m, "velocity": sp.velocity_ned_m_s,
+            "acceleration": sp.acceleration_ned_m_s2, "jerk": NAN3, "yaw": sp.yaw_rad, "yawspeed": sp.yawspeed_rad_s}
+
+
+def _attitude_setpoint(i: Inputs) -> Values | None:
+    s = i.snap
+    if s.attitude_setpoint_q_wxyz is None or not s.armed:
+        return None
+    return {"timestamp": s.time_us, "q_d": s.attitude_setpoint_q_wxyz, "thrust_body": _thrust_body(s)}
+
+
+def _rates_setpoint(i: Inputs) -> Values | None:
+    s = i.snap
+    if not s.armed:
+        return None
+    roll, pitch, yaw = s.rates_setpoint_rad_s
+    return {"timestamp": s.time_us, "roll": roll, "pitch": pitch, "yaw": yaw, "thrust_body": _thrust_body(s)}
+
+
+def _thrust_setpoint(i: Inputs) -> Values | None:
+    s = i.snap
+    return None if not s.armed else {"timestamp": s.time_us, "timestamp_sample": s.time_us, "xyz": _thrust_body(s)}
+
+
+def _actuator_motors(i: Inputs) -> Values:
+    s = i.snap
+    control = (*s.motor_commands, *(NAN,) * (ACTUATOR_CONTROLS - len(s.motor_commands)))
+    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "control": control}
+
+
+def _actuator_outputs(i: Inputs) -> Values:
+    return {"timestamp": i.snap.time_us, "output": [float(v) for v in servo_outputs(i.snap)]}
+
+
+def _battery(i: Inputs) -> Values:
+    s = i.snap
+    cells = (s.battery_voltage_v / BATTERY_CELLS,) * BATTERY_CELLS + (0.0,) * (14 - BATTERY_CELLS)
+    return {"timestamp": s.time_us, "voltage_v": s.battery_voltage_v, "remaining": s.battery_remaining,
+            "voltage_cell_v": cells}
+
+
+def _status(i: Inputs) -> Values:
+    s = i.snap
+    return {"timestamp": s.time_us, "arming_state": ARMING_STATE_ARMED if s.armed else ARMING_STATE_DISARMED,
+            "nav_state_user_intention": int(s.user_intended_nav_state), "nav_state": int(s.nav_state),
+            "nav_state_display": int(s.nav_state), "failsafe": s.failsafe, "system_id": i.sysid,
+            "accepts_offboard_setpoints": s.nav_state is NavState.OFFBOARD,
+            "pre_flight_checks_pass": s.pre_flight_checks_pass}
+
+
+def _status_state(s: VehicleSnapshot) -> Hashable:
+    return s.armed, s.nav_state, s.user_intended_nav_state, s.failsafe, s.pre_flight_checks_pass
+
+
+def _land_detected(i: Inputs) -> Values:
+    s = i.snap
+    landed = s.landed_state is LandedState.ON_GROUND
+    return {"timestamp": s.time_us, "ground_contact": landed, "maybe_landed": landed, "landed": landed,
+            "in_descend": s.landed_state is LandedState.LANDING, "has_low_throttle": landed,
+            "close_to_ground_or_skipped_check": landed or -s.pos_ned_m[2] < 1.0, "at_rest": landed}
+
+
+def _home(i: Inputs) -> Values | None:
+    s, h = i.snap, i.snap.home
+    if h is None:
+        return None
+    x, y, z = h.pos_ned_m
+    return {"timestamp": s.time_us, "lat": h.lat_deg, "lon": h.lon_deg, "alt": h.alt_amsl_m, "x": x, "y": y, "z": z,
+            "yaw": h.yaw_rad}
+
+
+def _manual(i: Inputs) -> Values | None:
+    """The last sticks while manual control is valid (the commander's COM_RC_LOSS_T watchdog)."""
+    if not i.snap.manual_control:
+        return None
+    m: ManualControlSetpoint = i.vehicle.commander.manual.setpoint
+    t = i.snap.time_us
+    return {"timestamp": t, "timestamp_sample": t, "roll": m.roll, "pitch": m.pitch, "yaw": m.yaw,
+            "throttle": m.throttle, "buttons": m.buttons}
+
+
+def _offboard_mode(i: Inputs) -> Values | None:
+    s, m = i.snap, i.snap.offboard_control_last
+    if m is None:
+        return None
+    return {"timestamp": s.time_us, "position": m.position, "velocity": m.velocity, "acceleration": m.acceleration,
+            "attitude": m.attitude, "body_rate": m.body_rate}
+
+
+SPECS = {
+    "vehicle_attitude": "uint64_t timestamp;uint64_t timestamp_sample;float[4] q;float[4] delta_q_reset;"
+                        "uint8_t quat_reset_counter;uint8_t[7] _padding0",
+    "vehicle_angular_velocity": "uint64_t timestamp;uint64_t timestamp_sample;float[3] xyz;float[3] xyz_derivative",
+    "vehicle_local_position":
+        "uint64_t timestamp;uint64_t timestamp_sample;uint64_t ref_timestamp;double ref_lat;double ref_lon;float x;"
+        "float y;float z;float[2] delta_xy;float delta_z;float vx;float vy;float vz;float z_deriv;float[2] delta_vxy;"
+        "float delta_vz;float ax;float ay;float az;float heading;float heading_var;float unaided_heading;"
+        "float delta_heading;float tilt_var;float ref_alt;float dist_bottom;float dist_bottom_var;"
+        "float delta_dist_bottom;float eph;float epv;float evh;float evv;float vxy_max;float vz_max;float hagl_min;"
+        "float hagl_max_z;float hagl_max_xy;bool xy_valid;bool z_valid;bool v_xy_valid;bool v_z_valid;"
+        "uint8_t xy_reset_counter;uint8_t z_reset_counter;uint8_t vxy_reset_counter;uint8_t vz_reset_counter;"
+        "uint8_t heading_reset_counter;bool heading_good_for_control;bool xy_global;bool z_global;"
+        "bool dist_bottom_valid;uint8_t dist_bottom_reset_counter;uint8_t dist_bottom_sensor_bitfield;"
+        "bool dead_reckoning",
+    "vehicle_global_position":
+        "uint64_t timestamp;uint64_t timestamp_sample;double lat;double lon;float alt;float alt_ellipsoid;"
+        "float delta_alt;float delta_terrain;float eph;float epv;float terrain_alt;bool lat_lon_valid;bool alt_valid;"
+        "uint8_t lat_lon_reset_counter;uint8_t alt_reset_counter;uint8_t terrain_reset_counter;"
+        "bool terrain_alt_valid;bool dead_reckoning;uint8_t[5] _padding0",
+    "vehicle_local_position_setpoint": "uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;"
+                                       "float[3] acceleration;float[3] thrust;float yaw;float yawspeed",
+    "trajectory_setpoint": "uint64_t timestamp;float[3] position;float[3] velocity;float[3] acceleration;"
+                           "float[3] jerk;float yaw;float yawspeed",
+    "vehicle_attitude_setpoint": "uint64_t timestamp;float yaw_sp_move_rate;float[4] q_d;float[3] thrust_body",
+    "vehicle_rates_setpoint": "uint64_t timestamp;float roll;float pitch;float yaw;float[3] thrust_body;"
+                              "bool reset_integral;uint8_t[7] _padding0",
+    "vehicle_thrust_setpoint": "uint64_t timestamp;uint64_t timestamp_sample;float[3] xyz;uint8_t[4] _padding0",
+    "actuator_motors": "uint64_t timestamp;uint64_t timestamp_sample;float[12] control;uint16_t reversible_flags;"
+                       "uint8_t[6] _padding0",
+    "actuator_outputs": "uint64_t timestamp;uint32_t noutputs;float[16] output;uint8_t[4] _padding0",
+    "battery_status":
+        "uint64_t timestamp;float voltage_v;float current_a;float current_average_a;float discharged_mah;"
+        "float remaining;float scale;float time_remaining_s;float temperature;float[14] voltage_cell_v;"
+        "float max_cell_voltage_delta;float full_charge_capacity_wh;float remaining_capacity_wh;"
+        "float nominal_voltage;float internal_resistance_estimate;float ocv_estimate;float ocv_estimate_filtered;"
+        "float volt_based_soc_estimate;float voltage_prediction;float prediction_error;"
+        "float estimation_covariance_norm;uint16_t capacity;uint16_t cycle_count;uint16_t average_time_to_empty;"
+        "uint16_t manufacture_date;uint16_t state_of_health;uint16_t max_error;uint16_t interface_error;"
+        "uint16_t faults;uint16_t over_discharge_count;bool connected;uint8_t cell_count;uint8_t source;"
+        "uint8_t priority;uint8_t id;bool is_powering_off;bool is_required;uint8_t warning;uint8_t[2] _padding0",
+    "vehicle_status":
+        "uint64_t timestamp;uint64_t armed_time;uint64_t takeoff_time;uint64_t nav_state_timestamp;"
+        "uint32_t valid_nav_states_mask;uint32_t can_set_nav_states_mask;uint8_t arming_state;"
+        "uint8_t latest_arming_reason;uint8_t latest_disarming_reason;uint8_t nav_state_user_intention;"
+        "uint8_t nav_state;uint8_t executor_in_charge;uint8_t nav_state_display;bool accepts_offboard_setpoints;"
+        "uint8_t hil_state;uint8_t vehicle_type;bool failsafe;bool failsafe_and_user_took_over;"
+        "uint8_t failsafe_defer_state;bool gcs_connection_lost;uint8_t gcs_connection_lost_counter;"
+        "bool high_latency_data_link_lost;bool is_vtol;bool is_vtol_tailsitter;bool in_transition_mode;"
+        "bool in_transition_to_fw;uint8_t system_type;uint8_t system_id;uint8_t component_id;"
+        "bool safety_button_available;bool safety_off;bool power_input_valid;bool usb_connected;"
+        "bool open_drone_id_system_present;bool open_drone_id_system_healthy;bool parachute_system_present;"
+        "bool parachute_system_healthy;bool traffic_avoidance_system_present;bool rc_calibration_in_progress;"
+        "bool calibration_enabled;bool pre_flight_checks_pass;uint8_t[5] _padding0",
+    "vehicle_land_detected": "uint64_t timestamp;bool freefall;bool ground_contact;bool maybe_landed;bool landed;"
+                             "bool in_ground_effect;bool in_descend;bool has_low_throttle;bool vertical_movement;"
+                             "bool horizontal_movement;bool rotational_movement;bool close_to_ground_or_skipped_check;"
+                             "bool at_rest;uint8_t[4] _padding0",
+    "home_position": "uint64_t timestamp;double lat;double lon;float alt;float x;float y;float z;float roll;"
+                     "float pitch;float yaw;uint32_t update_count;bool valid_alt;bool valid_hpos;bool valid_lpos;"
+                     "bool valid_attitude;bool manual_home;uint8_t[3] _padding0",
+    "manual_control_setpoint": "uint64_t timestamp;uint64_t timestamp_sample;float roll;float pitch;float yaw;"
+                               "float throttle;float flaps;float aux1;float aux2;float aux3;float aux4;float aux5;"
+                               "float aux6;uint16_t buttons;bool valid;uint8_t data_source;bool sticks_moving;"
+                               "uint8_t[7] _padding0",
+    "offboard_control_mode": "uint64_t timestamp;bool position;bool velocity;bool acceleration;bool attitude;"
+                             "bool body_rate;bool thrust_and_torque;bool direct_actuator;uint8_t[1] _padding0",
+}
+
+MS = 1000
+# name: (least interval in µs, values, state written on change or None) -- logged_topics.cpp's intervals
+_TABLE: dict[str, tuple[int, Callable[[Inputs], Values | None], Callable[[VehicleSnapshot], Hashable] | None]] = {
+    "vehicle_attitude": (0, _attitude, None),
+    "vehicle_angular_velocity": (10 * MS, _angular_velocity, None),
+    "vehicle_local_position": (8 * MS, _local_position, None),
+    "vehicle_global_position": (8 * MS, _global_position, None),
+    "vehicle_local_position_setpoint": (100 * MS, _local_setpoint, None),
+    "trajectory_setpoint": (200 * MS, _trajectory_setpoint, None),
+    "vehicle_attitude_setpoint": (50 * MS, _attitude_setpoint, None),
+    "vehicle_rates_setpoint": (20 * MS, _rates_setpoint, None),
+    "vehicle_thrust_setpoint": (20 * MS, _thrust_setpoint, None),
+    "actuator_motors": (100 * MS, _actuator_motors, None),
+    "actuator_outputs": (100 * MS, _actuator_outputs, None),
+    "battery_status": (200 * MS, _battery, None),
+    # published at 2 Hz or at once on a change (Commander.cpp); land_detected on change and at 1 Hz
+    "vehicle_status": (500 * MS, _status, _status_state),
+    "vehicle_land_detected": (1000 * MS, _land_detected, lambda s: s.landed_state),
+    "home_position": (1000 * MS, _home, lambda s: s.home),
+    "manual_control_setpoint": (200 * MS, _manual, None),
+    "offboard_control_mode": (100 * MS, _offboard_mode, lambda s: s.offboard_control_last),
+}
+
+
+# fields that never change, set once as the format's defaults
+CONSTANTS: dict[str, Values] = {
+    "vehicle_local_position": {"evh": 0.1, "evv": 0.1, "vxy_max": math.inf, "vz_max": math.inf,
+                               "hagl_min": math.inf, "hagl_max_z": math.inf, "hagl_max_xy": math.inf},
+    "vehicle_global_position": {"eph": 0.3, "epv": 0.4, "lat_lon_valid": True, "alt_valid": True},
+    "actuator_outputs": {"noutputs": PWM_OUTPUTS},
+    "battery_status": {"scale": 1.0, "time_remaining_s": NAN, "temperature": NAN, "connected": True,
+                       "cell_count": BATTERY_CELLS, "id": 1},
+    "vehicle_status": {"vehicle_type": VEHICLE_TYPE_ROTARY_WING, "system_type": MAV_TYPE_QUADROTOR,
+                       "component_id": 1, "power_input_valid": True},
+    "home_position": {"valid_alt": True, "valid_hpos": True, "valid_lpos": True},
+    "manual_control_setpoint": {"valid": True, "data_source": SOURCE_MAVLINK_0},
+}
+
+
+def default_topics() -> list[Topic]:
+    """Every topic a flight log holds, in a fixed order (their msg_ids)."""
+    topics = []
+    for name, (interval, values, state) in _TABLE.items():
+        fmt = MessageFormat(name, SPECS[name])
+        fmt.set_defaults(CONSTANTS.get(name, {}))
+        topics.append(Topic(fmt, interval, values, state))
+    return topics
