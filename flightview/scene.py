@@ -1,4 +1,4 @@
-"""What the view draws, as plain numbers: the vehicle's arms from its attitude, the fence box, the ground grid.
+"""What the view draws, as plain numbers: the vehicle's arms from its attitude, the fence box.
 
 Pure geometry, no Rerun: the world of the view is east-north-up (x east, y north, z up, metres) so the ground is
 the x-y plane; the vehicle reports north-east-down (NED) positions and its attitude as the rotation from its body
@@ -14,9 +14,7 @@ Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]  # w, x, y, z
 
 ARM_M = 0.25  # a 500 mm-class quad (SIH's default airframe is about that size), drawn bigger than life below
-DRAW_SCALE = 3.0  # so the vehicle stays visible from a view of the whole fence
-GRID_HALF_M = 20.0
-GRID_STEP_M = 2.0
+DRAW_SCALE = 4.0  # so the vehicle stays visible from a view of the whole fence
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,17 +78,6 @@ def fence_box(fence: FenceBox) -> tuple[Vec3, Vec3]:
     mid_alt = (fence.min_alt_m + fence.max_alt_m) / 2
     half_height = (fence.max_alt_m - fence.min_alt_m) / 2
     return (hx, hy, hz + mid_alt), (fence.half_width_m, fence.half_width_m, half_height)
-
-
-def ground_grid(half_m: float = GRID_HALF_M, step_m: float = GRID_STEP_M) -> list[list[Vec3]]:
-    """Lines on the ground (z = 0) every `step_m` metres out to `half_m` each way."""
-    count = int(half_m / step_m)
-    lines = []
-    for i in range(-count, count + 1):
-        c = i * step_m
-        lines.append([(c, -half_m, 0.0), (c, half_m, 0.0)])
-        lines.append([(-half_m, c, 0.0), (half_m, c, 0.0)])
-    return lines
 
 
 def euler_to_q(roll: float, pitch: float, yaw: float) -> Quat:
