@@ -17,7 +17,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly
+	$(BIN)/mypy sitl_emu joyfly flightview
 	$(BIN)/python -m pytest -q
 	$(MAKE) test-compiled
 
@@ -38,7 +38,7 @@ compiled-check:
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly
+	$(BIN)/mypy sitl_emu joyfly flightview
 
 bench: $(STAMP)
 	$(BIN)/python -m bench

@@ -12,6 +12,8 @@ Figures (targets from issue 4 in brackets):
               in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
   latency     joyfly joystick event -> setpoint datagram, median and p99 [p99 < 5 ms] (bench/joyfly_latency.py)
   scale       largest --count N kept on time at real time on one core, hovering, default streams [100]
+  view        `serve --view` at real time, hovering: % of one core of serve and of the Rerun viewer it starts (no
+              browser connected), against serve without the view
   params      full parameter download (PARAM_REQUEST_LIST to the last PARAM_VALUE) from `serve` at real time, wall
               time [< 1 s; PX4 SITL 0.98 s] (bench/params.py)
 Every figure is measured here and now; the machine line says how busy the host was.
@@ -36,7 +38,7 @@ if str(REPO) not in sys.path:  # `python bench/run.py`
 from bench import core, params, runner, scale, serve  # noqa: E402
 from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
-NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params")
+NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params", "view")
 
 
 def say(line: str) -> None:
@@ -98,6 +100,14 @@ def bench_serve(quick: bool) -> None:
             "PX4 SITL does)")
         batched = serve.hover_cpu_share(seconds, ("--batch-ms", "20", "--log-dir", logs))
         say(f"serve at real time --batch-ms 20: {batched:.1f} % of one core (same, waking every 20 ms)")
+
+
+def bench_view(quick: bool) -> None:
+    seconds = 5.0 if quick else 30.0
+    plain, _ = serve.hover_cpu_shares(seconds)
+    viewed, viewer = serve.hover_cpu_shares(seconds, ("--view",))
+    say(f"serve --view at real time: {viewed:.1f} % of one core (without the view: {plain:.1f} %), and its Rerun "
+        f"viewer process {viewer:.1f} % (hovering {seconds:.0f} s, no browser connected)")
 
 
 def bench_startup(quick: bool) -> None:
@@ -162,7 +172,7 @@ def bench_params(quick: bool) -> None:
 
 BENCHES: dict[str, Callable[[bool], None]] = {
     "core": bench_core, "runner": bench_runner, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
-    "latency": bench_latency, "scale": bench_scale, "params": bench_params,
+    "latency": bench_latency, "scale": bench_scale, "params": bench_params, "view": bench_view,
 }
 
 

@@ -9,10 +9,13 @@ from __future__ import annotations
 import logging
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import click
 
+from flightview.launch import ViewOptions
+from flightview.options import view_options, view_settings
 from joyfly.cli_joystick import joystick
 from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
@@ -28,6 +31,7 @@ from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.view import add_browser_view, check_view_options
 
 D = FlyOptions()
 
@@ -92,7 +96,9 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
       "--speed N (1 for PX4 SITL or a real vehicle). joyfly's rates and timeouts run as fast; it warns when the "
       "vehicle's clock says otherwise.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
-def fly(config_path: str | None, **cli_options: Any) -> None:
+@view_options
+def fly(config_path: str | None, view: bool, view_port: int | None, record_view: Path | None,
+        **cli_options: Any) -> None:
     """Connect, take off to --alt in OFFBOARD (or arm in PX4's Position/Altitude mode with --control position/altitude)
     and fly with the joystick; Ctrl-C lands (see --on-exit)."""
     try:
@@ -100,10 +106,13 @@ def fly(config_path: str | None, **cli_options: Any) -> None:
         opts = build_options(file_options, cli_options, source=config_path)
     except (ConfigError, JoystickError) as err:
         raise UserError(str(err)) from None
-    sys.exit(run_fly(opts, profile_table))
+    view_opts = view_settings(view, view_port, record_view)
+    check_view_options(view_opts)
+    sys.exit(run_fly(opts, profile_table, view_options=view_opts))
 
 
-def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) -> int:
+def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
+            view_options: ViewOptions | None = None) -> int:
     """Open the joystick and the link, fly until done; returns the exit status."""
     out = out or sys.stdout
     clock: WallClock | ScaledClock = WallClock() if opts.speed == 1.0 else ScaledClock(opts.speed)
@@ -126,7 +135,7 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None) ->
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), "warn", text)))
     session.link.on_message.append(watch.observe)
-    return fly_session(session, view, out)
+    return fly_session(session, add_browser_view(view, session, view_options, out), out)
 
 
 def throttle_problem(control: str, profile: Any) -> str | None:
@@ -149,12 +158,17 @@ def throttle_problem(control: str, profile: Any) -> str | None:
               help="How to fly, as `joyfly fly --control`: OFFBOARD setpoints (velocity, step) or PX4's Position / "
                    "Altitude mode with MANUAL_CONTROL (position, altitude; the script then takes off with the "
                    "throttle).")
-def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str) -> None:
+@view_options
+def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str, view: bool,
+         view_port: int | None, record_view: Path | None) -> None:
     """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
     from joyfly.demo import DemoError, run_demo
 
+    view_opts = view_settings(view, view_port, record_view)
+    check_view_options(view_opts)
     try:
-        sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control))
+        sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control,
+                          view_options=view_opts))
     except (DemoError, TransportError, JoystickError) as err:
         raise UserError(str(err)) from None
 

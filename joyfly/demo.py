@@ -14,6 +14,7 @@ import time
 from dataclasses import replace
 from typing import Any, TextIO
 
+from flightview.launch import ViewOptions
 from joyfly.clock import ScaledClock
 from joyfly.config import FlyOptions
 from joyfly.dashboard import make_view
@@ -134,10 +135,12 @@ def script_source(script_path: str | None, clock: Any, control: str = "velocity"
 
 
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
-             out: TextIO | None = None, options: FlyOptions | None = None, control: str | None = None) -> int:
+             out: TextIO | None = None, options: FlyOptions | None = None, control: str | None = None,
+             view_options: ViewOptions | None = None) -> int:
     """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed). `control` picks the way
     of flying (FlyOptions.control), position/altitude at QGroundControl's MANUAL_CONTROL rate."""
     from joyfly.run import fly_session
+    from joyfly.view import add_browser_view
 
     out = out or sys.stdout
     opts = options or FlyOptions()
@@ -158,11 +161,17 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
               f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}\n")
     settings = opts.session_settings(exit_when_landed=True)
     session = make_session(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
+    try:
+        shown = add_browser_view(view, session, view_options, out)
+    except BaseException:
+        if emulator is not None:
+            emulator.stop()
+        raise
     watchdog = threading.Timer(DEMO_TIMEOUT_S / clock.speed, session.request_exit)
     watchdog.daemon = True
     watchdog.start()
     try:
-        status = fly_session(session, view, out)
+        status = fly_session(session, shown, out)
     finally:
         watchdog.cancel()
         if emulator is not None:

@@ -16,6 +16,7 @@ from typing import Any
 
 import click
 
+from flightview.options import view_options, view_settings
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli_options import (
     CONTEXT,
@@ -216,11 +217,14 @@ def main(verbose: int) -> None:
                    "HH_MM_SS.ulg, the vehicle's UTC time; DIR-N for instance N of a --count), and serve them to "
                    "ground stations' log download.")
 @click.option("--no-log", is_flag=True, help="Write no flight logs.")
+@view_options
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
-          params_reset: bool, seed: int, no_console: bool, wind_text: str | None, log_dir: Path, no_log: bool) -> None:
+          params_reset: bool, seed: int, no_console: bool, wind_text: str | None, log_dir: Path, no_log: bool,
+          **view: Any) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
+        _check_view(view)
         check_host(bind_host, "--bind")
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
                                 parse_address(gcs_remote, "--gcs-remote"))
@@ -254,13 +258,53 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
+    live = _start_view(nodes, view, runner)
     console = attach_console([node.vehicle for node in nodes], runner, not no_console)
-    _run_until_signalled(runner, console)
-    for logger in loggers:
-        logger.close()  # a flight cut short keeps its log up to here
+    try:
+        _run_until_signalled(runner, console)
+    finally:
+        if live is not None:
+            live.close()
+        for logger in loggers:
+            logger.close()  # a flight cut short keeps its log up to here
     for node in nodes:
         node.close()
     _save_all(stores)
+
+
+def _check_view(view: dict[str, Any]) -> None:
+    """--view without the extra, on a port in use, or an unwritable --record-view: one sentence, before any port
+    opens."""
+    options = view_settings(**view)
+    if options.wanted:
+        from flightview.launch import check_view
+        from flightview.server import ViewError
+
+        try:
+            check_view(options)
+        except ViewError as err:
+            raise UsageProblem(str(err)) from None
+
+
+def _start_view(nodes: list[Any], view: dict[str, Any], runner: RealTimeRunner) -> Any:
+    """--view / --record-view: the live view fed by a runner hook (sitl_emu/view.py), or None; one sentence on a
+    problem (the nodes are closed first)."""
+    options = view_settings(**view)
+    if not options.wanted:
+        return None
+    from flightview.launch import open_view
+    from flightview.server import ViewError
+    from sitl_emu.view import ServeView
+
+    try:
+        handle = open_view("sitl-emu", ServeView.keys(nodes), options, lambda line: click.echo(f"{TOOL}: {line}"))
+    except ViewError as err:
+        for node in nodes:
+            node.close()
+        raise UserError(str(err)) from None
+    assert handle is not None
+    runner.hooks.append(ServeView(handle, nodes))
+    return handle
 
 
 def _save_or_fail(store: Any) -> None:

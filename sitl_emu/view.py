@@ -1,0 +1,62 @@
+"""`sitl-emu serve --view`: every vehicle's snapshot drawn live in the browser (the flightview package, Rerun).
+
+The runner calls the hook after each wake-up (runner.hooks, between batches of ticks, never inside the physics
+tick); the hook logs at most flightview.live.RATE_HZ frames a wall second, one per vehicle, read from each
+vehicle's snapshot() (cached per tick, the same one telemetry reads) and its manual-control sticks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from flightview.launch import ViewHandle
+from flightview.scene import Frame
+from sitl_emu.px4 import mode_name
+from sitl_emu.types import VehicleSnapshot
+
+
+def vehicle_key(sysid: int) -> str:
+    return f"sysid{sysid}"
+
+
+def snapshot_frame(snap: VehicleSnapshot, sticks: tuple[float, float, float, float] | None) -> Frame:
+    """What the view shows of one vehicle, from its snapshot."""
+    sp = snap.local_setpoint
+    setpoint = None
+    if sp is not None and not any(math.isnan(c) for c in sp.position_ned_m):
+        setpoint = sp.position_ned_m
+    home = snap.home.pos_ned_m if snap.home is not None else None
+    return Frame(time_s=snap.time_us / 1e6, pos_ned_m=snap.pos_ned_m, q_wxyz=snap.q_wxyz, setpoint_ned_m=setpoint,
+                 home_ned_m=home, mode=mode_name(snap.nav_state), armed=snap.armed, sticks=sticks)
+
+
+def manual_sticks(vehicle: Any, snap: VehicleSnapshot) -> tuple[float, float, float, float] | None:
+    """PX4's manual_control_setpoint as forward, right, up, yaw (-1..1) while a MAVLink joystick is present."""
+    if not snap.manual_control:
+        return None
+    m = vehicle.commander.manual.setpoint
+    return (m.pitch, m.roll, m.throttle, m.yaw)
+
+
+class ServeView:
+    """The runner hook feeding the view from the nodes' vehicles."""
+
+    def __init__(self, handle: ViewHandle, nodes: Sequence[Any]) -> None:
+        self.handle = handle
+        self.nodes = list(nodes)
+
+    @staticmethod
+    def keys(nodes: Sequence[Any]) -> list[str]:
+        return [vehicle_key(node.sysid) for node in nodes]
+
+    def __call__(self) -> None:
+        live = self.handle.live
+        if not live.due():
+            return
+        for node in self.nodes:
+            vehicle = node.vehicle
+            snap = vehicle.snapshot()
+            live.log(vehicle_key(node.sysid), snapshot_frame(snap, manual_sticks(vehicle, snap)))
+        live.end_frame()
