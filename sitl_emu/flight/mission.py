@@ -130,6 +130,9 @@ class MissionNavigator:
         self.previous = self.current = self.next = None
         self._roi, self._cruise = None, NAN
         self.wants_rtl = False
+        for done in self.items[:self.result.seq_current]:  # replayCachedSpeedChangeItems: a resume keeps the speed
+            if done.command == DO_CHANGE_SPEED:
+                self._issue(done)
         if not self.items:
             self._say("No valid mission available, refusing takeoff" if nav.landed
                       else "No valid mission available, loitering", Severity.CRITICAL)

@@ -169,6 +169,20 @@ def test_change_speed_limits_the_cruise_speed() -> None:
     assert 1.8 < peak < 2.2
 
 
+def test_a_resumed_mission_keeps_the_changed_speed() -> None:
+    f = Flight([TAKEOFF_ITEM, do(DO_CHANGE_SPEED, 1, 2.0, -1), wp(20, 0), wp(20, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 3)
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 3) == MavResult.ACCEPTED  # Hold
+    f.run_until(lambda: f.speed < 0.1, 10.0)
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 4) == MavResult.ACCEPTED  # and on
+    peak = 0.0
+    while not f.store.finished:
+        f.run_until(lambda: True)
+        peak = max(peak, f.speed)
+    assert 1.8 < peak < 2.2
+
+
 def test_do_jump_repeats_the_items_its_count_says() -> None:
     f = Flight([TAKEOFF_ITEM, wp(6, 0), wp(6, 6), do(DO_JUMP, 1, 1), wp(0, 6)])
     f.start()
