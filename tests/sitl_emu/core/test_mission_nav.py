@@ -125,6 +125,17 @@ def test_mission_set_current_while_flying_turns_to_that_item() -> None:
     assert f.currents == [0, 1, 3] and [s for s, _ in f.reached] == [0, 3]
 
 
+def test_a_new_upload_while_flying_is_flown_from_its_current_item() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(30, 0), wp(30, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1)
+    new = Flight([wp(0, 20), wp(-10, 20)]).store.plan(PLAN_MISSION).items
+    f.store.replace(PLAN_MISSION, new, current_seq=1)  # what a completed upload does
+    f.run_until(lambda: f.store.finished)
+    f.v.run_for(6.0)
+    assert f.at(-10, 20) < 1.0 and f.store.seq_reached == 1
+
+
 def test_waypoint_hold_time_and_loiter_time_wait_there() -> None:
     f = Flight([TAKEOFF_ITEM, wp(8, 0, 5.0, 3.0), wp(0, 0, 5.0, 4.0, cmd=LOITER_TIME), wp(0, 8)])
     f.start()
