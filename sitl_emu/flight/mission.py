@@ -98,11 +98,17 @@ class MissionNavigator:
     _cruise: float = NAN
     _roi: Vec3 | None = None
 
-    def load(self, items: tuple[NavItem, ...], current_seq: int) -> None:
-        """A new plan (upload or clear): the result starts over."""
+    def load(self, items: tuple[NavItem, ...], current_seq: int, nav: NavInput | None = None,
+             s: MissionSettings | None = None) -> None:
+        """A new plan (upload or clear): the result starts over; while the mission flies (`nav` given), the vehicle
+        goes on with the new plan's current item at once (MissionBase::onMissionUpdate)."""
+        flying = self._active and nav is not None and s is not None
         self.items, self._jumps = items, {}
         self.result = Result(seq_current=current_seq)
-        self._active, self._planned_valid = False, True
+        self._active, self._planned_valid = flying and bool(items), True
+        if flying and nav is not None and s is not None:
+            self._work = Work.DEFAULT
+            self._set_items(nav, s)
 
     def set_current(self, seq: int, nav: NavInput | None, s: MissionSettings) -> None:
         """MISSION_SET_CURRENT / MISSION_START(n) (Mission::set_current_mission_index): the same item keeps
@@ -130,6 +136,9 @@ class MissionNavigator:
         self.previous = self.current = self.next = None
         self._roi, self._cruise = None, NAN
         self.wants_rtl = False
+        for done in self.items[:self.result.seq_current]:  # replayCachedSpeedChangeItems: a resume keeps the speed
+            if done.command == DO_CHANGE_SPEED:
+                self._issue(done)
         if not self.items:
             self._say("No valid mission available, refusing takeoff" if nav.landed
                       else "No valid mission available, loitering", Severity.CRITICAL)

@@ -42,7 +42,7 @@ class MissionFlight:
         plan = self.store.plan(PLAN_MISSION)
         if plan.items is not self._items_ref:
             self._items_ref = plan.items
-            self.navigator.load(nav_items(plan.items, ref, home_alt_amsl_m), self.store.current_seq)
+            self.navigator.load(nav_items(plan.items, ref, home_alt_amsl_m), self.store.current_seq, nav, settings)
             self._changes_seen = self.store.current_changes
             self._publish()
         elif self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)

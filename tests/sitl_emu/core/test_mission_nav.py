@@ -125,6 +125,17 @@ def test_mission_set_current_while_flying_turns_to_that_item() -> None:
     assert f.currents == [0, 1, 3] and [s for s, _ in f.reached] == [0, 3]
 
 
+def test_a_new_upload_while_flying_is_flown_from_its_current_item() -> None:
+    f = Flight([TAKEOFF_ITEM, wp(30, 0), wp(30, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1)
+    new = Flight([wp(0, 20), wp(-10, 20)]).store.plan(PLAN_MISSION).items
+    f.store.replace(PLAN_MISSION, new, current_seq=1)  # what a completed upload does
+    f.run_until(lambda: f.store.finished)
+    f.v.run_for(6.0)
+    assert f.at(-10, 20) < 1.0 and f.store.seq_reached == 1
+
+
 def test_waypoint_hold_time_and_loiter_time_wait_there() -> None:
     f = Flight([TAKEOFF_ITEM, wp(8, 0, 5.0, 3.0), wp(0, 0, 5.0, 4.0, cmd=LOITER_TIME), wp(0, 8)])
     f.start()
@@ -162,6 +173,20 @@ def test_change_speed_limits_the_cruise_speed() -> None:
     f = Flight([TAKEOFF_ITEM, do(DO_CHANGE_SPEED, 1, 2.0, -1), wp(40, 0)])
     f.start()
     f.run_until(lambda: f.store.current_seq == 2)
+    peak = 0.0
+    while not f.store.finished:
+        f.run_until(lambda: True)
+        peak = max(peak, f.speed)
+    assert 1.8 < peak < 2.2
+
+
+def test_a_resumed_mission_keeps_the_changed_speed() -> None:
+    f = Flight([TAKEOFF_ITEM, do(DO_CHANGE_SPEED, 1, 2.0, -1), wp(20, 0), wp(20, 30)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 3)
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 3) == MavResult.ACCEPTED  # Hold
+    f.run_until(lambda: f.speed < 0.1, 10.0)
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 4) == MavResult.ACCEPTED  # and on
     peak = 0.0
     while not f.store.finished:
         f.run_until(lambda: True)
