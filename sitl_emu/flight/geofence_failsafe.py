@@ -9,7 +9,8 @@ After src/modules/commander/failsafe/failsafe.cpp (fromGfActParam, checked with 
 - 4 Terminate: TERMINATION, never cleared while armed (the commander keeps an armed vehicle in termination).
 Hold, Return and Land clear on a mode change or disarming (OnModeChangeOrDisarm); a mode change while the fence is
 still breached is the user taking over: the action stops and starts again only after the breach cleared and comes
-back (the action stays registered while its condition holds, so it is not re-added).
+back (the action stays registered while its condition holds, so it is not re-added). A GF_ACTION changed during a
+breach changes the registered action (checkFailsafe updates it, keeping its delay and clear condition).
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ class GeofenceFailsafe:
         self._breached = False
         self._taken_over = False
         self._fail_act_us = 0
+        self._gf_action = -1
 
     def reset(self) -> None:
         """Arming, disarming or a user mode change: the action ends; while the breach lasts it stays taken over."""
@@ -56,6 +58,8 @@ class GeofenceFailsafe:
             self._taken_over = False
         elif not self._active and not self._taken_over:
             self._start(now_us, result.action, fail_act_us, worse_than_hold_active)
+        elif self._active and result.action != self._gf_action:  # checkFailsafe: the action follows GF_ACTION
+            self.action, self._gf_action = _ACTION_MODES.get(result.action), result.action
         if self.action is None:
             return None
         if self.action is NavState.AUTO_RTL and user in (NavState.AUTO_RTL, NavState.AUTO_LAND):
@@ -81,7 +85,7 @@ class GeofenceFailsafe:
 
     def _start(self, now_us: int, gf_action: int, fail_act_us: int, worse_than_hold_active: bool) -> None:
         self._active = True  # Warning: registered, no mode
-        self.action = _ACTION_MODES.get(gf_action)
+        self.action, self._gf_action = _ACTION_MODES.get(gf_action), gf_action
         self._fail_act_us = fail_act_us
         if self.action in _DELAYED and fail_act_us > _MIN_DELAY_US and not worse_than_hold_active:
             self._hold_until_us = now_us + fail_act_us

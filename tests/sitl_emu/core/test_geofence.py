@@ -323,3 +323,9 @@ def test_failsafe_sticks_take_over_only_after_the_delay_of_return_or_land():
     quick.update(0, BREACH[GF_ACTION_LAND], NavState.POSCTL, 0, False)
     assert not quick.sticks_may_take_over(1 * S)
     assert GeofenceFailsafe().sticks_may_take_over(0)
+
+
+def test_failsafe_action_follows_a_gf_action_change_during_the_breach():
+    f = GeofenceFailsafe()
+    assert f.update(0, BREACH[GF_ACTION_WARN], NavState.OFFBOARD, 5 * S, False) is None
+    assert f.update(1 * S, BREACH[GF_ACTION_TERMINATE], NavState.OFFBOARD, 5 * S, False) is NavState.TERMINATION

@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.px4 import MavCmd, MavResult, NavState
+from sitl_emu.px4 import MavCmd, MavResult, MavState, NavState
 from sitl_emu.testing.client import FlightClient
 from sitl_emu.testing.sim import Sim
 
@@ -263,3 +263,20 @@ def test_reposition_outside_the_fence_is_refused(sim):
     assert abs(north(gcs)) < 1.0
     reposition(sim, gcs, 15.0, 0.0, 5.0)
     gcs.wait(lambda: abs(north(gcs) - 15.0) < 0.5, 20.0, "the allowed reposition")
+
+
+def test_warning_only_reports_and_terminate_stops_the_motors(sim):
+    """GF_ACTION 1: the breach text, no failsafe, the flight goes on; GF_ACTION 4: termination at once (HEARTBEAT
+    FLIGHT_TERMINATION, the vehicle falls)."""
+    gcs = Gcs(sim)
+    fly_up(sim, gcs, {"GF_MAX_HOR_DIST": 15.0, "GF_ACTION": 1})
+    n0 = len(gcs.seen.texts)
+    offboard_to(gcs, 0.0, 25.0, 5.0)
+    gcs.wait(lambda: gcs.seen.pos_ned_m is not None and abs(gcs.seen.pos_ned_m[1] - 25.0) < 1.0, 30.0, "25 m east")
+    assert gcs.texts_after(n0) == ["Geofence: exceeding maximum distance to Home"]
+    assert gcs.in_mode(NavState.OFFBOARD) and gcs.seen.heartbeat.system_status != MAV_STATE_CRITICAL
+    sim.vehicle().params.set("GF_ACTION", 4)
+    gcs.wait(lambda: gcs.in_mode(NavState.TERMINATION), 5.0, "termination")
+    assert gcs.texts_after(n0)[1:] == ["Failsafe activated"]
+    gcs.wait(lambda: gcs.seen.pos_ned_m is not None and gcs.seen.pos_ned_m[2] > -0.5, 10.0, "the fall")
+    assert gcs.seen.heartbeat.system_status == MavState.FLIGHT_TERMINATION
