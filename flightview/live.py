@@ -112,7 +112,7 @@ class LiveView:
         grown = self._trail_sent.get(key) != len(trail) or len(trail) == TRAIL_POINTS
         if self._frames % TRAIL_EVERY == 0 and grown and len(trail) > 1:
             self._trail_sent[key] = len(trail)
-            self.rec.log(f"world/{key}/trail", self.rr.LineStrips3D([list(trail)], colors=[colour], radii=[0.03]))
+            self.rec.log(f"world/{key}/trail", self.rr.LineStrips3D([list(trail)], colors=[colour], radii=[0.05]))
 
     def _log_position_plots(self, key: str, frame: Frame, pos: tuple[float, float, float]) -> None:
         """North, east and altitude: each one entity with two series, the position and the setpoint (NaN: none)."""
@@ -160,7 +160,8 @@ class LiveView:
             rrb.Horizontal(rrb.Spatial3DView(origin="world", name="3D", line_grid=rrb.archetypes.LineGrid3D(
                                visible=True, spacing=1.0), eye_controls=rrb.archetypes.EyeControls3D(
                                position=EYE_POSITION, look_target=EYE_TARGET)),
-                           rrb.Vertical(*plots, rrb.TextLogView(origin="modes", name="modes")),
+                           rrb.Vertical(*plots, rrb.TextLogView(origin="modes", name="modes"),
+                                        row_shares=[2, 2, 2, 2, 1.5, 2]),
                            column_shares=[3, 2]),
             rrb.TimePanel(timeline="flight_time", play_state="following"),  # the live end, however slow the page
             collapse_panels=True)

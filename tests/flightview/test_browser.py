@@ -21,15 +21,16 @@ import pytest
 from support.view_process import require_rerun, view_process, wait_until
 
 CHROMIUM_ARGS = ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-                 "--ignore-gpu-blocklist", "--window-size=1280,720")
-FLOWN_S = 14.0  # the script's moves are over (joyfly's take-off, then 5 s of sticks)
-PAGE_TIMEOUT_S = 120.0  # ~30 s on 2 cores; more for a loaded machine
+                 "--ignore-gpu-blocklist", "--window-size=1024,576")
+FLOWN_S = 15.0  # the script's moves are over (joyfly's take-off, then 5 s of sticks)
+PAGE_TIMEOUT_S = 180.0  # ~30 s on 2 cores; minutes on a machine loaded by other work (software GL)
 FRONT_ARM = (255, 40, 40)  # flightview.live: the vehicle's front arms
 VEHICLE_LINE = (255, 160, 0)  # flightview.live.PALETTE[0]: the first vehicle's position lines
 # take off (joyfly does it), fly a little north-east and turn, then hover until the test stops the demo
 SCRIPT = """\
-8    forward=0.4 right=0.3
-+3   forward=0 right=0 yaw=0.3
+8    forward=0.5
++1.6 forward=0 right=0.5
++1.6 right=0 yaw=0.3
 +2   yaw=0
 +300 end
 """
@@ -95,13 +96,13 @@ def drawn(shot: Path, with_trail: bool = False) -> tuple[bool, str]:
     with Image.open(shot) as full:
         image = full.convert("RGB")
     width, height = image.size
-    scene = image.crop((0, 40, int(width * 0.6), height - 40)).reduce(2)
-    plots = image.crop((int(width * 0.6), 40, width, height - 40)).reduce(2)
+    scene = image.crop((0, 40, int(width * 0.6), height - 40))
+    plots = image.crop((int(width * 0.6), 40, width, height - 40))
     colours = len(set(pixels(scene)))
     arms, trail, lines = count_near(scene, FRONT_ARM), count_near(scene, VEHICLE_LINE), count_near(plots, VEHICLE_LINE)
     report = (f"3D view: {colours} colours, {arms} front-arm pixels, {trail} trail pixels; plots: {lines} pixels "
               "of the vehicle's series")
-    return colours > 50 and arms > 5 and lines > 25 and (trail > 30 or not with_trail), report
+    return colours > 50 and arms > 20 and lines > 200 and (trail > 60 or not with_trail), report
 
 
 def test_the_page_draws_the_vehicle_and_the_plots(tmp_path: Path) -> None:
@@ -135,9 +136,9 @@ def test_the_page_draws_the_vehicle_and_the_plots(tmp_path: Path) -> None:
 
 
 def save_small(shot: Path, target: Path) -> None:
-    """A README-sized copy: 960 px wide, 64 colours."""
+    """A README-sized copy: 960 px wide, 256 colours."""
     from PIL import Image
 
     with Image.open(shot) as image:
         small = image.convert("RGB").resize((960, int(960 * image.height / image.width)), Image.Resampling.LANCZOS)
-    small.quantize(colors=64, method=Image.Quantize.MEDIANCUT).save(target, optimize=True)
+    small.quantize(colors=256, method=Image.Quantize.FASTOCTREE).save(target, optimize=True)
