@@ -13,7 +13,7 @@ from sitl_emu.params.registry import ParamDef, integer, real
 
 PARAMS: list[ParamDef] = [
     integer("SYS_FAILURE_EN", 1, 0, 1),
-    integer("COM_DLL_EXCEPT", 0, 0, 7),
+    integer("COM_DLL_EXCEPT", 0, 0, 31),
     integer("CBRK_FLIGHTTERM", 121212, 0, 121212),
     integer("FD_FAIL_R", 60, 0, 180, "deg"),
     integer("FD_FAIL_P", 60, 0, 180, "deg"),

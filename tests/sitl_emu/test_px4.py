@@ -14,9 +14,9 @@ def test_every_mav_cmd_has_the_number_and_name_of_common_xml():
 
 
 def test_mav_cmd_holds_the_commands_the_emulator_answers():
-    # commander (Commander.cpp handle_command), navigator (DO_SET_MISSION_CURRENT) and the mavlink module
-    assert {int(c) for c in MavCmd} == {20, 21, 22, 176, 179, 185, 186, 192, 224, 241, 246, 300, 400, 401, 410, 510,
-                                        511, 512, 519, 520}
+    # commander (Commander.cpp handle_command: DO_ORBIT too), navigator (DO_SET_MISSION_CURRENT), the mavlink module
+    assert {int(c) for c in MavCmd} == {20, 21, 22, 34, 176, 179, 185, 186, 192, 224, 241, 246, 300, 400, 401, 410, 420,
+                                        510, 511, 512, 519, 520}
 
 
 def test_results_and_severities_match_common_xml():

@@ -60,6 +60,7 @@ class FakeVehicle:
     events: list[VehicleEvent] = field(default_factory=list)
     snap_changes: dict[str, Any] = field(default_factory=dict)
     params: Any = None
+    gcs_heartbeats: int = 0  # ground-station heartbeats the receiver passed on (the data-link watchdog)
 
     def step(self) -> None:
         self.time_us += self.dt_us
@@ -88,6 +89,9 @@ class FakeVehicle:
 
     def reboot(self) -> None:
         self.time_us = 0
+
+    def gcs_heartbeat(self) -> None:
+        self.gcs_heartbeats += 1
 
 
 class Client:
