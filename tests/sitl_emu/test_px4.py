@@ -15,7 +15,7 @@ def test_every_mav_cmd_has_the_number_and_name_of_common_xml():
 
 def test_mav_cmd_holds_the_commands_the_emulator_answers():
     # commander (Commander.cpp handle_command) and the mavlink module (mavlink_receiver.cpp)
-    assert {int(c) for c in MavCmd} == {20, 21, 22, 176, 179, 185, 186, 192, 241, 246, 300, 400, 401, 410, 510, 511,
+    assert {int(c) for c in MavCmd} == {20, 21, 22, 34, 176, 179, 185, 186, 192, 241, 246, 300, 400, 401, 410, 510, 511,
                                         512, 519, 520}
 
 
