@@ -52,6 +52,7 @@ class FenceChecks:
         self.monitor = GeofenceMonitor()
         self._settings: GeofenceSettings = geofence_settings(params)
         self._version = params.version
+        self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
 
     @property
     def settings(self) -> GeofenceSettings:
@@ -61,11 +62,17 @@ class FenceChecks:
 
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
              ref: GeoRef, emit: Emit) -> None:
-        """One navigator geofence check: the result goes to the commander (c.geofence), the texts out, and the Hold
-        position after a breach into the navigator's queue."""
+        """The navigator's geofence work before a commander cycle: the breach check when due, then the mission
+        against the fence when either changed."""
+        if self.monitor.due(now_us, store.plan(PLAN_FENCE)):
+            self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
+        self._check_mission(store, c, emit)
+
+    def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
+                      truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:
+        """One geofence check: the result goes to the commander (c.geofence), the texts out, and the Hold position
+        after a breach into the navigator's queue."""
         plan = store.plan(PLAN_FENCE)
-        if not self.monitor.due(now_us, plan):
-            return
         ready = c.estimator_ready
         inputs = GeofenceInputs(estimate=_geo(ref, estimate_ned_m) if ready else None,
                                 gps=_geo(ref, truth_ned_m) if ready else None, home=home_point(c), landed=c.landed,
@@ -80,6 +87,19 @@ class FenceChecks:
             p = out.reposition
             c.nav_commands.append(NavCommand(NavCommandKind.REPOSITION, p.lat_deg, p.lon_deg, p.alt_amsl_m))
 
+    def _check_mission(self, store: MissionStore, c: Commander, emit: Emit) -> None:
+        """The mission against the fence, again whenever the mission, the fence, home or a parameter changed
+        (mission_base.cpp check_mission_valid): a violation makes the mission invalid and is told once."""
+        home = home_point(c)
+        key = (store.plan(PLAN_MISSION).opaque_id, store.count(PLAN_MISSION), store.plan(PLAN_FENCE).opaque_id,
+               store.count(PLAN_FENCE), home, self.params.version)
+        if key == self._mission_key:
+            return
+        self._mission_key = key
+        text = self.mission_violation(store, c) if store.count(PLAN_MISSION) else None
+        store.fence_violation = text
+        if text is not None:
+            emit(Severity.CRITICAL, "navigator", text, True, True)
 
     def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:
         """Drop a reposition or altitude change whose target the fence forbids (GF_ACTION other than None and

@@ -96,6 +96,7 @@ class MissionStore:
     seq_reached: int = -1
     finished: bool = False
     current_changes: int = 0  # MISSION_SET_CURRENT / MISSION_START requests, for the navigator to follow
+    fence_violation: str | None = None  # the navigator's mission-vs-geofence check (vehicle_fence.py), None: passes
 
     def plan(self, plan_type: int) -> Plan:
         return self.plans[plan_type]
@@ -138,8 +139,8 @@ class MissionStore:
     @property
     def mission_valid(self) -> bool:
         """mission_result.valid: PX4 main's feasibility checks refuse none of the reference's plans (a first waypoint
-        beyond MIS_DIST_1WP still flies), so any stored mission is valid here."""
-        return self.count(PLAN_MISSION) > 0
+        beyond MIS_DIST_1WP still flies); a waypoint outside the geofence does (checkMissionAgainstGeofence)."""
+        return self.count(PLAN_MISSION) > 0 and self.fence_violation is None
 
     def mission_state(self, mode_active: bool = False) -> int:
         """MISSION_CURRENT.mission_state (mavlink_mission.cpp update_mission_state): COMPLETE once the navigator

@@ -280,3 +280,29 @@ def test_warning_only_reports_and_terminate_stops_the_motors(sim):
     assert gcs.texts_after(n0)[1:] == ["Failsafe activated"]
     gcs.wait(lambda: gcs.seen.pos_ned_m is not None and gcs.seen.pos_ned_m[2] > -0.5, 10.0, "the fall")
     assert gcs.seen.heartbeat.system_status == MavState.FLIGHT_TERMINATION
+
+
+def mission_item(gcs: Gcs, sim: Sim, seq: int, north_m: float, east_m: float) -> Any:
+    lat, lon, _ = ned_to_global(_ref(sim), (north_m, east_m, 0.0))
+    return gcs.mav.mission_item_int_encode(1, 1, seq, 6, 16, 0, 1, 0, 0, 0, NAN, round(lat * 1e7), round(lon * 1e7),
+                                           5.0, 0)
+
+
+def test_a_mission_outside_the_fence_is_not_flown(sim):
+    """checkMissionAgainstGeofence (mission_feasibility_checker.cpp): after an upload, a waypoint outside the fence
+    is reported once and makes the mission invalid, so MISSION_START is refused; a fence that holds it makes the same
+    mission valid again."""
+    gcs = Gcs(sim)
+    gcs.wait(lambda: gcs.healthy, 10.0, "healthy")
+    assert gcs.upload(circle(gcs, sim, 20.0), FENCE) == 0
+    n0 = len(gcs.seen.texts)
+    assert gcs.upload([mission_item(gcs, sim, 0, 10.0, 0.0), mission_item(gcs, sim, 1, 50.0, 0.0)], 0) == 0
+    gcs.wait(lambda: "Geofence violation for waypoint 2" in gcs.texts_after(n0), 2.0, "the mission's fence check")
+    assert gcs.command(MavCmd.COMPONENT_ARM_DISARM, 1) == MavResult.ACCEPTED
+    assert gcs.command(MavCmd.MISSION_START, 0, 0) != MavResult.ACCEPTED
+    assert gcs.command(MavCmd.COMPONENT_ARM_DISARM, 0) == MavResult.ACCEPTED
+    assert gcs.upload(circle(gcs, sim, 80.0), FENCE) == 0
+    gcs.spin(0.5)
+    assert gcs.command(MavCmd.COMPONENT_ARM_DISARM, 1) == MavResult.ACCEPTED
+    assert gcs.command(MavCmd.MISSION_START, 0, 0) == MavResult.ACCEPTED
+    assert gcs.texts_after(n0).count("Geofence violation for waypoint 2") == 1
