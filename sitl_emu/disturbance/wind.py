@@ -27,9 +27,10 @@ from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
-from scipy import signal
 
 from sitl_emu.types import Vec3
+
+# scipy.signal is imported where it is used: it takes seconds to import, and a vehicle without turbulence needs none
 
 FT: Final = 0.3048  # m per foot
 TURBULENCE_LEVELS: Final = {"light": 15 * 0.514444, "moderate": 30 * 0.514444, "severe": 45 * 0.514444}  # W20 m/s
@@ -136,6 +137,8 @@ def dryden_transfer_functions(scales: DrydenScales, v_m_s: float) -> list[tuple[
 
 def dryden_psd(scales: DrydenScales, v_m_s: float, omega: np.ndarray) -> list[np.ndarray]:
     """The one-sided Dryden power spectral densities of u, v, w (m^2/s^2 per rad/s) at angular frequencies omega."""
+    from scipy import signal
+
     out = []
     for num, den in dryden_transfer_functions(scales, v_m_s):
         _, h = signal.freqs(num, den, worN=omega)
@@ -145,6 +148,8 @@ def dryden_psd(scales: DrydenScales, v_m_s: float, omega: np.ndarray) -> list[np
 
 def discrete_filters(scales: DrydenScales, v_m_s: float, dt_s: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """The shaping filters discretised with the bilinear transform (b, a for lfilter)."""
+    from scipy import signal
+
     out = []
     for num, den in dryden_transfer_functions(scales, v_m_s):
         b, a, _ = signal.cont2discrete((num, den), dt_s, method="bilinear")
@@ -168,6 +173,8 @@ class DrydenTurbulence:
         if band != self._band:
             self._band = band
             self._filters = discrete_filters(dryden_scales((band + 0.5) * ALTITUDE_BAND_M, self.w20), self.v, self.dt)
+        from scipy import signal
+
         noise = self._rng.standard_normal((3, n)) * math.sqrt(math.pi / self.dt)  # one-sided PSD 1 per rad/s
         out = np.empty((n, 3))
         for i, (b, a) in enumerate(self._filters):
