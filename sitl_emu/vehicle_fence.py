@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
+from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.geofence import (
     GF_ACTION_NONE,
     GF_ACTION_WARN,
@@ -24,6 +24,7 @@ from sitl_emu.flight.geofence import (
 )
 from sitl_emu.flight.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
 from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore
+from sitl_emu.flight.nav_commands import NavCommand, NavCommandKind
 from sitl_emu.flight.rally import choose_destination
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global

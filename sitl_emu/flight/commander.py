@@ -10,22 +10,22 @@ UserModeIntention.cpp, failsafe/failsafe.cpp. See ../shared/reference/px4-behavi
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
-from enum import Enum
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import arming
-from sitl_emu.flight.failsafe import Failsafe, FallbackSettings
-from sitl_emu.flight.fault_failsafes import FaultFlags, FaultSettings
+from sitl_emu.flight.commander_settings import CommanderSettings
+from sitl_emu.flight.failsafe import Failsafe
+from sitl_emu.flight.fault_failsafes import FaultFlags
 from sitl_emu.flight.geofence import NO_BREACH, GeofenceResult
-from sitl_emu.flight.manual_control import INPUT_DISABLED, ManualControlSignal, ManualLossSettings
+from sitl_emu.flight.manual_control import ManualControlSignal
 from sitl_emu.flight.mission_store import MissionStore
 from sitl_emu.flight.mode_intention import ModeIntention
+from sitl_emu.flight.nav_commands import NavCommand
 from sitl_emu.flight.offboard import OffboardSignal
 from sitl_emu.flight.stick_gestures import Gesture, GestureDetector, StickMotion
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import AUTO_MODES, MANUAL_MODES, MANUAL_THRUST_MODES, UI_NAMES, MavState, NavState, Severity
-from sitl_emu.types import NAN, HomePosition, ManualControlSetpoint, OffboardControlMode, Vec3
+from sitl_emu.types import HomePosition, ManualControlSetpoint, OffboardControlMode, Vec3
 
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
@@ -34,63 +34,6 @@ NedOf = Callable[[float, float, float], Vec3]
 # the current position as a home candidate, None while the estimator is not ready (called only when home is set:
 # at arming, when first ready, on DO_SET_HOME)
 Here = Callable[[], HomePosition | None]
-
-
-@dataclass(frozen=True, slots=True)
-class CommanderSettings:
-    """The commander's parameters, read once per parameter change (commander_params.yaml names)."""
-
-    of_loss_us: int  # COM_OF_LOSS_T
-    disarm_land_us: int  # COM_DISARM_LAND (<= 0: off)
-    preflight_disarm_us: int  # COM_SPOOLUP_TIME + COM_DISARM_PRFLT (COM_DISARM_PRFLT <= 0: off)
-    home_enabled: bool  # COM_HOME_EN
-    fallback: FallbackSettings  # COM_OBL_RC_ACT, NAV_RCL_ACT
-    rc_loss_us: int  # COM_RC_LOSS_T
-    rc_in_mode: int  # COM_RC_IN_MODE
-    manual_loss: ManualLossSettings  # NAV_RCL_ACT, COM_RCL_EXCEPT, COM_FAIL_ACT_T
-    arm_gesture: bool  # MAN_ARM_GESTURE
-    override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
-    faults: FaultSettings  # NAV_DLL_ACT, COM_LOW_BAT_ACT, CBRK_FLIGHTTERM... (flight/fault_failsafes.py)
-
-    @classmethod
-    def from_params(cls, p: ParamRegistry) -> CommanderSettings:
-        prflt_s = float(p["COM_DISARM_PRFLT"])
-        return cls(
-            of_loss_us=int(float(p["COM_OF_LOSS_T"]) * 1e6),
-            disarm_land_us=int(float(p["COM_DISARM_LAND"]) * 1e6),
-            preflight_disarm_us=int((float(p["COM_SPOOLUP_TIME"]) + prflt_s) * 1e6) if prflt_s > 0 else 0,
-            home_enabled=bool(p["COM_HOME_EN"]),
-            fallback=FallbackSettings(obl_rc_act=int(p["COM_OBL_RC_ACT"]), rcl_act=int(p["NAV_RCL_ACT"])),
-            rc_loss_us=int(float(p["COM_RC_LOSS_T"]) * 1e6),
-            rc_in_mode=int(p["COM_RC_IN_MODE"]),
-            manual_loss=ManualLossSettings(rcl_act=int(p["NAV_RCL_ACT"]), rcl_except=int(p["COM_RCL_EXCEPT"]),
-                                           fail_act_us=int(float(p["COM_FAIL_ACT_T"]) * 1e6),
-                                           input_disabled=int(p["COM_RC_IN_MODE"]) == INPUT_DISABLED),
-            arm_gesture=int(p["MAN_ARM_GESTURE"]) == 1,
-            override_speed=float(p["MAN_OVERRIDE_SPD"]),
-            faults=FaultSettings.from_params(p),
-        )
-
-
-class NavCommandKind(Enum):
-    TAKEOFF = "takeoff"
-    REPOSITION = "reposition"
-    CHANGE_ALTITUDE = "change_altitude"
-    ORBIT = "orbit"  # DO_ORBIT: the orbit flight task applies it (flight/tasks_orbit.py)
-
-
-@dataclass(frozen=True, slots=True)
-class NavCommand:
-    """A request for the navigator that comes with a command (global coordinates, NaN = keep current)."""
-
-    kind: NavCommandKind
-    lat_deg: float = NAN
-    lon_deg: float = NAN
-    alt_amsl_m: float = NAN
-    yaw_rad: float = NAN
-    speed_m_s: float = NAN
-    radius_m: float = NAN  # DO_ORBIT param1 (the sign is the direction); speed_m_s is its param2
-    yaw_behaviour: float = NAN  # DO_ORBIT param3 (ORBIT_YAW_BEHAVIOUR)
 
 
 def _nowhere() -> HomePosition | None:

@@ -10,7 +10,8 @@ import math
 from collections.abc import Callable
 
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight.commander import Commander, NavCommand, NavCommandKind
+from sitl_emu.flight.commander import Commander
+from sitl_emu.flight.nav_commands import NavCommand, NavCommandKind
 from sitl_emu.px4 import (
     MODE_FLAG_AUTO_ENABLED,
     MODE_FLAG_CUSTOM_MODE_ENABLED,

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight import tasks, tasks_orbit
-from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.follow_estimator import TargetFix
 from sitl_emu.flight.manual_control import CENTRED
 from sitl_emu.flight.mission_store import MissionStore
+from sitl_emu.flight.nav_commands import NavCommand, NavCommandKind
 from sitl_emu.flight.stabilized import StabilizedMode
 from sitl_emu.flight.tasks import SetpointType
 from sitl_emu.flight.tasks_follow import FollowTargetTask

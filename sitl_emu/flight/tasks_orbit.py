@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.control.qmath import constrain, isfinite
-from sitl_emu.flight.commander import NavCommand
+from sitl_emu.flight.nav_commands import NavCommand
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.flight.sticks import stick_expo
 from sitl_emu.flight.tasks_core import NavInput, SetpointType, wrap_pi

@@ -9,8 +9,8 @@ import math
 
 import pytest
 
-from sitl_emu.flight.commander import NavCommand, NavCommandKind
 from sitl_emu.flight.follow_estimator import STALE_US, TargetEstimator, TargetFix
+from sitl_emu.flight.nav_commands import NavCommand, NavCommandKind
 from sitl_emu.flight.tasks_core import NavInput
 from sitl_emu.flight.tasks_follow import FollowTargetTask
 from sitl_emu.flight.tasks_orbit import FailedOrbitHold, OrbitSettings, OrbitTask, apply_orbit, sanitize
