@@ -13,6 +13,7 @@ from typing import Any
 
 from flightview.launch import ViewHandle
 from flightview.scene import Frame
+from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.px4 import mode_name
 from sitl_emu.types import VehicleSnapshot
 
@@ -21,15 +22,25 @@ def vehicle_key(sysid: int) -> str:
     return f"sysid{sysid}"
 
 
-def snapshot_frame(snap: VehicleSnapshot, sticks: tuple[float, float, float, float] | None) -> Frame:
-    """What the view shows of one vehicle, from its snapshot."""
+def snapshot_frame(snap: VehicleSnapshot, sticks: tuple[float, float, float, float] | None,
+                   origin: GeoRef | None = None) -> Frame:
+    """What the view shows of one vehicle, from its snapshot; positions in the local frame of `origin` (the first
+    vehicle's: each vehicle of a --count has its own local frame, with its own home as origin), else its own."""
+    offset = (0.0, 0.0, 0.0)
+    if origin is not None:
+        offset = global_to_ned(origin, snap.ref_lat_deg, snap.ref_lon_deg, snap.ref_alt_amsl_m)
     sp = snap.local_setpoint
     setpoint = None
     if sp is not None and not any(math.isnan(c) for c in sp.position_ned_m):
-        setpoint = sp.position_ned_m
-    home = snap.home.pos_ned_m if snap.home is not None else None
-    return Frame(time_s=snap.time_us / 1e6, pos_ned_m=snap.pos_ned_m, q_wxyz=snap.q_wxyz, setpoint_ned_m=setpoint,
-                 home_ned_m=home, mode=mode_name(snap.nav_state), armed=snap.armed, sticks=sticks)
+        setpoint = _shift(sp.position_ned_m, offset)
+    home = _shift(snap.home.pos_ned_m, offset) if snap.home is not None else None
+    return Frame(time_s=snap.time_us / 1e6, pos_ned_m=_shift(snap.pos_ned_m, offset), q_wxyz=snap.q_wxyz,
+                 setpoint_ned_m=setpoint, home_ned_m=home, mode=mode_name(snap.nav_state), armed=snap.armed,
+                 sticks=sticks)
+
+
+def _shift(v: tuple[float, float, float], by: tuple[float, float, float]) -> tuple[float, float, float]:
+    return (v[0] + by[0], v[1] + by[1], v[2] + by[2])
 
 
 def manual_sticks(vehicle: Any, snap: VehicleSnapshot) -> tuple[float, float, float, float] | None:
@@ -55,8 +66,11 @@ class ServeView:
         live = self.handle.live
         if not live.due():
             return
+        origin = None
         for node in self.nodes:
             vehicle = node.vehicle
             snap = vehicle.snapshot()
-            live.log(vehicle_key(node.sysid), snapshot_frame(snap, manual_sticks(vehicle, snap)))
+            if origin is None and len(self.nodes) > 1:
+                origin = GeoRef(snap.ref_lat_deg, snap.ref_lon_deg, snap.ref_alt_amsl_m)
+            live.log(vehicle_key(node.sysid), snapshot_frame(snap, manual_sticks(vehicle, snap), origin))
         live.end_frame()
