@@ -121,8 +121,7 @@ class Vehicle:
         motors = self._motor_commands = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config())
         self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
-        climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
-        detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
+        detected = chain.land(self._estimate, c.armed, out, now)
         if detected is not None:
             c.on_land_detector(detected.landed, detected.maybe_landed)
         if out.messages:  # the task said something this tick
