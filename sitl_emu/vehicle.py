@@ -147,8 +147,7 @@ class Vehicle:
         self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
         if faults.noise is not None:
             self._estimate = faults.estimate(self._estimate, dt_s)
-        climb_rate_controlled = out.attitude is None and out.setpoint_type is not SetpointType.NONE
-        detected = chain.land(self._estimate, c.armed, climb_rate_controlled, now)
+        detected = chain.land(self._estimate, c.armed, out, now)
         if detected is not None:
             c.on_land_detector(detected.landed, detected.maybe_landed)
         if out.messages:  # the task said something this tick

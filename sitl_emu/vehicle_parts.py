@@ -15,7 +15,7 @@ from sitl_emu.control.qmath import isfinite, norm, yaw_from_q
 from sitl_emu.flight.commander import Commander
 from sitl_emu.flight.land_detector import LandDetector, LandDetectorInput, LandDetectorState
 from sitl_emu.flight.mode_executor import ExecutorOutput, ModeExecutor
-from sitl_emu.flight.tasks_core import IDLE_ACC_Z_M_S2, NavInput
+from sitl_emu.flight.tasks_core import IDLE_ACC_Z_M_S2, NavInput, SetpointType
 from sitl_emu.geo import GeoRef
 from sitl_emu.params import ParamRegistry
 from sitl_emu.params.settings import cascade_settings
@@ -66,13 +66,10 @@ class ControlChain:
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)
 
-    def land(self, est: RigidBodyState, armed: bool, climb_rate_controlled: bool,
-             now_us: int) -> LandDetectorState | None:
+    def land(self, est: RigidBodyState, armed: bool, out: ExecutorOutput, now_us: int) -> LandDetectorState | None:
         """Run the land detector on the new state when it is due: at 50 Hz, and at once when arming changes. Its new
-        state (PX4's vehicle_land_detected), or None when it did not run this tick.
-
-        `climb_rate_controlled` is PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard
-        position/velocity/acceleration (not offboard attitude/rates, not manual modes)."""
+        state (PX4's vehicle_land_detected), or None when it did not run this tick. `out` is this tick's executor
+        output: whether the climb rate is controlled (see climb_rate_controlled)."""
         if now_us < self._land_next_us and armed == self._land_armed:
             return None
         self._land_next_us, self._land_armed = now_us + LAND_DETECTOR_PERIOD_US, armed
@@ -81,9 +78,15 @@ class ControlChain:
             time_us=now_us, armed=armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
             specific_force_norm_m_s2=norm(est.specific_force_frd), thrust_setpoint=ctrl.thrust_setpoint,
             hover_thrust=ctrl.hover_thrust, setpoint_vz_m_s=descent_vz(ctrl.local_setpoint),
-            in_descent_mode=climb_rate_controlled))
+            in_descent_mode=climb_rate_controlled(out)))
         self.ground_contact = state.ground_contact
         return state
+
+
+def climb_rate_controlled(out: ExecutorOutput) -> bool:
+    """PX4's control_mode.flag_control_climb_rate_enabled: auto modes and offboard position/velocity/acceleration
+    (not offboard attitude/rates, not manual modes)."""
+    return out.attitude is None and out.setpoint_type is not SetpointType.NONE
 
 
 def published_setpoints(ctrl: MulticopterControl, nav_state: NavState, armed: bool,

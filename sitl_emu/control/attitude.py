@@ -18,6 +18,7 @@ from sitl_emu.control.qmath import (
     constrain3,
     dcm_z,
     isfinite,
+    q_between,
     q_canonical,
     q_from_two_vectors,
     q_inv,
@@ -61,11 +62,11 @@ class AttitudeControl:
         else:
             qd_red = q_mul(qd_red, q)
         # mix the full and the reduced setpoint: the yaw part only with weight yaw_w
-        q_mix = q_canonical(q_mul(q_inv(qd_red), q_sp))
+        q_mix = q_canonical(q_between(qd_red, q_sp))
         w, z = constrain(q_mix[0], -1.0, 1.0), constrain(q_mix[3], -1.0, 1.0)
         qd = q_mul(qd_red, (cos(self._yaw_w * acos(w)), 0.0, 0.0, sin(self._yaw_w * asin(z))))
         # quaternion attitude control law, qe the rotation from q to qd
-        qe = q_canonical(q_mul(q_inv(q), qd))
+        qe = q_canonical(q_between(q, qd))
         rate_sp = (2.0 * qe[1] * self._kp[0], 2.0 * qe[2] * self._kp[1], 2.0 * qe[3] * self._kp[2])
         if yawspeed_ff_rad_s != 0.0 and isfinite(yawspeed_ff_rad_s):
             # feed-forward the yaw rate about the world z axis, expressed in the body frame

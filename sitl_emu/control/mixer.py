@@ -73,10 +73,10 @@ def _desaturation_gain(vec: Vec4, u: Vec4, hi: float) -> float:
             continue
         if u[i] < 0.0:
             k = -u[i] / vec[i]
-            k_min, k_max = min(k_min, k), max(k_max, k)
+            k_min, k_max = (k if k < k_min else k_min), (k if k > k_max else k_max)
         if u[i] > hi:
             k = (hi - u[i]) / vec[i]
-            k_min, k_max = min(k_min, k), max(k_max, k)
+            k_min, k_max = (k if k < k_min else k_min), (k if k > k_max else k_max)
     return k_min + k_max
 
 
@@ -103,6 +103,8 @@ def _saturation_flags(achieved: Vec3, demand: Vec3) -> tuple[Flags3, Flags3]:
 
 def allocated_torque(u: Vec4) -> Vec3:
     """Normalised torque that motor commands u produce (inverse of the mix above)."""
-    return (sum(ROLL[i] * u[i] for i in range(4)) / (4 * _K * _K),
-            sum(PITCH[i] * u[i] for i in range(4)) / (4 * _K * _K),
-            sum(YAW[i] * u[i] for i in range(4)) / 4.0)
+    return _dot4(ROLL, u) / (4 * _K * _K), _dot4(PITCH, u) / (4 * _K * _K), _dot4(YAW, u) / 4.0
+
+
+def _dot4(a: Vec4, b: Vec4) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]

@@ -25,6 +25,16 @@ def q_inv(q: Vec4) -> Vec4:
     return q[0], -q[1], -q[2], -q[3]
 
 
+def q_between(a: Vec4, b: Vec4) -> Vec4:
+    """The rotation from unit quaternion a to b: q_mul(q_inv(a), b), PX4's `a.inversed() * b`, multiplied out."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw + ax * bx + ay * by + az * bz,
+            aw * bx - ax * bw - ay * bz + az * by,
+            aw * by + ax * bz - ay * bw - az * bx,
+            aw * bz - ax * by + ay * bx - az * bw)
+
+
 def q_normalized(q: Vec4) -> Vec4:
     w, x, y, z = q
     n = math.sqrt(w * w + x * x + y * y + z * z)
