@@ -91,6 +91,7 @@ class ModeExecutor:
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[tasks.NavInput], tuple[Vec3, float] | None] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
+        self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
     def attach_missions(self, store: MissionStore) -> None:
         """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
@@ -102,7 +103,6 @@ class ModeExecutor:
         if isinstance(task, MissionTask) and task.wants_rtl:
             return NavState.AUTO_RTL
         return None
-        self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
     def offboard(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None,
                  attitude: AttitudeSetpoint | None) -> None:
