@@ -358,7 +358,9 @@ async def _failure_injection(mavsdk_asyncio: Any, port: int, s: Session) -> None
         with pytest.raises(FailureError) as denied:
             await s.call("Failure.inject(GPS, OFF, 0) disabled", failure.inject(FailureUnit.SENSOR_GPS,
                                                                               FailureType.OFF, 0))
-        assert denied.value.result.name == "DENIED"
+        # DISABLED: MAVSDK read SYS_FAILURE_EN = 0 first and did not send (failure_impl.cpp); DENIED: it sent the
+        # command before its parameter read finished and the vehicle denied it. Which one depends on that race.
+        assert denied.value.result.name in ("DENIED", "DISABLED")
         await s.call("Param.set_param_int(SYS_FAILURE_EN, 1)", param.set_param_int("SYS_FAILURE_EN", 1))
         await s.call("Action.arm", action.arm())
         await s.call("Action.takeoff", action.takeoff())
