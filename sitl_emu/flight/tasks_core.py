@@ -4,7 +4,8 @@
 `src/modules/flight_mode_manager/tasks/Auto/FlightTaskAuto.cpp` does: per-cycle trajectory constraints
 (_updateTrajConstraints: takeoff speed/acceleration near the ground, MPC_ACC_UP_MAX/MPC_Z_V_AUTO_UP upwards,
 MPC_ACC_DOWN_MAX/MPC_Z_V_AUTO_DN downwards), the land speed profile (_prepareLandSetpoints), the idle setpoint,
-heading towards the waypoint (MPC_YAW_MODE 0) and the yaw-rate limit (_limitYawRate, MPC_YAWRAUTO_MAX).
+heading towards the waypoint (MPC_YAW_MODE 0) and its smoothing (_smoothYaw: heading.py, MPC_YAWRAUTO_MAX and
+MPC_YAWRAUTO_ACC).
 It also reproduces FlightModeManager's reset of the trajectory while the takeoff ramp has not started
 (`src/modules/flight_mode_manager/FlightModeManager.cpp` generateTrajectorySetpoint -> FlightTaskAuto::reActivate).
 """
@@ -16,8 +17,10 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any, Final
 
-from sitl_emu.control.qmath import constrain, isfinite
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.flight.heading import HeadingSmoother
+from sitl_emu.flight.heading import wrap_pi as wrap_pi  # the tasks import it from here
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
@@ -28,7 +31,6 @@ REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajecto
 IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
 _NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
-_TWO_PI: Final = 2.0 * math.pi
 
 
 class SetpointType(Enum):
@@ -107,6 +109,8 @@ class AutoSettings:
     xy_cruise: float
     xy_err_max: float
     yawrate_max_rad_s: float
+    yawacc_max_rad_s2: float
+    yaw_err_rad: float
     yaw_mode: int
     nav_acc_rad: float
     nav_mc_alt_rad: float
@@ -121,7 +125,8 @@ class AutoSettings:
     @classmethod
     def from_params(cls, params: ParamRegistry) -> AutoSettings:
         values: dict[str, Any] = {f: _get(params, name, default) for f, (name, default) in _PARAM_NAMES.items()}
-        values["yawrate_max_rad_s"] = math.radians(values["yawrate_max_rad_s"])
+        for name in ("yawrate_max_rad_s", "yawacc_max_rad_s2", "yaw_err_rad"):
+            values[name] = math.radians(values[name])
         values["yaw_mode"] = int(values["yaw_mode"])
         return cls(**values)
 
@@ -134,7 +139,8 @@ _PARAM_NAMES: dict[str, tuple[str, float]] = {
     "tko_ramp_t": ("MPC_TKO_RAMP_T", 3.0), "land_speed": ("MPC_LAND_SPEED", 0.7),
     "land_crawl": ("MPC_LAND_CRWL", 0.3), "land_alt1": ("MPC_LAND_ALT1", 10.0), "land_alt2": ("MPC_LAND_ALT2", 5.0),
     "land_alt3": ("MPC_LAND_ALT3", 1.0), "xy_cruise": ("MPC_XY_CRUISE", 5.0), "xy_err_max": ("MPC_XY_ERR_MAX", 2.0),
-    "yawrate_max_rad_s": ("MPC_YAWRAUTO_MAX", 60.0), "yaw_mode": ("MPC_YAW_MODE", 0),
+    "yawrate_max_rad_s": ("MPC_YAWRAUTO_MAX", 60.0), "yawacc_max_rad_s2": ("MPC_YAWRAUTO_ACC", 20.0),
+    "yaw_err_rad": ("MIS_YAW_ERR", 12.0), "yaw_mode": ("MPC_YAW_MODE", 0),
     "nav_acc_rad": ("NAV_ACC_RAD", 10.0), "nav_mc_alt_rad": ("NAV_MC_ALT_RAD", 0.8),
     "takeoff_alt": ("MIS_TAKEOFF_ALT", 2.5), "rtl_return_alt": ("RTL_RETURN_ALT", 30.0),
     "rtl_descend_alt": ("RTL_DESCEND_ALT", 10.0), "rtl_land_delay": ("RTL_LAND_DELAY", 0.0),
@@ -145,10 +151,6 @@ _PARAM_NAMES: dict[str, tuple[str, float]] = {
 
 def _get(params: ParamRegistry, name: str, default: float) -> float:
     return float(params.get(name)) if name in params else float(default)
-
-
-def wrap_pi(angle: float) -> float:
-    return (angle + math.pi) % _TWO_PI - math.pi
 
 
 @dataclass(frozen=True, slots=True)
@@ -176,7 +178,8 @@ class AutoCore:
         self._unsmoothed_vz = 0.0
         self._yaw_sp_prev = nav.yaw_rad
         self._yaw_lock: float | None = None
-        self._yawspeed_filt = 0.0
+        self.heading = HeadingSmoother(nav.yaw_rad)  # FlightTaskAuto::activate: no previous setpoint here
+        self.yaw_sp_aligned = False  # FlightTaskAuto's _yaw_sp_aligned
         self._kind_prev: SetpointType | None = None
         self._land_heading = NAN
         self.want_takeoff = False
@@ -194,7 +197,7 @@ class AutoCore:
         else:
             vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
-        yaw, yawspeed = self._limit_yaw_rate(nav, self._yaw_target(nav, wp), dt_s)
+        yaw, yawspeed = self._smooth_yaw(self._yaw_target(nav, wp), dt_s)
         self._kind_prev = kind
         ax, ay, az = self.smoother.axes
         out = TrajectorySetpoint((ax.x, ay.x, az.x), (ax.v, ay.v, az.v), (ax.a, ay.a, az.a), yaw, yawspeed)
@@ -218,6 +221,8 @@ class AutoCore:
     def _idle(self, nav: NavInput) -> TrajectorySetpoint:
         self.smoother.reset((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), nav.pos_ned_m)
         self._kind_prev, self.want_takeoff, self._yaw_sp_prev = SetpointType.IDLE, False, nav.yaw_rad
+        self.heading.reset(nav.yaw_rad, 0.0)  # _smoothYaw without a heading setpoint
+        self.yaw_sp_aligned = True
         return _IDLE_SETPOINT  # frozen: one shared instance
 
     def _hold_before_ramp(self, nav: NavInput, out: TrajectorySetpoint) -> TrajectorySetpoint:
@@ -278,19 +283,16 @@ class AutoCore:
             self._yaw_lock = nav.yaw_rad
         return self._yaw_lock
 
-    def _limit_yaw_rate(self, nav: NavInput, yaw_sp: float, dt_s: float) -> tuple[float, float]:
-        """FlightTaskAuto::_limitYawRate: rate-limit the heading and feed its filtered rate forward."""
-        prev = self._yaw_sp_prev if isfinite(self._yaw_sp_prev) else nav.yaw_rad
-        max_rate = self.s.yawrate_max_rad_s
-        max_step = max_rate * dt_s
-        dyaw = constrain(wrap_pi(yaw_sp - prev), -max_step, max_step)
-        yaw_sp = wrap_pi(prev + dyaw)
-        if dt_s > 0.0:
-            alpha = dt_s / (dt_s + 0.2)
-            self._yawspeed_filt += alpha * (dyaw / dt_s - self._yawspeed_filt)
-        self._yaw_sp_prev = yaw_sp
-        return yaw_sp, constrain(self._yawspeed_filt, -max_rate, max_rate)
-
+    def _smooth_yaw(self, yaw_sp: float, dt_s: float) -> tuple[float, float]:
+        """FlightTaskAuto::_smoothYaw: the heading setpoint through HeadingSmoothing (rate and acceleration
+        limited), aligned when within MIS_YAW_ERR of the target and not turning at the rate limit."""
+        s, heading = self.s, self.heading
+        heading.set_limits(s.yawrate_max_rad_s, s.yawacc_max_rad_s2)
+        heading.update(yaw_sp, dt_s)
+        yaw, rate = heading.heading_rad, heading.rate_rad_s
+        self.yaw_sp_aligned = abs(wrap_pi(yaw_sp - yaw)) < s.yaw_err_rad and abs(rate) < s.yawrate_max_rad_s
+        self._yaw_sp_prev = yaw
+        return yaw, rate
 
 class Task:
     """One activation of an auto mode. Subclasses implement `_waypoint(nav)`."""

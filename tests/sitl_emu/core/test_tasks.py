@@ -315,7 +315,7 @@ def test_rtl_landed_stays_idle(params):
 # ---------------------------------------------------------------- reposition
 
 
-def test_reposition_flies_at_the_given_speed_and_turns_at_the_yaw_rate_limit(params):
+def test_reposition_flies_at_the_given_speed_and_turns_within_the_yaw_rate_and_acceleration_limits(params):
     pm = hovering(-10.0)
     task = make_reposition(pm.nav(), params, (30.0, 0.0, -15.0), math.pi / 2, 2.0)
     pm.fly(task, 30.0)
@@ -324,10 +324,12 @@ def test_reposition_flies_at_the_given_speed_and_turns_at_the_yaw_rate_limit(par
     assert max(math.hypot(*sp.velocity_ned_m_s[:2]) for *_, sp in pm.history) <= 2.0 * 1.03
     yaws = [sp.yaw_rad for *_, sp in pm.history]
     assert yaws[-1] == pytest.approx(math.pi / 2, abs=1e-3)
-    max_rate = max(abs(b - a) for a, b in itertools.pairwise(yaws)) / DT
-    assert max_rate <= math.radians(60.0) + 1e-6  # MPC_YAWRAUTO_MAX
+    rates = [(b - a) / DT for a, b in itertools.pairwise(yaws)]
+    assert max(map(abs, rates)) <= math.radians(60.0) + 1e-6  # MPC_YAWRAUTO_MAX
+    assert max(abs(b - a) for a, b in itertools.pairwise(rates)) / DT <= math.radians(20.0) * 1.01  # MPC_YAWRAUTO_ACC
+    # HeadingSmoothing: 90 deg at 20 deg/s^2 never reaches 60 deg/s: accelerate half way, brake the other half
     t_turned = next(t for (t, *_), y in zip(pm.history, yaws, strict=True) if abs(y - math.pi / 2) < 1e-3)
-    assert t_turned == pytest.approx(1.5, abs=0.1)
+    assert t_turned == pytest.approx(2.0 * math.sqrt(90.0 / 20.0), abs=0.1)
 
 
 def test_reposition_nan_components_keep_the_current_position(params):
