@@ -62,6 +62,8 @@ DEFAULT_MODULES = (
     "sitl_emu/flight/tasks.py",
     "sitl_emu/flight/tasks_core.py",
     "sitl_emu/flight/tasks_manual.py",
+    "sitl_emu/flight/tasks_mission.py",
+    "sitl_emu/flight/tasks_orbit.py",
     "sitl_emu/flight/tasks_rtl.py",
     "sitl_emu/vehicle.py",
     "sitl_emu/vehicle_parts.py",
