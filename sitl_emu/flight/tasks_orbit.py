@@ -25,10 +25,11 @@ from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.control.qmath import constrain, isfinite
+from sitl_emu.flight.heading import HeadingSmoother
 from sitl_emu.flight.nav_commands import NavCommand
 from sitl_emu.flight.smoothing import PositionSmoother
 from sitl_emu.flight.sticks import stick_expo
-from sitl_emu.flight.tasks_core import NavInput, SetpointType, wrap_pi
+from sitl_emu.flight.tasks_core import NavInput, SetpointType
 from sitl_emu.flight.tasks_manual import TASK_PERIOD_US, ManualAltitudeTask, ManualSettings, VerticalSmoothing
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.params import ParamRegistry
@@ -69,20 +70,6 @@ class OrbitSettings:
                    f("MPC_XY_VEL_MAX"), f("MPC_XY_ERR_MAX"), f("MPC_JERK_AUTO"), f("MPC_ACC_UP_MAX"),
                    f("MPC_ACC_DOWN_MAX"), f("MPC_Z_V_AUTO_UP"), f("MPC_Z_V_AUTO_DN"), f("NAV_MC_ALT_RAD"),
                    math.radians(f("MPC_YAWRAUTO_MAX")), math.radians(f("MPC_YAWRAUTO_ACC")))
-
-
-class HeadingSmoother:
-    """HeadingSmoothing: the heading follows its target with a limited rate and angular acceleration."""
-
-    def __init__(self, heading: float, rate: float) -> None:
-        self.heading, self.rate = heading, rate
-
-    def update(self, target: float, max_rate: float, max_acc: float, dt_s: float) -> None:
-        err = wrap_pi(target - self.heading)
-        wanted = math.copysign(min(max_rate, math.sqrt(2.0 * max_acc * abs(err))), err)
-        step = max_acc * dt_s
-        self.rate = constrain(wanted, self.rate - step, self.rate + step)
-        self.heading = wrap_pi(self.heading + self.rate * dt_s)
 
 
 def sanitize(radius: float, velocity: float, o: OrbitSettings) -> tuple[float, float]:
@@ -238,11 +225,13 @@ class OrbitTask(ManualAltitudeTask):
         """HeadingSmoothing on the yaw setpoint; its rate is the feed-forward only while approaching."""
         h = self._heading
         if not isfinite(sp.yaw_rad):
-            h.heading, h.rate = nav.yaw_rad, 0.0
+            h.reset(nav.yaw_rad, 0.0)
             return sp
-        h.update(sp.yaw_rad, self.o.yawrate_max, self.o.yawacc_max, dt_s)
-        rate = h.rate if self._approaching else sp.yawspeed_rad_s
-        return TrajectorySetpoint(sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2, h.heading, rate)
+        h.set_limits(self.o.yawrate_max, self.o.yawacc_max)
+        h.update(sp.yaw_rad, dt_s)
+        rate = h.rate_rad_s if self._approaching else sp.yawspeed_rad_s
+        return TrajectorySetpoint(sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2, h.heading_rad,
+                                  rate)
 
     # ---- what it reports -------------------------------------------------------------------------------------------
     def status(self, ref: GeoRef) -> OrbitStatus:
