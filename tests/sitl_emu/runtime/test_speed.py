@@ -50,7 +50,7 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
         lockstep = fly_square(client)
         client.close()
     api, gcs, sink = free_udp_ports(3)
-    proc = _serve(20.0, api, gcs, sink, sink)
+    proc = _serve(20.0, api, gcs, sink, sink, "--no-log")  # about simulated time; logs: tests/sitl_emu/log
     try:
         assert proc.stdout is not None
         proc.stdout.readline()
