@@ -32,7 +32,7 @@ test-compiled: $(STAMP)
 
 compiled-check:
 	rm -rf $(CHECK_DIR) && mkdir -p $(CHECK_DIR)
-	cp -r sitl_emu joyfly flightview tests tools pyproject.toml $(CHECK_DIR)/
+	cp -r sitl_emu joyfly flightview tests tools examples pyproject.toml $(CHECK_DIR)/
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m core
 
