@@ -77,6 +77,8 @@ class Commander:
         self._last_reject_text_us: int | None = None
         self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle_faults.py)
         self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (flight/geofence_monitor.py)
+        self._checks_key: tuple[object, ...] = ()  # what pre_flight_checks_pass last ran for
+        self._checks_pass = False
         self.mission_store: MissionStore | None = None  # the stored plans (the Vehicle's), for AUTO.MISSION's checks
 
     @property
@@ -187,8 +189,17 @@ class Commander:
         return arming.can_run(nav_state, self.check_inputs())
 
     def pre_flight_checks_pass(self) -> bool:
-        """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed)."""
-        return arming.can_arm(self.nav_state, self.check_inputs(), self.armed) and not self.geofence.breached
+        """Arming checks pass for the current nav_state (drives system_status STANDBY vs UNINIT when disarmed).
+
+        PX4 runs these checks once per commander cycle; here they run at most once per cycle (the commander's
+        now_us) and again when the mode, the arming state or the geofence result changes, however many snapshots
+        ask in between."""
+        key = (self.now_us, self.nav_state, self.armed, self.geofence)
+        if key != self._checks_key:
+            self._checks_key = key
+            self._checks_pass = arming.can_arm(self.nav_state, self.check_inputs(), self.armed) and \
+                not self.geofence.breached
+        return self._checks_pass
 
     def system_status(self) -> MavState:
         """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
