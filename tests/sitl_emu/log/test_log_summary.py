@@ -11,13 +11,14 @@ import struct
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from support.log_flight import RecordingClient, log_files
 
 from sitl_emu.cli import main
 from sitl_emu.log.plot import INSTALL_HINT
-from sitl_emu.log.summary import read_ulog, summarise
+from sitl_emu.log.summary import mode_label, read_ulog, series, summarise
 from sitl_emu.testing.client import fly_square
 from sitl_emu.testing.sim import Sim
 
@@ -153,3 +154,29 @@ def test_bad_input_is_one_sentence_and_status_2(flown: Flown, tmp_path: Path, ca
     assert out == ""
     assert err.startswith(f"sitl-emu: {path}") and err.endswith(".\n") and err.count("\n") == 1, err
     assert "Traceback" not in err
+
+
+class _Dataset:
+    def __init__(self, data: dict) -> None:
+        self.data = data
+
+
+class _PX4LikeULog:
+    """What pyulog gives for a real PX4 log whose first vehicle_status sample predates the log's start (PX4 logs the
+    last published sample of each topic when the logger starts): uint64 timestamps before start_timestamp."""
+
+    start_timestamp = 5_000_000
+
+    def get_dataset(self, name: str, multi_id: int = 0) -> _Dataset:
+        if name != "vehicle_status":
+            raise KeyError(name)
+        return _Dataset({"timestamp": np.array([4_000_000, 6_000_000, 7_500_000], dtype=np.uint64),
+                         "nav_state": np.array([4, 17, 99], dtype=np.uint8)})
+
+
+def test_samples_before_the_logs_start_and_unknown_modes():
+    t, nav = series(_PX4LikeULog(), "vehicle_status", "nav_state")
+    assert list(t) == pytest.approx([-1.0, 1.0, 2.5])  # negative, not wrapped around 2**64
+    assert list(nav) == [4, 17, 99]
+    assert series(_PX4LikeULog(), "vehicle_local_position", "z") is None
+    assert [mode_label(n) for n in (4, 17, 14, 99)] == ["Hold", "Takeoff", "Offboard", "nav_state 99"]
