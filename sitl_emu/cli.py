@@ -37,6 +37,7 @@ from sitl_emu.cli_options import (
     parse_home,
 )
 from sitl_emu.console import attach_console
+from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
 from sitl_emu.mavlink.link import PortInUseError
 from sitl_emu.runtime.node import LinkSettings
@@ -340,6 +341,7 @@ def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:
 
 
 main.add_command(campaign)  # sitl_emu/campaign/cli.py (issue 16)
+main.add_command(log_command)  # sitl_emu/log/cli.py (issue 15)
 
 
 if __name__ == "__main__":

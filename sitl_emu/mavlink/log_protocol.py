@@ -10,7 +10,9 @@ place in that list.
   last one, num_logs the count, last_log_num `end` (the count when `end` is 0xFFFF), as the rewritten handler does.
 - LOG_REQUEST_DATA {id, ofs, count}, after a listing, streams LOG_DATA in 90-byte pieces (the file's last one
   shorter) from `ofs` until `count` bytes are covered or the file ends; an unknown id, an offset at or past the
-  end, or no listing yet: nothing.
+  end, or no listing yet: nothing (and what was streaming stops). PX4 sums ofs + count in 32 bits: a count near
+  0xFFFFFFFF from an offset past 0 ends the piece after its first LOG_DATA. A new request replaces the one
+  streaming, whether or not the client read it to the end.
 - LOG_REQUEST_END stops what is streaming; LOG_ERASE stops it and erases every log.
 PX4's handler looks at no target; this one answers only requests for its own system (or system 0), since several
 emulated vehicles may share one process.
@@ -147,7 +149,10 @@ class LogProtocol:
             except OSError:
                 return
         log = self._open
-        log.offset, log.end, log.sending = msg.ofs, msg.ofs + msg.count, msg.ofs < log.size_bytes
+        # PX4 adds ofs and count as uint32_t (state_sending_data's chunk_finished), so a huge count from an offset
+        # past 0 wraps to an end just before the offset: one LOG_DATA, then it waits for the next request
+        end = (msg.ofs + msg.count) & 0xFFFFFFFF
+        log.offset, log.end, log.sending = msg.ofs, end, msg.ofs < log.size_bytes
 
     def _on_erase(self, msg: Any, ctx: LinkContext) -> None:
         self._stop()

@@ -150,3 +150,62 @@ def test_erase_removes_every_log(logs):
     _send(h, "LOG_REQUEST_LIST", 0, LIST_ALL)
     h.run(0.2)
     assert _entries(h)[-1] == (0, 0, 0, 0, 0)
+
+
+def _listed(logs):
+    h, contents, _ = logs
+    _send(h, "LOG_REQUEST_LIST", 0, LIST_ALL)
+    h.run(0.2)
+    return h, contents
+
+
+def _start_whole_download_of_log_0(h: Harness) -> int:
+    """LOG_REQUEST_DATA for all of log 0, one tick of it streamed; the LOG_DATA count so far."""
+    before = len(h.gcs.of_type("LOG_DATA"))
+    _send(h, "LOG_REQUEST_DATA", 0, 0, 0xFFFFFFFF)
+    h.run(0.004)
+    sent = len(h.gcs.of_type("LOG_DATA"))
+    assert sent - before == DATA_PER_TICK  # the download is under way, far from its end
+    return sent
+
+
+def test_an_offset_past_the_end_sends_nothing_and_stops_the_stream(logs):
+    """mavlink_log_handler.cpp handle_log_request_data: ofs >= size_bytes -> Idle, nothing sent."""
+    h, contents = _listed(logs)
+    assert _download(h, 0, len(contents[0]) + 1, 10) == b""
+    assert _download(h, 1, 10**9, 0xFFFFFFFF) == b""
+    sent = _start_whole_download_of_log_0(h)
+    _send(h, "LOG_REQUEST_DATA", 0, 10**6, 90)
+    h.run(0.5)
+    assert len(h.gcs.of_type("LOG_DATA")) == sent
+    assert _download(h, 1, 0, 90 * 3) == contents[1]  # and the next request is answered
+
+
+def test_a_huge_count_from_an_offset_wraps_as_px4s_uint32_sum_does(logs):
+    """PX4 compares the offset with start_offset + byte_count, both uint32_t: past 0xFFFFFFFF it wraps."""
+    h, contents = _listed(logs)
+    assert _download(h, 0, 0, 0xFFFFFFFF) == contents[0]
+    assert _download(h, 0, 900, 0xFFFFFFFF - 900) == contents[0][900:]  # sum 0xFFFFFFFF: to the end
+    assert _download(h, 0, 900, 0xFFFFFFFF) == contents[0][900:990]  # wraps: one LOG_DATA
+    assert _download(h, 0, 8990, 0xFFFFFFFF) == contents[0][8990:]  # one LOG_DATA, the file's last 10 bytes
+
+
+def test_an_unknown_id_sends_nothing_and_stops_the_stream(logs):
+    h, contents = _listed(logs)
+    for unknown in (3, 0xFFFF):
+        sent = _start_whole_download_of_log_0(h) if unknown == 3 else len(h.gcs.of_type("LOG_DATA"))
+        _send(h, "LOG_REQUEST_DATA", unknown, 0, 0xFFFFFFFF)
+        h.run(0.5)
+        assert len(h.gcs.of_type("LOG_DATA")) == sent
+    assert _download(h, 0, 0, 0xFFFFFFFF) == contents[0]
+
+
+def test_a_client_that_stops_mid_download_then_asks_again_gets_the_new_request(logs):
+    """No LOG_REQUEST_END: the next LOG_REQUEST_DATA replaces the piece being streamed (same log or another)."""
+    h, contents = _listed(logs)
+    _start_whole_download_of_log_0(h)
+    assert _download(h, 0, 4500, 0xFFFFFFFF - 4500) == contents[0][4500:]  # nothing of the old piece after it
+    _start_whole_download_of_log_0(h)
+    assert _download(h, 1, 0, 1000) == contents[1]  # another log: only its data follows
+    _start_whole_download_of_log_0(h)
+    assert _download(h, 0, 0, 0xFFFFFFFF) == contents[0]  # from the start again: the whole file, once
