@@ -2,10 +2,10 @@
 Ray (2 workers), timed from the driver.
 
 The flight is examples/campaign_square.py with no square: take off in OFFBOARD to 3 m, hold HOLD_S, land. `fly`
-below wraps it and adds the worker's peak RSS so far (getrusage in the worker itself, the same for both engines) as
-a metric. Ray is started here before the campaign, so that ray.init's start-up is timed apart from the cases; the
-workers' own start-up (spawn and imports for local, Ray's worker processes and the preload task for Ray) is counted
-in the campaign's wall time, as a user sees it.
+below wraps it and adds, as metrics, the flight's CPU time and the worker's peak RSS so far (getrusage in the worker
+itself, the same for both engines). Ray is started here before the campaign, so that ray.init's start-up is timed
+apart from the cases; the workers' own start-up (spawn and imports for local, Ray's worker processes and the preload
+task for Ray) is counted in the campaign's wall time, as a user sees it.
 """
 
 from __future__ import annotations
@@ -26,10 +26,13 @@ HOLD_S = 10.0  # with take-off, the OFFBOARD lead-in and landing to disarm: ~30 
 
 
 def fly(sim: Any, case: Case) -> Outcome:
-    """The example's flight, with the worker's peak resident memory (MiB) after it."""
+    """The example's flight, with its CPU seconds and the worker's peak resident memory (MiB) after it."""
+    before = resource.getrusage(resource.RUSAGE_SELF)
     outcome: Outcome = load_scenario(EXAMPLE)(sim, case)
-    peak_mib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # Linux: KiB
-    return Outcome(outcome.passed, {**outcome.metrics, "worker_peak_rss_mib": peak_mib}, outcome.note)
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    cpu_s = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    extra = {"cpu_s": cpu_s, "worker_peak_rss_mib": after.ru_maxrss / 1024}  # ru_maxrss: KiB on Linux
+    return Outcome(outcome.passed, {**outcome.metrics, **extra}, outcome.note)
 
 
 @dataclass
@@ -41,6 +44,7 @@ class Run:
     passed: int
     sim_s: float  # mean simulated seconds per case
     case_wall_s: float  # mean wall seconds per case inside the worker (run_case's own clock)
+    case_cpu_s: float  # mean CPU seconds of the flight itself (the scenario, not the Sim's set-up)
     peak_rss_mib: float  # the largest worker's peak RSS
 
     @property
@@ -64,7 +68,7 @@ def run(engine: str, workers: int, count: int) -> Run:
     run_campaign(SELF, flight_cases(count), engine=engine, workers=workers, on_row=rows.append)
     wall = time.perf_counter() - start
     return Run(engine, workers, count, wall, sum(bool(r["passed"]) for r in rows),
-               _mean(rows, "sim_s"), _mean(rows, "wall_s"),
+               _mean(rows, "sim_s"), _mean(rows, "wall_s"), _mean(rows, "metric.cpu_s"),
                max((float(r.get("metric.worker_peak_rss_mib") or 0.0) for r in rows), default=0.0))
 
 

@@ -181,8 +181,8 @@ def bench_campaign(quick: bool) -> None:
     ray2, init_s = campaign.run_ray(2, count)
     for r in (local1, local2, ray2):
         say(f"campaign {r.engine} x{r.workers}: {r.per_minute:.1f} cases per minute ({r.cases} cases of "
-            f"{r.sim_s:.1f} s simulated, {r.passed} passed, {r.wall_s:.1f} s wall; {r.case_wall_s:.2f} s wall per "
-            f"case inside the worker)")
+            f"{r.sim_s:.1f} s simulated, {r.passed} passed, {r.wall_s:.1f} s wall; {r.case_wall_s:.2f} s wall and "
+            f"{r.case_cpu_s:.2f} s CPU per case inside the worker)")
     say(f"campaign local scaling 1 -> 2 workers: x{local2.per_minute / local1.per_minute:.2f} cases per minute")
     say(f"campaign ray overhead: {ray2.worker_s_per_case - local2.worker_s_per_case:+.2f} s per case (worker wall "
         f"per case, start-up and scheduling included, ray {ray2.worker_s_per_case:.2f} s - local "
