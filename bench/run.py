@@ -16,6 +16,9 @@ Figures (targets from issue 4 in brackets):
               browser connected), against serve without the view
   params      full parameter download (PARAM_REQUEST_LIST to the last PARAM_VALUE) from `serve` at real time, wall
               time [< 1 s; PX4 SITL 0.98 s] (bench/params.py)
+  campaign    (not in the default set: ~2 min) cases per minute of a ~30 s simulated flight, local engine with 1 and 2
+              workers and Ray with 2; Ray's overhead per case and ray.init's start-up; peak RSS per worker
+              (bench/campaign.py)
 Every figure is measured here and now; the machine line says how busy the host was.
 """
 
@@ -35,10 +38,11 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
-from bench import core, params, runner, scale, serve  # noqa: E402
+from bench import campaign, core, params, runner, scale, serve  # noqa: E402
 from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
-NAMES = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params", "view")
+DEFAULT = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params", "view")
+NAMES = (*DEFAULT, "campaign")
 
 
 def say(line: str) -> None:
@@ -170,16 +174,35 @@ def bench_params(quick: bool) -> None:
         f"(best of {runs}; target < 1, PX4 SITL 0.981 s)")
 
 
+def bench_campaign(quick: bool) -> None:
+    count = 4 if quick else 8
+    local1 = campaign.run("local", 1, count)
+    local2 = campaign.run("local", 2, count)
+    ray2, init_s = campaign.run_ray(2, count)
+    for r in (local1, local2, ray2):
+        say(f"campaign {r.engine} x{r.workers}: {r.per_minute:.1f} cases per minute ({r.cases} cases of "
+            f"{r.sim_s:.1f} s simulated, {r.passed} passed, {r.wall_s:.1f} s wall; {r.case_wall_s:.2f} s wall and "
+            f"{r.case_cpu_s:.2f} s CPU per case inside the worker)")
+    say(f"campaign local scaling 1 -> 2 workers: x{local2.per_minute / local1.per_minute:.2f} cases per minute")
+    say(f"campaign ray overhead: {ray2.worker_s_per_case - local2.worker_s_per_case:+.2f} s per case (worker wall "
+        f"per case, start-up and scheduling included, ray {ray2.worker_s_per_case:.2f} s - local "
+        f"{local2.worker_s_per_case:.2f} s, 2 workers); ray.init {init_s:.2f} s once per campaign, not counted above")
+    say(f"campaign peak RSS per worker: local {max(local1.peak_rss_mib, local2.peak_rss_mib):.0f} MiB, ray "
+        f"{ray2.peak_rss_mib:.0f} MiB (the largest worker's getrusage ru_maxrss after its cases)")
+
+
 BENCHES: dict[str, Callable[[bool], None]] = {
     "core": bench_core, "runner": bench_runner, "serve": bench_serve, "startup": bench_startup, "flight": bench_flight,
     "latency": bench_latency, "scale": bench_scale, "params": bench_params, "view": bench_view,
+    "campaign": bench_campaign,
 }
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter runs (~1 min in all)")
-    parser.add_argument("--only", nargs="+", choices=NAMES, default=list(NAMES), help="run only these")
+    parser.add_argument("--only", nargs="+", choices=NAMES, default=list(DEFAULT),
+                        help="run only these (default: all but campaign)")
     args = parser.parse_args(argv)
     machine()
     for name in args.only:

@@ -103,10 +103,6 @@ class LocalEngine:
         pool = [_Worker(self.context, ref) for _ in range(min(self.workers, len(pending)))]
         try:
             while pending or any(w.busy for w in pool):
-                for worker in pool:
-                    worker.poll_ready()
-                    if worker.ready and worker.busy is None and pending:
-                        worker.give(ref, pending.popleft(), limits)
                 for index, worker in enumerate(pool):
                     result = _collect(worker, limits)
                     if result is None:
@@ -115,6 +111,10 @@ class LocalEngine:
                     if not worker.process.is_alive():
                         worker.stop()
                         pool[index] = _Worker(self.context, ref) if pending else worker
+                for worker in pool:  # after collecting: a worker that just finished gets its next case before _wait
+                    worker.poll_ready()
+                    if worker.ready and worker.busy is None and pending:
+                        worker.give(ref, pending.popleft(), limits)
                 _wait(pool, limits)
         finally:
             for worker in pool:
