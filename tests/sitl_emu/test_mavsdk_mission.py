@@ -4,7 +4,7 @@ followed to its end (current == total), is_mission_finished true, then clear_mis
 (test_mavsdk.py's session covers upload/download/clear without flying.)
 
 MAVSDK's timeouts run on the wall clock, so the server runs only a few times faster than real time; the waits are
-generous wall-clock bounds (a loaded 2-core machine), never timing asserts. The flight is about 40 simulated seconds.
+generous wall-clock bounds (a loaded 2-core machine), never timing asserts. The flight is about 20 simulated seconds.
 """
 
 from __future__ import annotations
