@@ -126,8 +126,12 @@ async def _breach_handled(telemetry: Any, texts: list[str]) -> None:
     await _wait("flight mode HOLD (the failsafe's delay)", telemetry.flight_mode, lambda m: m == FlightMode.HOLD, 30.0)
     await _wait("flight mode RETURN_TO_LAUNCH", telemetry.flight_mode, lambda m: m == FlightMode.RETURN_TO_LAUNCH,
                 30.0)
-    assert "Geofence: approaching or outside geofence" in texts
-    assert "Failsafe activated: entering Hold for 5 seconds" in texts and "Failsafe activated" in texts
+    wanted = ("Geofence: approaching or outside geofence", "Failsafe activated: entering Hold for 5 seconds",
+              "Failsafe activated")
+    deadline = time.monotonic() + 10.0  # the texts come on their own subscription, maybe after the mode change
+    while not all(text in texts for text in wanted) and time.monotonic() < deadline:
+        await asyncio.sleep(0.1)
+    assert all(text in texts for text in wanted), texts
     await _wait("landed and disarmed", telemetry.armed, lambda armed: not armed, 120.0)
     p = (await _call(telemetry.position_velocity_ned())).position
     assert math.hypot(p.north_m, p.east_m) < 1.5
