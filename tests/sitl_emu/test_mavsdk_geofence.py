@@ -12,43 +12,22 @@ from __future__ import annotations
 import asyncio
 import math
 import time
-from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
+from support.mavsdk_waits import call as _call
+from support.mavsdk_waits import offset as _offset
+from support.mavsdk_waits import wait as _wait
 from support.serve_process import load_mavsdk, serve
 
 SPEED = 4.0
-CALL_TIMEOUT_S = 15.0
-EARTH_RADIUS_M = 6371000.0
 
 
 @pytest.fixture()
 def server(tmp_path: Path):
     with serve(tmp_path, tmp_path / "serve.log", SPEED) as ports:
         yield ports.api_remote
-
-
-async def _call(awaitable: Awaitable[Any]) -> Any:
-    return await asyncio.wait_for(awaitable, CALL_TIMEOUT_S)
-
-
-async def _wait(what: str, probe: Callable[[], Awaitable[Any]], accept: Callable[[Any], bool],
-                timeout_s: float) -> Any:
-    deadline = time.monotonic() + timeout_s
-    value: Any = None
-    while time.monotonic() < deadline:
-        value = await _call(probe())
-        if accept(value):
-            return value
-        await asyncio.sleep(0.1)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}; last value: {value}")
-
-
-def _offset(lat: float, lon: float, north_m: float, east_m: float) -> tuple[float, float]:
-    return (lat + math.degrees(north_m / EARTH_RADIUS_M),
-            lon + math.degrees(east_m / (EARTH_RADIUS_M * math.cos(math.radians(lat)))))
 
 
 @pytest.mark.timeout(300)
