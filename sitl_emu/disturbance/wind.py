@@ -83,16 +83,24 @@ def parse_wind(text: str) -> WindSettings:
     parts = [p.strip() for p in text.replace("@", ",").split(",")]
     if len(parts) not in (2, 3):
         raise ValueError(f"wind {text!r}: expected SPEED@FROM_DEG[,TURBULENCE], e.g. 5@270 or 5@270,light")
-    speed, from_deg = float(parts[0]), float(parts[1])
+    try:
+        speed, from_deg = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ValueError(f"wind {text!r}: SPEED and FROM_DEG must be numbers, e.g. 5@270") from None
     if not (math.isfinite(speed) and math.isfinite(from_deg)) or speed < 0.0:
         raise ValueError(f"wind {text!r}: speed must be >= 0 and both numbers finite")
+    if not -360.0 <= from_deg <= 360.0:
+        raise ValueError(f"wind {text!r}: the direction it blows from is in degrees, -360 to 360")
     return WindSettings(speed, from_deg % 360.0, turbulence_w20(parts[2]) if len(parts) == 3 else 0.0)
 
 
 def turbulence_w20(text: str) -> float:
     """'light', 'moderate', 'severe' or W20 in m/s."""
     level = TURBULENCE_LEVELS.get(text.lower())
-    value = level if level is not None else float(text)
+    try:
+        value = level if level is not None else float(text)
+    except ValueError:
+        value = math.nan
     if not (math.isfinite(value) and value >= 0.0):
         raise ValueError(f"turbulence {text!r}: light, moderate, severe or W20 in m/s >= 0")
     return value
