@@ -158,9 +158,12 @@ def throttle_problem(control: str, profile: Any) -> str | None:
               help="How to fly, as `joyfly fly --control`: OFFBOARD setpoints (velocity, step) or PX4's Position / "
                    "Altitude mode with MANUAL_CONTROL (position, altitude; the script then takes off with the "
                    "throttle).")
+@click.option("--wind", default=None, metavar="SPEED@FROM[,TURBULENCE]",
+              help="Wind on the built-in emulator, as `sitl-emu serve --wind`: e.g. 5@270 (5 m/s from the west), "
+                   "5@270,light|moderate|severe or a W20 in m/s.")
 @view_options
-def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str, view: bool,
-         view_port: int | None, record_view: Path | None) -> None:
+def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str, wind: str | None,
+         view: bool, view_port: int | None, record_view: Path | None) -> None:
     """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
     from joyfly.demo import DemoError, run_demo
 
@@ -168,7 +171,7 @@ def demo(url: str | None, speed: float, script_path: str | None, live: bool | No
     check_view_options(view_opts)
     try:
         sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control,
-                          view_options=view_opts))
+                          view_options=view_opts, wind=wind))
     except (DemoError, TransportError, JoystickError) as err:
         raise UserError(str(err)) from None
 

@@ -95,16 +95,22 @@ class VehicleTimeClock:
 class EmbeddedVehicle:
     """sitl_emu's vehicle node on free loopback ports, run in real time (x speed) in a daemon thread."""
 
-    def __init__(self, joyfly_port: int, speed: float) -> None:
+    def __init__(self, joyfly_port: int, speed: float, wind: str | None = None) -> None:
+        """`wind` is `sitl-emu serve --wind`'s SPEED@FROM_DEG[,TURBULENCE] text (None: calm air)."""
         try:
             from sitl_emu.cli import build_params, build_vehicle
+            from sitl_emu.disturbance.wind import parse_wind
             from sitl_emu.runtime.node import LinkSettings, VehicleNode
             from sitl_emu.runtime.runner import RealTimeRunner
         except ImportError as exc:
             raise DemoError(f"The bundled emulator cannot be imported ({exc}): reinstall with `make demo`.") from None
         settings = LinkSettings(bind_host="127.0.0.1", api_port=0, api_remote=("127.0.0.1", joyfly_port),
                                 gcs_port=0, gcs_remote=("127.0.0.1", 14550))
-        self.node: Any = VehicleNode(build_vehicle(build_params(None, ()), None, 0, 1), settings)
+        try:
+            wind_settings = parse_wind(wind) if wind is not None else None
+        except ValueError as err:
+            raise DemoError(f"--wind: {err}") from None
+        self.node: Any = VehicleNode(build_vehicle(build_params(None, ()), None, 0, 1, wind_settings), settings)
         self.runner = RealTimeRunner([self.node], speed=speed)
         self._thread = threading.Thread(target=self.runner.run, name="sitl-emu", daemon=True)
 
@@ -136,9 +142,10 @@ def script_source(script_path: str | None, clock: Any, control: str = "velocity"
 
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
              out: TextIO | None = None, options: FlyOptions | None = None, control: str | None = None,
-             view_options: ViewOptions | None = None) -> int:
+             view_options: ViewOptions | None = None, wind: str | None = None) -> int:
     """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed). `control` picks the way
-    of flying (FlyOptions.control), position/altitude at QGroundControl's MANUAL_CONTROL rate."""
+    of flying (FlyOptions.control), position/altitude at QGroundControl's MANUAL_CONTROL rate; `wind` (SPEED@FROM_DEG
+    [,TURBULENCE]) blows on the built-in emulator."""
     from joyfly.run import fly_session
     from joyfly.view import add_browser_view
 
@@ -146,10 +153,17 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
     opts = options or FlyOptions()
     if control is not None:
         opts = replace(opts, control=control, rate=MANUAL_RATE_HZ if control in MANUAL_CONTROLS else opts.rate)
+    if url is not None and wind is not None:
+        raise DemoError("--wind blows on the built-in emulator only: give the vehicle at --url its own wind "
+                        "(sitl-emu serve --wind).")
     transport: Any = open_transport(url) if url else UdpTransport(("127.0.0.1", 0), None)
     emulator = None
     if url is None:
-        emulator = EmbeddedVehicle(transport.local_port, speed)
+        try:
+            emulator = EmbeddedVehicle(transport.local_port, speed, wind)
+        except DemoError:
+            transport.close()
+            raise
         transport.remote = emulator.api_address
         transport.description = f"the built-in emulator (UDP {emulator.api_address[1]})"
         emulator.start()
@@ -158,7 +172,8 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
     sticks = script_source(script_path, clock, opts.control)
     view = make_view(out, live)
     out.write(f"joyfly demo: {transport.description}, scripted joystick "
-              f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}\n")
+              f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}"
+              f"{f', wind {wind}' if wind else ''}\n")
     settings = opts.session_settings(exit_when_landed=True)
     session = make_session(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
     try:

@@ -4,11 +4,14 @@ terminal (CI), and against a vehicle already listening at --url."""
 from __future__ import annotations
 
 import io
+import re
 import socket
 import subprocess
 import sys
 
-from joyfly.demo import EmbeddedVehicle, run_demo
+import pytest
+
+from joyfly.demo import DemoError, EmbeddedVehicle, run_demo
 
 SPEED = 10.0  # the built-in emulator: joyfly reads its simulated clock, so timeouts stay in step when slow
 # A vehicle already listening runs on the wall clock at a speed factor; PX4's 1 s offboard-loss window is 1/speed s
@@ -65,3 +68,34 @@ def test_demo_in_position_mode_takes_off_with_the_throttle_and_stays_inside_the_
     assert "inside" in closest  # the full stick north stops at the fence
     distance = next(line for line in text.splitlines() if line.startswith("distance flown"))
     assert float(distance.split()[2]) > 15.0  # climb + square + fence push
+
+
+def test_demo_flies_in_wind_and_lands() -> None:
+    out = io.StringIO()
+    assert run_demo(speed=SPEED, live=False, out=out, wind="5@270,light") == 0, out.getvalue()
+    text = out.getvalue()
+    assert "wind 5@270,light" in text.splitlines()[0]
+    assert "Landed and disarmed" in text
+
+
+def test_demo_wind_reaches_the_built_in_emulator() -> None:
+    vehicle = EmbeddedVehicle(0, 1.0, "5@270")
+    try:
+        assert vehicle.node.vehicle.faults.wind is not None
+    finally:
+        vehicle.node.close()
+
+
+@pytest.mark.parametrize(("kwargs", "said"), [
+    ({"wind": "5@999"}, "--wind: wind '5@999': the direction it blows from is in degrees, -360 to 360"),
+    ({"wind": "5@270", "url": "udp://127.0.0.1:14540@127.0.0.1:14557"}, "--wind blows on the built-in emulator only"),
+])
+def test_demo_refuses_bad_wind_in_one_sentence(kwargs: dict[str, str], said: str) -> None:
+    with pytest.raises(DemoError, match="^" + re.escape(said)):
+        run_demo(live=False, out=io.StringIO(), **kwargs)  # type: ignore[arg-type]
+
+
+def test_demo_cli_bad_wind_exits_2() -> None:
+    proc = subprocess.run([sys.executable, "-m", "joyfly", "demo", "--wind", "north"], stdin=subprocess.DEVNULL,
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2 and "--wind" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
