@@ -180,9 +180,10 @@ def isfinite(x: float) -> bool:
 
 
 def all_finite3(v: Vec3) -> bool:
-    """Every component of v finite, with one isfinite: each finite component times 0.0 is +-0.0 and so is their sum
-    (no overflow, unlike a plain sum), while an inf or NaN component makes its product NaN and the sum with it."""
-    return isfinite(v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0)
+    """Every component of v finite, in one expression (the vector form of isfinite above, for the same reason): each
+    finite component times 0.0 is +-0.0 and so is their sum (no overflow, unlike a plain sum), while an inf or NaN
+    component makes its product NaN, and the sum with it."""
+    return v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0 == 0.0
 
 
 def constrain(v: float, lo: float, hi: float) -> float:

@@ -363,13 +363,16 @@ class PositionSmoother:
         if isfinite(target[0]) and isfinite(target[1]):
             dx, dy = target[0] - ax.x, target[1] - ay.x
             dist = math.hypot(dx, dy)
-            speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
+            speed = max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0)
+            cruise = self.cruise_speed_m_s
+            speed = speed if speed < cruise else cruise  # min(cruise, speed)
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
             out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
             out1 = uy * speed + (ff[1] if isfinite(ff[1]) else 0.0)
         if isfinite(target[2]):
             dz = target[2] - az.x
-            speed = min(az.max_vel, max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0))
+            speed = max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0)
+            speed = speed if speed < az.max_vel else az.max_vel  # min(max_vel, speed)
             out2 = _sign(dz) * speed + (ff[2] if isfinite(ff[2]) else 0.0)
         return (out0, out1, out2)
 
