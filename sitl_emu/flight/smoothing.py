@@ -169,9 +169,8 @@ class AxisSmoother:
         self._t2 = 0.0 if t2 < 0.0 else t2
 
     def update_traj(self, dt_s: float, time_stretch: float = 1.0) -> None:
-        """Advance along the planned profile by `dt_s` (>= 0) scaled by `time_stretch` (0..1)
-        (VelocitySmoothing::updateTraj): T1 at +jerk, T2 at constant acceleration, T3 at -jerk, then constant
-        velocity."""
+        """Advance the plan by `dt_s` (>= 0) times `time_stretch` (0..1) (VelocitySmoothing::updateTraj): T1 at +jerk,
+        T2 at constant acceleration, T3 at -jerk, then constant velocity; each for min(rest, its duration)."""
         rest = self._time = self._time + dt_s * time_stretch
         t1, t2, t3 = self._t1, self._t2, self._t3
         if t1 == 0.0 and t2 == 0.0 and t3 == 0.0:  # nothing planned: constant velocity
@@ -180,7 +179,6 @@ class AxisSmoother:
             else:
                 self.j, self.a, self.v, self.x = 0.0, self._a0, self._v0, self._x0
             return
-        # each phase for min(rest, its duration), written `t if t < rest else rest`
         j, a, v, x = _evaluate_poly(self._dir * self.max_jerk, self._a0, self._v0, self._x0, t1 if t1 < rest else rest)
         rest -= t1
         if rest > 0.0:
@@ -364,8 +362,7 @@ class PositionSmoother:
             dx, dy = target[0] - ax.x, target[1] - ay.x
             dist = math.hypot(dx, dy)
             speed = max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0)
-            cruise = self.cruise_speed_m_s
-            speed = speed if speed < cruise else cruise  # min(cruise, speed)
+            speed = speed if speed < self.cruise_speed_m_s else self.cruise_speed_m_s  # min(cruise, speed)
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
             out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
             out1 = uy * speed + (ff[1] if isfinite(ff[1]) else 0.0)
