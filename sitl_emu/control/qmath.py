@@ -179,6 +179,13 @@ def isfinite(x: float) -> bool:
     return x - x == 0.0
 
 
+def all_finite3(v: Vec3) -> bool:
+    """Every component of v finite, in one expression (the vector form of isfinite above, for the same reason): each
+    finite component times 0.0 is +-0.0 and so is their sum (no overflow, unlike a plain sum), while an inf or NaN
+    component makes its product NaN, and the sum with it."""
+    return v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0 == 0.0
+
+
 def constrain(v: float, lo: float, hi: float) -> float:
     """Like PX4's math::constrain: NaN passes through."""
     return lo if v < lo else (hi if v > hi else v)

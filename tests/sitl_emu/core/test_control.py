@@ -10,7 +10,7 @@ from sitl_emu.control.attitude import AttitudeControl
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.mixer import allocated_torque, mix
 from sitl_emu.control.position import PositionControl, input_valid
-from sitl_emu.control.qmath import euler_from_q, q_from_euler, yaw_from_q
+from sitl_emu.control.qmath import all_finite3, euler_from_q, isfinite, q_from_euler, yaw_from_q
 from sitl_emu.control.rate import RateControl
 from sitl_emu.params import default_registry
 from sitl_emu.params.settings import cascade_settings
@@ -334,3 +334,15 @@ def test_controllers_and_physics_never_read_the_parameter_registry():
         imported = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
         imported |= {a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
         assert not {m for m in imported if m and m.startswith("sitl_emu.params")}, path.name
+
+
+def test_finiteness_helpers_agree_with_math_isfinite():
+    """qmath.isfinite and all_finite3 are arithmetic (for the compiled build): the same answer as math.isfinite for
+    signed zeros, the extremes, infinities and NaN, also where a plain sum would overflow (1e308 + 1e308)."""
+    values = (0.0, -0.0, 1.5, -1e308, 1e308, 5e-324, math.inf, -math.inf, math.nan)
+    for x in values:
+        assert isfinite(x) == math.isfinite(x)
+    for a in values:
+        for b in values:
+            for c in values:
+                assert all_finite3((a, b, c)) == (math.isfinite(a) and math.isfinite(b) and math.isfinite(c))
