@@ -68,10 +68,12 @@ class FenceChecks:
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
              ref: GeoRef, emit: Emit) -> None:
         """The navigator's geofence work before a commander cycle: the breach check when due, then the mission
-        against the fence when either changed."""
-        if self.monitor.due(now_us, store.plan(PLAN_FENCE)):
+        against the fence when a plan, home or a parameter was replaced."""
+        fence = store.plan(PLAN_FENCE)
+        if self.monitor.due(now_us, fence):
             self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
-        self._check_mission(store, c, emit)
+        if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
+            self._check_mission(store, c, emit)
 
     def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
                       truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:
@@ -96,8 +98,6 @@ class FenceChecks:
         """The mission against the fence, again whenever the mission, the fence, home or a parameter changed
         (mission_base.cpp check_mission_valid): a violation makes the mission invalid and is told once."""
         mission, fence = store.plan(PLAN_MISSION), store.plan(PLAN_FENCE)
-        if not self._inputs_replaced(mission, fence, c):
-            return
         key = (mission.opaque_id, mission.count, fence.opaque_id, fence.count, home_point(c), self.params.version)
         if key == self._mission_key:
             return
