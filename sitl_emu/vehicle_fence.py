@@ -70,7 +70,7 @@ class FenceChecks:
         """The navigator's geofence work before a commander cycle: the breach check when due, then the mission
         against the fence when a plan, home or a parameter was replaced."""
         fence = store.plan(PLAN_FENCE)
-        if self.monitor.due(now_us, fence):
+        if self.monitor.due(now_us, fence, position_valid=c.estimator_ready):  # as _breach_check's inputs
             self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
         if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
             self._check_mission(store, c, emit)
