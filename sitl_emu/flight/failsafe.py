@@ -105,6 +105,7 @@ _RANK: dict[NavState, int] = {
     NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
 }
 _DISARM_RANK = 9
+_HOLD_RANK = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT = "Failsafe activated"
 
 # an action in force: (rank, mode, disarm); rank 0: none, the user's mode
@@ -185,7 +186,7 @@ class Failsafe:
     def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
                   current: _Action) -> _Action:
         """The geofence_breached failsafe joins the others: the worse action wins."""
-        worse_than_hold = self._rank > _RANK[NavState.AUTO_LOITER]
+        worse_than_hold = self._rank > _HOLD_RANK
         wanted = self.geofence.update(now_us, result, user, fail_act_us, worse_than_hold)
         return _worse(current, user, wanted, False)
 
