@@ -58,15 +58,16 @@ class MonitorSettings:
     fd_max_rad: tuple[float, float]  # FD_FAIL_R, FD_FAIL_P (0: off)
     fd_ttri_us: tuple[int, int]  # FD_FAIL_R_TTRI, FD_FAIL_P_TTRI
     sih_wind_from: tuple[float, float]  # SIH_WIND_N, SIH_WIND_E
+    fd_cos_tilt: float  # cos of the smaller of FD_FAIL_R / FD_FAIL_P: a tilt with a larger cosine breaks neither
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> MonitorSettings:
         g = p.get
+        fd_max_rad = (math.radians(abs(g("FD_FAIL_R"))), math.radians(abs(g("FD_FAIL_P"))))
         return cls(BatterySettings.from_params(p), int(p["COM_LOW_BAT_ACT"]), int(p["EKF2_NOAID_TOUT"]),
-                   int(p["COM_DL_LOSS_T"]) * 1_000_000,
-                   (math.radians(abs(g("FD_FAIL_R"))), math.radians(abs(g("FD_FAIL_P")))),
+                   int(p["COM_DL_LOSS_T"]) * 1_000_000, fd_max_rad,
                    (round(g("FD_FAIL_R_TTRI") * 1e6), round(g("FD_FAIL_P_TTRI") * 1e6)),
-                   (g("SIH_WIND_N"), g("SIH_WIND_E")))
+                   (g("SIH_WIND_N"), g("SIH_WIND_E")), math.cos(min(fd_max_rad)))
 
 
 class VehicleFaults:
@@ -76,6 +77,7 @@ class VehicleFaults:
                  wind: WindSettings | None = None, noise: EstimateNoiseSettings | None = None) -> None:
         self.params, self.flags, self._emit = params, flags, emit
         self.failures = fi.FailureTable()
+        self._motor_stop = 0  # the motors' OFF mask in `failures`, kept here as it is read every tick
         self.manager_running = int(params["SYS_FAILURE_EN"]) == 1  # reboot_required: read at boot
         self.battery = BatterySimulator()
         self._settings, self._params_version = MonitorSettings.from_params(params), params.version
@@ -90,7 +92,7 @@ class VehicleFaults:
     # ---- per tick -----------------------------------------------------------------------------------------------
     def motors(self, cmd: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """The mixer's commands with the stopped motors at 0 (ControlAllocator motor_stop_mask)."""
-        stop = self.failures.mask(fi.MOTOR)
+        stop = self._motor_stop
         if not stop:
             return cmd
         m0, m1, m2, m3 = cmd
@@ -138,7 +140,7 @@ class VehicleFaults:
         since = self._fd_since_us
         _, qx, qy, _ = est.q_wxyz
         # cos(tilt) = cos(roll) cos(pitch): a vehicle tilted less than both limits has neither beyond (cheap test)
-        if not armed or 1.0 - 2.0 * (qx * qx + qy * qy) > math.cos(min(s.fd_max_rad)):
+        if not armed or 1.0 - 2.0 * (qx * qx + qy * qy) > s.fd_cos_tilt:
             since[0] = since[1] = None
             return False
         failed = False
@@ -194,3 +196,5 @@ class VehicleFaults:
             self._gps_off_us = (self._gps_off_us if self._gps_off_us is not None else now_us) if off else None
         elif unit == fi.BATTERY:
             self.battery.failed = bool(self.failures.mask(fi.BATTERY))
+        elif unit == fi.MOTOR:
+            self._motor_stop = self.failures.mask(fi.MOTOR)

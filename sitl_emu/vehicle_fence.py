@@ -23,7 +23,7 @@ from sitl_emu.flight.geofence import (
     point_allowed,
 )
 from sitl_emu.flight.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
-from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore
+from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
 from sitl_emu.flight.nav_commands import NavCommand, NavCommandKind
 from sitl_emu.flight.rally import choose_destination
 from sitl_emu.flight.tasks_core import NavInput
@@ -54,6 +54,10 @@ class FenceChecks:
         self._settings: GeofenceSettings = geofence_settings(params)
         self._version = params.version
         self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
+        # the very objects that key was made of (plans and home are replaced, never changed in place): while they
+        # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
+        # changes)
+        self._mission_inputs: tuple[object, ...] = (None, None, None, -1)
 
     @property
     def settings(self) -> GeofenceSettings:
@@ -64,10 +68,12 @@ class FenceChecks:
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
              ref: GeoRef, emit: Emit) -> None:
         """The navigator's geofence work before a commander cycle: the breach check when due, then the mission
-        against the fence when either changed."""
-        if self.monitor.due(now_us, store.plan(PLAN_FENCE)):
+        against the fence when a plan, home or a parameter was replaced."""
+        fence = store.plan(PLAN_FENCE)
+        if self.monitor.due(now_us, fence, position_valid=c.estimator_ready):  # as _breach_check's inputs
             self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
-        self._check_mission(store, c, emit)
+        if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
+            self._check_mission(store, c, emit)
 
     def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
                       truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:
@@ -91,16 +97,23 @@ class FenceChecks:
     def _check_mission(self, store: MissionStore, c: Commander, emit: Emit) -> None:
         """The mission against the fence, again whenever the mission, the fence, home or a parameter changed
         (mission_base.cpp check_mission_valid): a violation makes the mission invalid and is told once."""
-        home = home_point(c)
-        key = (store.plan(PLAN_MISSION).opaque_id, store.count(PLAN_MISSION), store.plan(PLAN_FENCE).opaque_id,
-               store.count(PLAN_FENCE), home, self.params.version)
+        mission, fence = store.plan(PLAN_MISSION), store.plan(PLAN_FENCE)
+        key = (mission.opaque_id, mission.count, fence.opaque_id, fence.count, home_point(c), self.params.version)
         if key == self._mission_key:
             return
         self._mission_key = key
-        text = self.mission_violation(store, c) if store.count(PLAN_MISSION) else None
+        text = self.mission_violation(store, c) if mission.count else None
         store.fence_violation = text
         if text is not None:
             emit(Severity.CRITICAL, "navigator", text, True, True)
+
+    def _inputs_replaced(self, mission: Plan, fence: Plan, c: Commander) -> bool:
+        """Whether a plan, home or the parameters were replaced since the last call (maybe with equal values)."""
+        inputs = self._mission_inputs
+        if inputs[0] is mission and inputs[1] is fence and inputs[2] is c.home and inputs[3] == self.params.version:
+            return False
+        self._mission_inputs = (mission, fence, c.home, self.params.version)
+        return True
 
     def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:
         """Drop a reposition or altitude change whose target the fence forbids (GF_ACTION other than None and

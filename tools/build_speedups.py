@@ -68,6 +68,17 @@ DEFAULT_MODULES = (
     "sitl_emu/vehicle.py",
     "sitl_emu/vehicle_parts.py",
     "sitl_emu/geo.py",
+    # the features' per-cycle work: faults, battery, geofence and the stored plans
+    "sitl_emu/vehicle_faults.py",
+    "sitl_emu/vehicle_fence.py",
+    "sitl_emu/flight/battery.py",
+    "sitl_emu/flight/failure_injection.py",
+    "sitl_emu/flight/fault_failsafes.py",
+    "sitl_emu/flight/geofence.py",
+    "sitl_emu/flight/geofence_failsafe.py",
+    "sitl_emu/flight/geofence_monitor.py",
+    "sitl_emu/flight/heading.py",
+    "sitl_emu/flight/mission_store.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]

@@ -40,13 +40,15 @@ class BatterySettings:
     low_thr: float  # BAT_LOW_THR
     crit_thr: float  # BAT_CRIT_THR
     emergen_thr: float  # BAT_EMERGEN_THR
+    drain_us: float  # the discharge time in us: SIM_BAT_DRAIN, at least 1 s
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> BatterySettings:
         g = p.get
-        return cls(bool(p["SIM_BAT_ENABLE"]), g("SIM_BAT_DRAIN"), g("SIM_BAT_MIN_PCT") / 100.0,
+        drain_s = g("SIM_BAT_DRAIN")
+        return cls(bool(p["SIM_BAT_ENABLE"]), drain_s, g("SIM_BAT_MIN_PCT") / 100.0,
                    int(p["BAT1_N_CELLS"]), g("BAT1_V_CHARGED"), g("BAT1_V_EMPTY"), g("BAT_LOW_THR"),
-                   g("BAT_CRIT_THR"), g("BAT_EMERGEN_THR"))
+                   g("BAT_CRIT_THR"), g("BAT_EMERGEN_THR"), max(drain_s, 1.0) * 1e6)
 
 
 def determine_warning(soc: float, s: BatterySettings) -> int:
@@ -73,17 +75,19 @@ class BatterySimulator:
     def update(self, now_us: int, armed: bool, s: BatterySettings) -> None:
         if armed:
             if self._last_us is not None:
-                self.fraction -= (now_us - self._last_us) / (max(s.drain_s, 1.0) * 1e6)
+                self.fraction -= (now_us - self._last_us) / s.drain_us
             self._last_us = now_us
         else:
             self.fraction, self._last_us = 1.0, None
-        self.fraction = max(self.fraction, s.min_fraction)
+        if self.fraction < s.min_fraction:
+            self.fraction = s.min_fraction
         self.voltage_v = ((1.0 - self.fraction) * s.v_empty + self.fraction * s.v_charged) * s.cells
         self.remaining = 0.0 if self.failed else self.fraction
         warning = WARNING_EMERGENCY if self.failed else determine_warning(self.fraction, s)
         if now_us < INITIALIZE_US or not s.enabled:
             warning = WARNING_NONE
-        self.warning = max(self.warning, warning) if armed else warning
+        if warning > self.warning or not armed:  # while armed the warning only rises
+            self.warning = warning
 
 
 # COM_LOW_BAT_ACT -> (action at critical, action at emergency); None: a warning only

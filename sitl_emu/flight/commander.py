@@ -167,15 +167,18 @@ class Commander:
 
     # ---- checks -------------------------------------------------------------------------------------------------
     def check_inputs(self, now_us: int | None = None) -> arming.CheckInputs:
-        t = self.now_us if now_us is None else now_us
+        return self._check_inputs(self.now_us if now_us is None else now_us, self.settings)
+
+    def _check_inputs(self, now_us: int, st: CommanderSettings) -> arming.CheckInputs:
+        """check_inputs with the settings already at hand (the commander cycle reads them once)."""
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self._offboard_available(t),
-                                  manual_control=self.manual_control_valid(t),
+                                  offboard_signal=self._offboard_available(now_us, st),
+                                  manual_control=self.manual.valid(now_us, st.rc_loss_us),
                                   mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost)
 
-    def _offboard_available(self, now_us: int) -> bool:
+    def _offboard_available(self, now_us: int, st: CommanderSettings) -> bool:
         """offboardCheck.cpp: a fresh signal, and for position or velocity setpoints a local position and velocity."""
-        if not self.offboard_fresh(now_us):
+        if not self._offboard.fresh(now_us, st.of_loss_us):
             return False
         mode = self._offboard.mode
         return not (self.fault_flags.position_lost and mode is not None and (mode.position or mode.velocity))
@@ -291,8 +294,8 @@ class Commander:
     def _apply_mode(self, now_us: int) -> None:
         """The mode in force: the user's mode, or the failsafe's fallback while it cannot run; an armed vehicle never
         leaves termination."""
-        inputs = self.check_inputs(now_us)
         st = self.settings
+        inputs = self._check_inputs(now_us, st)
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
                                          settings=st.fallback, terminated=self.terminated, now_us=now_us,
                                          manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss,

@@ -105,7 +105,21 @@ _RANK: dict[NavState, int] = {
     NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
 }
 _DISARM_RANK = 9
+_HOLD_RANK = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT = "Failsafe activated"
+
+# an action in force: (rank, mode, disarm); rank 0: none, the user's mode
+_Action = tuple[int, NavState, bool]
+
+
+def _worse(current: _Action, user: NavState, wanted: NavState | None, disarm: bool) -> _Action:
+    """Combine one source's want with the action so far: disarming beats every mode (keeping the user's mode),
+    otherwise the higher-ranked mode wins; a source that wants nothing (None, no disarm) changes nothing."""
+    if disarm:
+        return (_DISARM_RANK, user, True) if current[0] < _DISARM_RANK else current
+    if wanted is not None and _RANK[wanted] > current[0]:
+        return _RANK[wanted], wanted, False
+    return current
 
 
 class Failsafe:
@@ -143,26 +157,21 @@ class Failsafe:
             return Decision(user, False)
         if terminated:
             return self._decide(NavState.TERMINATION, False, "")
-        rank, mode, disarm = 0, user, False
+        action: _Action = (0, user, False)
         # framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with
         # its Hold first): for the user's own mode, missing sticks are not a reason to fall back at once
         if not can_run(user, inputs, ignoring=Req.MANUAL):
             fallback = resolve_fallback(user, settings, inputs)
-            rank, mode, disarm = (_DISARM_RANK, user, True) if fallback is None else (_RANK[fallback], fallback, False)
+            action = _worse(action, user, fallback, fallback is None)
         if manual_loss is not None:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
-            if self.manual_loss.disarm and rank < _DISARM_RANK:
-                rank, mode, disarm = _DISARM_RANK, user, True
-            elif wanted is not None and _RANK[wanted] > rank:
-                rank, mode, disarm = _RANK[wanted], wanted, False
+            action = _worse(action, user, wanted, self.manual_loss.disarm)
         if faults is not None:
             for want in self.faults.wanted(now_us, user, *faults):
-                if want.disarm and rank < _DISARM_RANK:
-                    rank, mode, disarm = _DISARM_RANK, user, True
-                elif want.mode is not None and _RANK[want.mode] > rank:
-                    rank, mode, disarm = _RANK[want.mode], want.mode, False
+                action = _worse(action, user, want.mode, want.disarm)
         if geofence is not None:
-            rank, mode, disarm = self._geofence(now_us, geofence, user, fail_act_us, (rank, mode, disarm))
+            action = self._geofence(now_us, geofence, user, fail_act_us, action)
+        rank, mode, disarm = action
         if rank == 0:
             self.active, self._rank = False, 0
             return Decision(user, False)
@@ -175,13 +184,11 @@ class Failsafe:
         return decision
 
     def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
-                  current: tuple[int, NavState, bool]) -> tuple[int, NavState, bool]:
+                  current: _Action) -> _Action:
         """The geofence_breached failsafe joins the others: the worse action wins."""
-        worse_than_hold = self._rank > _RANK[NavState.AUTO_LOITER]
+        worse_than_hold = self._rank > _HOLD_RANK
         wanted = self.geofence.update(now_us, result, user, fail_act_us, worse_than_hold)
-        if wanted is not None and _RANK[wanted] > current[0]:
-            return _RANK[wanted], wanted, False
-        return current
+        return _worse(current, user, wanted, False)
 
     def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
         self.active = True

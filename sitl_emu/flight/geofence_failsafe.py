@@ -53,8 +53,8 @@ class GeofenceFailsafe:
 
     def update(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
                worse_than_hold_active: bool) -> NavState | None:
-        self._breached = result.breached
-        if not result.breached:
+        breached = self._breached = result.breached
+        if not breached:
             self._taken_over = False
         elif not self._active and not self._taken_over:
             self._start(now_us, result.action, fail_act_us, worse_than_hold_active)

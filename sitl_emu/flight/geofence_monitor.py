@@ -76,10 +76,12 @@ class GeofenceMonitor:
         self._latched_at_us = 0  # _time_loitering_after_gf_breach (0: not latched)
         self._reposition_sent = False
 
-    def due(self, now_us: int, plan: Plan) -> bool:
-        """Whether `update` would do anything now (the caller may skip building its inputs otherwise)."""
-        return ((plan.opaque_id, plan.count) != self._plan_key or bool(self._latched_at_us)
-                or self._last_check_us is None or now_us - self._last_check_us > CHECK_INTERVAL_US)
+    def due(self, now_us: int, plan: Plan, position_valid: bool = True) -> bool:
+        """Whether `update` would do anything now (the caller may skip building its inputs otherwise). Without a
+        valid position (`update` gets None for it) only a new fence plan or the post-breach latch need an update."""
+        if (plan.opaque_id, plan.count) != self._plan_key or self._latched_at_us:
+            return True
+        return position_valid and (self._last_check_us is None or now_us - self._last_check_us > CHECK_INTERVAL_US)
 
     def update(self, now_us: int, plan: Plan, s: GeofenceSettings, inp: GeofenceInputs) -> GeofenceStep:
         step = GeofenceStep()

@@ -189,6 +189,15 @@ def _inputs(north: float, *, armed: bool = True, in_hold: bool = False) -> Geofe
     return GeofenceInputs(p, p, HOME, landed=False, armed=armed, in_hold=in_hold)
 
 
+def test_monitor_is_due_without_a_position_only_for_a_new_fence():
+    m = GeofenceMonitor()
+    plan = _plan([item(CIRCLE_IN, 0, 0, 50.0)])
+    assert m.due(0, plan, position_valid=False)  # the fence is still to be built
+    m.update(0, plan, GeofenceSettings(action=GF_ACTION_RETURN), GeofenceInputs(None, None, None, True, False, False))
+    assert not m.due(8_000, plan, position_valid=False) and m.due(8_000, plan)
+    assert m.due(8_000, _plan([]), position_valid=False)
+
+
 def test_monitor_checks_every_200_ms_and_reports_each_new_breach_once():
     m = GeofenceMonitor()
     plan = _plan([item(CIRCLE_IN, 0, 0, 50.0)])
