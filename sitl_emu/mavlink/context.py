@@ -114,4 +114,18 @@ class Handler(Protocol):
 
     def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None: ...
 
-    def tick(self, ctx: LinkContext) -> None: ...
+    # Optional: `WATCHES_VEHICLE: ClassVar[bool] = True` for a handler whose tick() also acts on what vehicle_news()
+    # returns (below): an idle one is ticked again when that changes.
+
+    def tick(self, ctx: LinkContext) -> bool | None:
+        """Stream, retry, time out. Return False when only a message on this link (or, with WATCHES_VEHICLE, news
+        of the vehicle) can give it work again: no transfer under way, no timeout to watch; the endpoint then skips
+        it until then. None or True: tick it again next time."""
+
+
+def vehicle_news(vehicle: Vehicle) -> tuple[int, int, bool, int]:
+    """What protocol handlers act on between messages: the parameters' version (params_protocol sends changed
+    values, as PX4's parameter_update subscription) and the navigator's mission progress (mission_protocol reports
+    it, as PX4's mission_result subscription)."""
+    store = vehicle.mission_store()
+    return vehicle.params.version, store.current_seq, store.finished, store.seq_reached

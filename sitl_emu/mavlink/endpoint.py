@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink.context import EndpointStats, NodeView
+from sitl_emu.mavlink.context import EndpointStats, NodeView, vehicle_news
 from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
@@ -110,6 +110,12 @@ class Endpoint:
         self._now_us = 0
         self._handlers: list[Handler] = [cls() for cls in handler_classes]
         self._tickers = [h for h in self._handlers if getattr(h, "TICKS", True)]  # context.py: TICKS False = idle
+        # the handlers ticked at the next emit: one whose tick() says it is idle (False) sleeps until a message
+        # arrives on this link (dispatch wakes them all), so idle protocols cost nothing per tick
+        self._awake: list[Handler] = list(self._tickers)
+        # some handlers also act on news of the vehicle (context.vehicle_news): a change wakes them all
+        self._watches_vehicle = any(getattr(h, "WATCHES_VEHICLE", False) for h in self._tickers)
+        self._news: tuple[int, int, bool, int] | None = None
         self._routes: dict[str, list[Handler]] = {}
         for h in self._handlers:
             for msg_type in h.MESSAGES:
@@ -165,6 +171,7 @@ class Endpoint:
             return
         self.stats.rx_messages += 1
         self.seen_components.add(src)
+        self.wake_handlers()
         try:
             self.receiver.handle(msg, self)
             for handler in self._routes.get(msg_type, ()):
@@ -223,19 +230,40 @@ class Endpoint:
             self.streams.emit_due(self, self.node.snapshot)
         if events:
             self._pending_texts.extend(e for e in events if e.statustext)
-        if self._pending_texts and self.gcs_connected():
+        # texts wait for a GCS; while none has ever been heard, without a call per tick
+        if self._pending_texts and self.last_gcs_heartbeat_us is not None and self.gcs_connected():
             self.streams.send_statustexts(self, list(self._pending_texts))
             self._pending_texts.clear()
-        for handler in self._tickers:
+        if self._watches_vehicle:  # news of the vehicle since the last emit wakes the handlers
+            news = vehicle_news(self.node.vehicle)
+            if news != self._news:
+                self._news = news
+                self.wake_handlers()
+        if self._awake:
+            self._tick_handlers()
+
+    def _tick_handlers(self) -> None:
+        """Tick the awake handlers in their table order; keep awake those that may have more to do."""
+        awake: list[Handler] = []
+        for handler in self._awake:
             try:
-                handler.tick(self)
+                if handler.tick(self) is False:
+                    continue  # idle until its next message
             except Exception as err:
                 self.stats.handler_errors += 1
                 log.error("%s link: error in %s.tick: %r", self.link_name, type(handler).__name__, err,
                           exc_info=log.isEnabledFor(logging.DEBUG))
+            awake.append(handler)
+        self._awake = awake
+
+    def wake_handlers(self) -> None:
+        """Tick every handler again from the next emit (a message arrived: any of them may have work now)."""
+        if len(self._awake) != len(self._tickers):
+            self._awake = list(self._tickers)
 
     def restart(self) -> None:
         """After a vehicle reboot: streams restart from time 0 at their current rates; the GCS must be heard again."""
+        self.wake_handlers()
         self.streams.restart()
         self.last_gcs_heartbeat_us = None
         self._pending_texts.clear()

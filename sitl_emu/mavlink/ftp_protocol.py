@@ -351,12 +351,14 @@ class FtpProtocol:
             raise FtpNak(Err.INVALID_SESSION)
         self._burst = _Burst(p.offset, (p.seq + 1) & 0xFFFF, self._source)
 
-    def tick(self, ctx: LinkContext) -> None:
+    def tick(self, ctx: LinkContext) -> bool:
+        """The idle session's timeout and the burst; False when neither is under way (idle until a request)."""
         if self._file is not None and ctx.now_us - self._last_request_us > SESSION_IDLE_US:
             self._close()  # "Session was closed without activity"
             self._kept_reply = None
         if self._burst is not None:
             self._stream(self._burst, ctx)
+        return self._file is not None or self._burst is not None
 
     def _stream(self, burst: _Burst, ctx: LinkContext) -> None:
         for n in range(1, BURST_PACKETS_PER_TICK + 1):

@@ -166,11 +166,13 @@ class LogProtocol:
             self._open = None
 
     # --- streaming ---------------------------------------------------------------------------------------------
-    def tick(self, ctx: LinkContext) -> None:
+    def tick(self, ctx: LinkContext) -> bool:
+        """Stream the listing and the requested data; False when nothing is left to send (idle until a request)."""
         if self._listing is not None:
             self._send_entries(self._listing, ctx)
         if self._open is not None and self._open.sending:
             self._send_data(self._open, ctx)
+        return self._listing is not None or (self._open is not None and self._open.sending)
 
     def _send_entries(self, listing: _Listing, ctx: LinkContext) -> None:
         logs = self._logs or []

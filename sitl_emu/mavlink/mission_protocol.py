@@ -71,6 +71,7 @@ class MissionProtocol:
         "MISSION_REQUEST_LIST", "MISSION_COUNT", "MISSION_CLEAR_ALL", "MISSION_ITEM", "MISSION_ITEM_INT",
         "MISSION_REQUEST", "MISSION_REQUEST_INT", "MISSION_ACK", "MISSION_SET_CURRENT",
     )
+    WATCHES_VEHICLE: ClassVar[bool] = True  # tick() reports the mission progress (context.vehicle_news)
 
     def __init__(self) -> None:
         self._state = IDLE
@@ -103,11 +104,12 @@ class MissionProtocol:
             self._int_mode = kind.endswith("_INT")  # PX4 follows the client's choice of message
         self._handlers[kind](msg, ctx)
 
-    def tick(self, ctx: LinkContext) -> None:
-        """Mission progress, retries and the protocol timeout (MavlinkMissionManager::send)."""
+    def tick(self, ctx: LinkContext) -> bool:
+        """Mission progress, retries and the protocol timeout (MavlinkMissionManager::send); False when no transfer
+        is under way and no MISSION_ITEM_REACHED repeat is due (idle until news or a message)."""
         self._report_progress(ctx)
         if self._state == IDLE:
-            return
+            return self._reached_repeats > 0
         now = ctx.now_us
         if now - self._sent_us > RETRY_US and self._state == GETLIST:
             self._request(ctx, self._seq)
@@ -116,6 +118,7 @@ class MissionProtocol:
         elif now - self._recv_us > TIMEOUT_US:
             _say(ctx, "Mission sync timeout")
             self._end(ctx)
+        return True
 
     def _report_progress(self, ctx: LinkContext) -> None:
         """The navigator's mission_result as send() reports it: MISSION_CURRENT at once when the current item or the

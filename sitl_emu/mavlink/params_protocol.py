@@ -95,6 +95,7 @@ class ParamProtocol:
     """One instance per link; see the module docstring."""
 
     MESSAGES: ClassVar[tuple[str, ...]] = ("PARAM_REQUEST_LIST", "PARAM_REQUEST_READ", "PARAM_SET")
+    WATCHES_VEHICLE: ClassVar[bool] = True  # tick() sends the values changed (context.vehicle_news)
 
     def __init__(self) -> None:
         self._next_index: int | None = None  # next index to stream, None when not streaming
@@ -170,12 +171,14 @@ class ParamProtocol:
         return "MAV_HASH_CHK_EN" not in registry or int(registry.get("MAV_HASH_CHK_EN")) == 1
 
     # --- transmit ----------------------------------------------------------------------------------------------
-    def tick(self, ctx: LinkContext) -> None:
-        # Every link, every tick: idle (no list streaming, registry unchanged) must cost next to nothing.
+    def tick(self, ctx: LinkContext) -> bool:
+        """Changed values, then the list being streamed; False when neither is left (idle until news or a
+        request)."""
         if self._next_index is None and self._seen_version == ctx.vehicle.params.version:
-            return
+            return False
         self._send_changes(ctx)
         self._stream(ctx)
+        return self._next_index is not None
 
     def _stream(self, ctx: LinkContext) -> None:
         if self._next_index is None:

@@ -103,9 +103,10 @@ class ShellBridge:
             self._out += PROMPT
 
     # --- transmit ----------------------------------------------------------------------------------------------
-    def tick(self, ctx: LinkContext) -> None:
+    def tick(self, ctx: LinkContext) -> bool:
+        """The shell's output and events; False until a SERIAL_CONTROL has opened the shell."""
         if self._shell is None:
-            return
+            return False
         self._collect_events(ctx)
         if self._shell.busy:
             self._continue_command(ctx)
@@ -117,6 +118,7 @@ class ShellBridge:
             data = list(chunk) + [0] * (MAX_CHUNK - len(chunk))
             ctx.send(ENCODER.serial_control_encode(SERIAL_CONTROL_DEV_SHELL, SERIAL_CONTROL_FLAG_REPLY, 0, 0,
                                                    len(chunk), data))
+        return True
 
     def _continue_command(self, ctx: LinkContext) -> None:
         """Output of the running command; when it has ended, the prompt and then the input that waited for it."""
