@@ -57,7 +57,7 @@ def shown_path(path: Path) -> str:
 
 class _Schedule:
     """When a topic is next due: an interval grid, and a state whose change is written at once; and how its 'D'
-    message is packed (ulog_writer.MessageFormat.data_packer)."""
+    message is packed (ulog_writer.DataPacker)."""
 
     __slots__ = ("next_us", "pack", "state")
 
@@ -136,7 +136,7 @@ class FlightLogger:
         self.files.append(path)
         self.node.vehicle.report(Severity.INFO, "logger", f"[logger] {shown_path(path)}")
         self._write(self._preamble(now_us))
-        self._plan = [(topic, _Schedule(topic.format.data_packer(msg_id, topic.values.names)))
+        self._plan = [(topic, _Schedule(ulog.DataPacker(topic.format, msg_id, topic.values.names)))
                       for msg_id, topic in enumerate(self.topics)]
         self._inputs = Inputs(self.node.vehicle, int(self.node.vehicle.sysid), self.node.snapshot)
         self._next_sync_us = now_us

@@ -13,10 +13,11 @@ tick, the local and global position at the EKF's ~125 Hz (8 ms; the reference lo
 Topics PX4 publishes on change (vehicle_status, vehicle_land_detected, home_position, offboard_control_mode) are
 written when their state changes and at PX4's publication period.
 
-Each topic's values are a tuple, in the order of the field names its `@fields(...)` line gives (the others keep the
-format's defaults). The topics logged at high rate, and those whose change is watched every tick, read the vehicle's
-estimate and the commander's fields; the controllers' setpoints and outputs come from the vehicle snapshot, which
-is only taken on a tick where such a topic is due (Inputs.snap).
+Each topic's values are a flat tuple, in the order of the field names its `@fields(...)` line gives, an array's
+elements in its place (t, t, *q); the other fields keep the format's defaults. The topics logged at high rate, and
+the states watched every tick (flight_log.py), read the vehicle's estimate and the commander's fields; the
+controllers' setpoints and outputs come from the vehicle snapshot, which is only taken on a tick where such a topic
+is due (Inputs.snap).
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ ACTUATOR_CONTROLS = 12  # actuator_motors.control
 PWM_OUTPUTS = 16
 
 Values = dict[str, Any]
-Row = tuple[Any, ...]  # a topic's values, in the order of its field names
+Row = tuple[Any, ...]  # a topic's values, in the order of its field names, arrays spread into their elements
 
 
 class Inputs:
@@ -76,7 +77,7 @@ class Inputs:
 
 @dataclass(frozen=True, slots=True)
 class Fields:
-    """How a topic's values are read: `read(inputs)` gives the values of the fields `names`, in that order (None:
+    """How a topic's values are read: `read(inputs)` gives the values of the fields `names` (a flat Row; None:
     nothing published now)."""
 
     names: tuple[str, ...]
@@ -107,13 +108,13 @@ def _thrust_body(snap: VehicleSnapshot) -> tuple[float, float, float]:
 @fields("timestamp", "timestamp_sample", "q")
 def _attitude(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, i.estimate.q_wxyz
+    return t, t, *i.estimate.q_wxyz
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
 def _angular_velocity(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, i.estimate.rates_frd_rad_s
+    return t, t, *i.estimate.rates_frd_rad_s
 
 
 @fields("timestamp", "timestamp_sample", "ref_lat", "ref_lon", "x", "y", "z", "vx", "vy", "vz", "z_deriv", "ax", "ay",
@@ -144,7 +145,7 @@ def _local_setpoint(i: Inputs) -> Row | None:
     if sp is None:
         return None
     (x, y, z), (vx, vy, vz) = sp.position_ned_m, sp.velocity_ned_m_s
-    return (s.time_us, x, y, z, vx, vy, vz, sp.acceleration_ned_m_s2, _thrust_body(s), sp.yaw_rad,
+    return (s.time_us, x, y, z, vx, vy, vz, *sp.acceleration_ned_m_s2, *_thrust_body(s), sp.yaw_rad,
             sp.yawspeed_rad_s)
 
 
@@ -153,7 +154,7 @@ def _trajectory_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    return (s.time_us, sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2, NAN3, sp.yaw_rad,
+    return (s.time_us, *sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2, *NAN3, sp.yaw_rad,
             sp.yawspeed_rad_s)
 
 
@@ -162,7 +163,7 @@ def _attitude_setpoint(i: Inputs) -> Row | None:
     s = i.snap
     if s.attitude_setpoint_q_wxyz is None or not s.armed:
         return None
-    return s.time_us, s.attitude_setpoint_q_wxyz, _thrust_body(s)
+    return s.time_us, *s.attitude_setpoint_q_wxyz, *_thrust_body(s)
 
 
 @fields("timestamp", "roll", "pitch", "yaw", "thrust_body")
@@ -171,7 +172,7 @@ def _rates_setpoint(i: Inputs) -> Row | None:
         return None
     s = i.snap
     roll, pitch, yaw = s.rates_setpoint_rad_s
-    return s.time_us, roll, pitch, yaw, _thrust_body(s)
+    return s.time_us, roll, pitch, yaw, *_thrust_body(s)
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
@@ -179,26 +180,26 @@ def _thrust_setpoint(i: Inputs) -> Row | None:
     if not i.vehicle.commander.armed:
         return None
     s = i.snap
-    return s.time_us, s.time_us, _thrust_body(s)
+    return s.time_us, s.time_us, *_thrust_body(s)
 
 
 @fields("timestamp", "timestamp_sample", "control")
 def _actuator_motors(i: Inputs) -> Row:
     s = i.snap
-    control = (*s.motor_commands, *(NAN,) * (ACTUATOR_CONTROLS - len(s.motor_commands)))
-    return s.time_us, s.time_us, control
+    unused = (NAN,) * (ACTUATOR_CONTROLS - len(s.motor_commands))
+    return s.time_us, s.time_us, *s.motor_commands, *unused
 
 
 @fields("timestamp", "output")
 def _actuator_outputs(i: Inputs) -> Row:
-    return i.snap.time_us, [float(v) for v in servo_outputs(i.snap)]
+    return i.snap.time_us, *(float(v) for v in servo_outputs(i.snap))
 
 
 @fields("timestamp", "voltage_v", "remaining", "voltage_cell_v")
 def _battery(i: Inputs) -> Row:
     battery = i.vehicle.faults.battery
     cells = (battery.voltage_v / BATTERY_CELLS,) * BATTERY_CELLS + (0.0,) * (14 - BATTERY_CELLS)
-    return i.time_us, battery.voltage_v, battery.remaining, cells
+    return i.time_us, battery.voltage_v, battery.remaining, *cells
 
 
 def _status_state(i: Inputs) -> tuple[bool, NavState, NavState, bool, bool]:
