@@ -265,6 +265,17 @@ class Vehicle:
             return LandedState.LANDING
         return LandedState.IN_AIR
 
+    @property
+    def estimate(self) -> RigidBodyState:
+        """The state estimate after the last step, read only: for readers of a few fields at high rate (the flight
+        logger), who need no whole snapshot."""
+        return self._estimate
+
+    def position_valid(self) -> bool:
+        """Whether the position estimate is valid (the snapshot's position_valid)."""
+        c = self.commander
+        return c.estimator_ready and not c.fault_flags.position_lost
+
     def snapshot(self) -> VehicleSnapshot:
         """Everything telemetry needs at the current simulated time (cached until the next step or input)."""
         if self._snap is None:

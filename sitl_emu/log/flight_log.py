@@ -31,7 +31,6 @@ from sitl_emu.log.info import parameter_messages, version_infos
 from sitl_emu.log.topics import Inputs, Topic, default_topics
 from sitl_emu.params import ParamType
 from sitl_emu.px4 import Severity
-from sitl_emu.types import VehicleSnapshot
 
 log = logging.getLogger(__name__)
 
@@ -57,13 +56,15 @@ def shown_path(path: Path) -> str:
 
 
 class _Schedule:
-    """When a topic is next due: an interval grid, and a state whose change is written at once."""
+    """When a topic is next due: an interval grid, and a state whose change is written at once; and how its 'D'
+    message is packed (ulog_writer.DataPacker)."""
 
-    __slots__ = ("next_us", "state")
+    __slots__ = ("next_us", "pack", "state")
 
-    def __init__(self) -> None:
+    def __init__(self, pack: Callable[[Any], bytes]) -> None:
         self.next_us = 0
         self.state: Hashable = object()
+        self.pack = pack
 
 
 class FlightLogger:
@@ -83,8 +84,8 @@ class FlightLogger:
         self._params: dict[str, float] = {}
         self._param_version = -1
         self._next_sync_us = 0
-        self._plan: list[tuple[int, Topic, _Schedule]] = []  # msg_id, topic, when it is next due
-        self._sysid = 0
+        self._plan: list[tuple[Topic, _Schedule]] = []  # in msg_id order: the topic, when it is next due
+        self._inputs: Inputs | None = None  # what the topics read, from the start of a log
 
     @property
     def writing(self) -> bool:
@@ -100,14 +101,14 @@ class FlightLogger:
         if not armed:
             self._failed = False
             if self._file is not None:
-                self._record(self.node.snapshot())  # the disarmed state and its texts end the log
+                self._record()  # the disarmed state and its texts end the log
                 self.close()
             self._event_seq = vehicle.last_event_seq  # texts from here on: those of the arming go in the new log
             return
         if self._file is None and not self._failed:
-            self._start(self.node.snapshot())
+            self._start(vehicle.time_us)
         if self._file is not None:
-            self._record(self.node.snapshot())
+            self._record()
 
     def close(self) -> None:
         """End the log being written (disarm, shutdown)."""
@@ -121,8 +122,8 @@ class FlightLogger:
         self.path = None
 
     # --- starting a log ----------------------------------------------------------------------------------------
-    def _start(self, snap: VehicleSnapshot) -> None:
-        path = log_path(self.directory, self.node.epoch_unix_us + snap.time_us)
+    def _start(self, now_us: int) -> None:
+        path = log_path(self.directory, self.node.epoch_unix_us + now_us)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             path = self._free_name(path)
@@ -134,10 +135,11 @@ class FlightLogger:
         self.path = path
         self.files.append(path)
         self.node.vehicle.report(Severity.INFO, "logger", f"[logger] {shown_path(path)}")
-        self._write(self._preamble(snap))
-        self._plan = [(msg_id, topic, _Schedule()) for msg_id, topic in enumerate(self.topics)]
-        self._sysid = int(self.node.vehicle.sysid)
-        self._next_sync_us = snap.time_us
+        self._write(self._preamble(now_us))
+        self._plan = [(topic, _Schedule(ulog.DataPacker(topic.format, msg_id, topic.values.names)))
+                      for msg_id, topic in enumerate(self.topics)]
+        self._inputs = Inputs(self.node.vehicle, int(self.node.vehicle.sysid), self.node.snapshot)
+        self._next_sync_us = now_us
         self._log_texts(self.node.vehicle.events_after(self._event_seq))  # the arming's texts and "[logger] ..."
 
     @staticmethod
@@ -150,7 +152,7 @@ class FlightLogger:
             candidate = path.with_name(f"{path.stem}_{n}{path.suffix}")
         return candidate
 
-    def _preamble(self, snap: VehicleSnapshot) -> bytes:
+    def _preamble(self, now_us: int) -> bytes:
         vehicle = self.node.vehicle
         formats = [t.format for t in self.topics]
         definitions, subscriptions = ulog.formats_and_subscriptions(formats)
@@ -158,30 +160,32 @@ class FlightLogger:
         params = vehicle.params
         self._params = {d.name: params.get(d.name) for d in params}
         self._param_version = params.version
-        return b"".join((ulog.file_header(snap.time_us), ulog.flag_bits(), infos, definitions,
+        return b"".join((ulog.file_header(now_us), ulog.flag_bits(), infos, definitions,
                          parameter_messages(params), subscriptions))
 
     # --- every tick --------------------------------------------------------------------------------------------
-    def _record(self, snap: VehicleSnapshot) -> None:
-        vehicle = self.node.vehicle
+    def _record(self) -> None:
+        """This tick's texts, changed parameters, due topics (a snapshot only if one of them reads it) and sync."""
+        vehicle, inputs = self.node.vehicle, self._inputs
+        assert inputs is not None  # set by _start
+        inputs.new_tick()
         events = vehicle.events_after(self._event_seq)
         out = [self._log_texts(events, write=False)] if events else []
         if vehicle.params.version != self._param_version:
             out.append(self._changed_params())
-        now = snap.time_us
-        inputs = Inputs(snap, self._sysid, vehicle)
-        for msg_id, topic, sched in self._plan:
+        now = inputs.time_us
+        for topic, sched in self._plan:
             state = topic.state
-            if now < sched.next_us and (state is None or state(snap) == sched.state):
+            if now < sched.next_us and (state is None or state(inputs) == sched.state):
                 continue
             if state is not None:
-                sched.state = state(snap)
+                sched.state = state(inputs)
             sched.next_us = sched.next_us + topic.interval_us
             if sched.next_us <= now:  # (after a pause, a change, or an interval shorter than a tick)
                 sched.next_us = now + topic.interval_us
-            values = topic.values(inputs)
+            values = topic.values.read(inputs)
             if values is not None:
-                out.append(ulog.data(msg_id, topic.format.pack(values)))
+                out.append(sched.pack(values))
         if now >= self._next_sync_us:
             out.append(ulog.sync())
             self._next_sync_us = now + SYNC_INTERVAL_US

@@ -1,4 +1,4 @@
-"""The uORB topics a flight log holds: PX4's names, fields and logging rates, their values from the vehicle snapshot.
+"""The uORB topics a flight log holds: PX4's names, fields and logging rates, their values from the vehicle.
 
 Field lists (names, C types, order and padding) are those of a ULog written by PX4 SITL+SIH (the shape of PX4's
 msg/*.msg once its message generator has sorted the fields by size; ../shared/reference/px4-ulog-topics.txt),
@@ -12,6 +12,12 @@ vehicle_angular_velocity every 10 ms. Every update here means PX4's publication 
 tick, the local and global position at the EKF's ~125 Hz (8 ms; the reference log: 124.9 and 120.6 Hz).
 Topics PX4 publishes on change (vehicle_status, vehicle_land_detected, home_position, offboard_control_mode) are
 written when their state changes and at PX4's publication period.
+
+Each topic's values are a flat tuple, in the order of the field names its `@fields(...)` line gives, an array's
+elements in its place (t, t, *q); the other fields keep the format's defaults. The topics logged at high rate, and
+the states watched every tick (flight_log.py), read the vehicle's estimate and the commander's fields; the
+controllers' setpoints and outputs come from the vehicle snapshot, which is only taken on a tick where such a topic
+is due (Inputs.snap).
 """
 
 from __future__ import annotations
@@ -19,10 +25,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
+from sitl_emu.control.qmath import yaw_from_q
+from sitl_emu.geo import ned_to_global
 from sitl_emu.log.ulog_writer import MessageFormat
 from sitl_emu.mavlink.telemetry_actuators import servo_outputs
+from sitl_emu.physics import RigidBodyState
 from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
 
@@ -38,22 +47,54 @@ ACTUATOR_CONTROLS = 12  # actuator_motors.control
 PWM_OUTPUTS = 16
 
 Values = dict[str, Any]
+Row = tuple[Any, ...]  # a topic's values, in the order of its field names, arrays spread into their elements
 
 
-class Inputs(NamedTuple):
-    """What a topic's values are made of: the snapshot, and the vehicle for the few things the snapshot lacks."""
+class Inputs:
+    """What the topics read at one tick: the time, the vehicle's estimate and the vehicle (cheap fields), and the
+    snapshot, taken on first use in a tick (`snap`) by `take_snapshot`."""
 
-    snap: VehicleSnapshot
-    sysid: int
-    vehicle: Any
+    __slots__ = ("_snap", "_take_snapshot", "estimate", "sysid", "time_us", "vehicle")
+
+    def __init__(self, vehicle: Any, sysid: int, take_snapshot: Callable[[], VehicleSnapshot]) -> None:
+        self.vehicle = vehicle
+        self.sysid = sysid
+        self._take_snapshot = take_snapshot
+        self.new_tick()
+
+    def new_tick(self) -> None:
+        """The vehicle stepped: read its time and estimate again, and forget the snapshot."""
+        self.time_us: int = self.vehicle.time_us
+        self.estimate: RigidBodyState = self.vehicle.estimate
+        self._snap: VehicleSnapshot | None = None
+
+    @property
+    def snap(self) -> VehicleSnapshot:
+        if self._snap is None:
+            self._snap = self._take_snapshot()
+        return self._snap
+
+
+@dataclass(frozen=True, slots=True)
+class Fields:
+    """How a topic's values are read: `read(inputs)` gives the values of the fields `names` (a flat Row; None:
+    nothing published now)."""
+
+    names: tuple[str, ...]
+    read: Callable[[Inputs], Row | None]
+
+
+def fields(*names: str) -> Callable[[Callable[[Inputs], Row | None]], Fields]:
+    """Decorates a topic's value function with the names of the fields its tuple fills."""
+    return lambda read: Fields(names, read)
 
 
 @dataclass(frozen=True, slots=True)
 class Topic:
     format: MessageFormat  # with the topic's constant fields as its defaults
     interval_us: int  # at most one message per interval (0: every tick)
-    values: Callable[[Inputs], Values | None]  # None: nothing published now
-    state: Callable[[VehicleSnapshot], Hashable] | None = None  # a change is written at once
+    values: Fields  # the fields it sets and how they are read
+    state: Callable[[Inputs], Hashable] | None = None  # a change is written at once (cheap reads: every tick)
 
     @property
     def name(self) -> str:
@@ -64,139 +105,163 @@ def _thrust_body(snap: VehicleSnapshot) -> tuple[float, float, float]:
     return (0.0, 0.0, -snap.thrust_setpoint)
 
 
-def _attitude(i: Inputs) -> Values:
-    s = i.snap
-    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "q": s.q_wxyz}
+@fields("timestamp", "timestamp_sample", "q")
+def _attitude(i: Inputs) -> Row:
+    t = i.time_us
+    return t, t, *i.estimate.q_wxyz
 
 
-def _angular_velocity(i: Inputs) -> Values:
-    s = i.snap
-    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "xyz": s.rates_frd_rad_s}
+@fields("timestamp", "timestamp_sample", "xyz")
+def _angular_velocity(i: Inputs) -> Row:
+    t = i.time_us
+    return t, t, *i.estimate.rates_frd_rad_s
 
 
-def _local_position(i: Inputs) -> Values:
-    s = i.snap
-    (x, y, z), (vx, vy, vz), (ax, ay, az) = s.pos_ned_m, s.vel_ned_m_s, s.acc_ned_m_s2
-    ok = s.position_valid
-    return {
-        "timestamp": s.time_us, "timestamp_sample": s.time_us,
-        "ref_lat": s.ref_lat_deg, "ref_lon": s.ref_lon_deg, "x": x, "y": y, "z": z, "vx": vx, "vy": vy, "vz": vz,
-        "z_deriv": vz, "ax": ax, "ay": ay, "az": az, "heading": s.euler_rad[2], "ref_alt": s.ref_alt_amsl_m,
-        "dist_bottom": -z, "eph": 0.3 if ok else 1e3, "epv": 0.4 if ok else 1e3, "xy_valid": ok, "z_valid": ok,
-        "v_xy_valid": ok, "v_z_valid": ok, "heading_good_for_control": ok, "xy_global": ok, "z_global": ok,
-        "dist_bottom_valid": ok,
-    }
+@fields("timestamp", "timestamp_sample", "ref_lat", "ref_lon", "x", "y", "z", "vx", "vy", "vz", "z_deriv", "ax", "ay",
+        "az", "heading", "ref_alt", "dist_bottom", "eph", "epv",
+        "xy_valid", "z_valid", "v_xy_valid", "v_z_valid", "heading_good_for_control", "xy_global", "z_global",
+        "dist_bottom_valid")
+def _local_position(i: Inputs) -> Row:
+    t, e, ref = i.time_us, i.estimate, i.vehicle.ref
+    (x, y, z), (vx, vy, vz), (ax, ay, az) = e.pos_ned_m, e.vel_ned_m_s, e.acc_ned_m_s2
+    ok = i.vehicle.position_valid()
+    return (t, t, ref.lat_deg, ref.lon_deg, x, y, z, vx, vy, vz, vz, ax, ay, az,
+            yaw_from_q(e.q_wxyz), ref.alt_amsl_m, -z, 0.3 if ok else 1e3, 0.4 if ok else 1e3,
+            *(ok,) * 8)  # the valid and global flags
 
 
-def _global_position(i: Inputs) -> Values | None:
-    s = i.snap
-    if not s.position_valid:
+@fields("timestamp", "timestamp_sample", "lat", "lon", "alt", "alt_ellipsoid")
+def _global_position(i: Inputs) -> Row | None:
+    if not i.vehicle.position_valid():
         return None
-    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "lat": s.lat_deg, "lon": s.lon_deg,
-            "alt": s.alt_amsl_m, "alt_ellipsoid": s.alt_amsl_m}
+    t = i.time_us
+    lat, lon, alt = ned_to_global(i.vehicle.ref, i.estimate.pos_ned_m)
+    return t, t, lat, lon, alt, alt
 
 
-def _local_setpoint(i: Inputs) -> Values | None:
+@fields("timestamp", "x", "y", "z", "vx", "vy", "vz", "acceleration", "thrust", "yaw", "yawspeed")
+def _local_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
     (x, y, z), (vx, vy, vz) = sp.position_ned_m, sp.velocity_ned_m_s
-    return {"timestamp": s.time_us, "x": x, "y": y, "z": z, "vx": vx, "vy": vy, "vz": vz,
-            "acceleration": sp.acceleration_ned_m_s2, "thrust": _thrust_body(s), "yaw": sp.yaw_rad,
-            "yawspeed": sp.yawspeed_rad_s}
+    return (s.time_us, x, y, z, vx, vy, vz, *sp.acceleration_ned_m_s2, *_thrust_body(s), sp.yaw_rad,
+            sp.yawspeed_rad_s)
 
 
-def _trajectory_setpoint(i: Inputs) -> Values | None:
+@fields("timestamp", "position", "velocity", "acceleration", "jerk", "yaw", "yawspeed")
+def _trajectory_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    return {"timestamp": s.time_us, "position": sp.position_ned_m, "velocity": sp.velocity_ned_m_s,
-            "acceleration": sp.acceleration_ned_m_s2, "jerk": NAN3, "yaw": sp.yaw_rad, "yawspeed": sp.yawspeed_rad_s}
+    return (s.time_us, *sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2, *NAN3, sp.yaw_rad,
+            sp.yawspeed_rad_s)
 
 
-def _attitude_setpoint(i: Inputs) -> Values | None:
+@fields("timestamp", "q_d", "thrust_body")
+def _attitude_setpoint(i: Inputs) -> Row | None:
     s = i.snap
     if s.attitude_setpoint_q_wxyz is None or not s.armed:
         return None
-    return {"timestamp": s.time_us, "q_d": s.attitude_setpoint_q_wxyz, "thrust_body": _thrust_body(s)}
+    return s.time_us, *s.attitude_setpoint_q_wxyz, *_thrust_body(s)
 
 
-def _rates_setpoint(i: Inputs) -> Values | None:
-    s = i.snap
-    if not s.armed:
+@fields("timestamp", "roll", "pitch", "yaw", "thrust_body")
+def _rates_setpoint(i: Inputs) -> Row | None:
+    if not i.vehicle.commander.armed:
         return None
+    s = i.snap
     roll, pitch, yaw = s.rates_setpoint_rad_s
-    return {"timestamp": s.time_us, "roll": roll, "pitch": pitch, "yaw": yaw, "thrust_body": _thrust_body(s)}
+    return s.time_us, roll, pitch, yaw, *_thrust_body(s)
 
 
-def _thrust_setpoint(i: Inputs) -> Values | None:
+@fields("timestamp", "timestamp_sample", "xyz")
+def _thrust_setpoint(i: Inputs) -> Row | None:
+    if not i.vehicle.commander.armed:
+        return None
     s = i.snap
-    return None if not s.armed else {"timestamp": s.time_us, "timestamp_sample": s.time_us, "xyz": _thrust_body(s)}
+    return s.time_us, s.time_us, *_thrust_body(s)
 
 
-def _actuator_motors(i: Inputs) -> Values:
+@fields("timestamp", "timestamp_sample", "control")
+def _actuator_motors(i: Inputs) -> Row:
     s = i.snap
-    control = (*s.motor_commands, *(NAN,) * (ACTUATOR_CONTROLS - len(s.motor_commands)))
-    return {"timestamp": s.time_us, "timestamp_sample": s.time_us, "control": control}
+    unused = (NAN,) * (ACTUATOR_CONTROLS - len(s.motor_commands))
+    return s.time_us, s.time_us, *s.motor_commands, *unused
 
 
-def _actuator_outputs(i: Inputs) -> Values:
-    return {"timestamp": i.snap.time_us, "output": [float(v) for v in servo_outputs(i.snap)]}
+@fields("timestamp", "output")
+def _actuator_outputs(i: Inputs) -> Row:
+    return i.snap.time_us, *(float(v) for v in servo_outputs(i.snap))
 
 
-def _battery(i: Inputs) -> Values:
-    s = i.snap
-    cells = (s.battery_voltage_v / BATTERY_CELLS,) * BATTERY_CELLS + (0.0,) * (14 - BATTERY_CELLS)
-    return {"timestamp": s.time_us, "voltage_v": s.battery_voltage_v, "remaining": s.battery_remaining,
-            "voltage_cell_v": cells}
+@fields("timestamp", "voltage_v", "remaining", "voltage_cell_v")
+def _battery(i: Inputs) -> Row:
+    battery = i.vehicle.faults.battery
+    cells = (battery.voltage_v / BATTERY_CELLS,) * BATTERY_CELLS + (0.0,) * (14 - BATTERY_CELLS)
+    return i.time_us, battery.voltage_v, battery.remaining, *cells
 
 
-def _status(i: Inputs) -> Values:
-    s = i.snap
-    return {"timestamp": s.time_us, "arming_state": ARMING_STATE_ARMED if s.armed else ARMING_STATE_DISARMED,
-            "nav_state_user_intention": int(s.user_intended_nav_state), "nav_state": int(s.nav_state),
-            "nav_state_display": int(s.nav_state), "failsafe": s.failsafe, "system_id": i.sysid,
-            "accepts_offboard_setpoints": s.nav_state is NavState.OFFBOARD,
-            "pre_flight_checks_pass": s.pre_flight_checks_pass}
+def _status_state(i: Inputs) -> tuple[bool, NavState, NavState, bool, bool]:
+    """(armed, nav_state, user-intended nav_state, failsafe, pre-flight checks pass), from the commander."""
+    c = i.vehicle.commander
+    return c.armed, c.nav_state, c.intention.user_intended, c.failsafe, c.pre_flight_checks_pass()
 
 
-def _status_state(s: VehicleSnapshot) -> Hashable:
-    return s.armed, s.nav_state, s.user_intended_nav_state, s.failsafe, s.pre_flight_checks_pass
+@fields("timestamp", "arming_state", "nav_state_user_intention", "nav_state", "nav_state_display", "failsafe",
+        "system_id", "accepts_offboard_setpoints", "pre_flight_checks_pass")
+def _status(i: Inputs) -> Row:
+    armed, nav_state, intended, failsafe, checks_pass = _status_state(i)
+    return (i.time_us, ARMING_STATE_ARMED if armed else ARMING_STATE_DISARMED, int(intended), int(nav_state),
+            int(nav_state), failsafe, i.sysid, nav_state is NavState.OFFBOARD, checks_pass)
 
 
-def _land_detected(i: Inputs) -> Values:
-    s = i.snap
-    landed = s.landed_state is LandedState.ON_GROUND
-    return {"timestamp": s.time_us, "ground_contact": landed, "maybe_landed": landed, "landed": landed,
-            "in_descend": s.landed_state is LandedState.LANDING, "has_low_throttle": landed,
-            "close_to_ground_or_skipped_check": landed or -s.pos_ned_m[2] < 1.0, "at_rest": landed}
+def _landed_state(i: Inputs) -> LandedState:
+    return i.vehicle.landed_state()
 
 
-def _home(i: Inputs) -> Values | None:
-    s, h = i.snap, i.snap.home
+@fields("timestamp", "ground_contact", "maybe_landed", "landed", "in_descend", "has_low_throttle",
+        "close_to_ground_or_skipped_check", "at_rest")
+def _land_detected(i: Inputs) -> Row:
+    landed_state = _landed_state(i)
+    landed = landed_state is LandedState.ON_GROUND
+    return (i.time_us, landed, landed, landed, landed_state is LandedState.LANDING, landed,
+            landed or -i.estimate.pos_ned_m[2] < 1.0, landed)
+
+
+def _home_state(i: Inputs) -> Hashable:
+    return i.vehicle.commander.home
+
+
+@fields("timestamp", "lat", "lon", "alt", "x", "y", "z", "yaw")
+def _home(i: Inputs) -> Row | None:
+    h = i.vehicle.commander.home
     if h is None:
         return None
     x, y, z = h.pos_ned_m
-    return {"timestamp": s.time_us, "lat": h.lat_deg, "lon": h.lon_deg, "alt": h.alt_amsl_m, "x": x, "y": y, "z": z,
-            "yaw": h.yaw_rad}
+    return i.time_us, h.lat_deg, h.lon_deg, h.alt_amsl_m, x, y, z, h.yaw_rad
 
 
-def _manual(i: Inputs) -> Values | None:
+@fields("timestamp", "timestamp_sample", "roll", "pitch", "yaw", "throttle", "buttons")
+def _manual(i: Inputs) -> Row | None:
     """The last sticks while manual control is valid (the commander's COM_RC_LOSS_T watchdog)."""
-    if not i.snap.manual_control:
+    c, t = i.vehicle.commander, i.time_us
+    if not c.manual_control_valid(t):
         return None
-    m: ManualControlSetpoint = i.vehicle.commander.manual.setpoint
-    t = i.snap.time_us
-    return {"timestamp": t, "timestamp_sample": t, "roll": m.roll, "pitch": m.pitch, "yaw": m.yaw,
-            "throttle": m.throttle, "buttons": m.buttons}
+    m: ManualControlSetpoint = c.manual.setpoint
+    return t, t, m.roll, m.pitch, m.yaw, m.throttle, m.buttons
 
 
-def _offboard_mode(i: Inputs) -> Values | None:
-    s, m = i.snap, i.snap.offboard_control_last
+def _offboard_state(i: Inputs) -> Hashable:
+    return i.vehicle.commander.offboard_mode_last
+
+
+@fields("timestamp", "position", "velocity", "acceleration", "attitude", "body_rate")
+def _offboard_mode(i: Inputs) -> Row | None:
+    m = i.vehicle.commander.offboard_mode_last
     if m is None:
         return None
-    return {"timestamp": s.time_us, "position": m.position, "velocity": m.velocity, "acceleration": m.acceleration,
-            "attitude": m.attitude, "body_rate": m.body_rate}
+    return i.time_us, m.position, m.velocity, m.acceleration, m.attitude, m.body_rate
 
 
 SPECS = {
@@ -270,7 +335,7 @@ SPECS = {
 
 MS = 1000
 # name: (least interval in µs, values, state written on change or None) -- logged_topics.cpp's intervals
-_TABLE: dict[str, tuple[int, Callable[[Inputs], Values | None], Callable[[VehicleSnapshot], Hashable] | None]] = {
+_TABLE: dict[str, tuple[int, Fields, Callable[[Inputs], Hashable] | None]] = {
     "vehicle_attitude": (0, _attitude, None),
     "vehicle_angular_velocity": (10 * MS, _angular_velocity, None),
     "vehicle_local_position": (8 * MS, _local_position, None),
@@ -285,10 +350,10 @@ _TABLE: dict[str, tuple[int, Callable[[Inputs], Values | None], Callable[[Vehicl
     "battery_status": (200 * MS, _battery, None),
     # published at 2 Hz or at once on a change (Commander.cpp); land_detected on change and at 1 Hz
     "vehicle_status": (500 * MS, _status, _status_state),
-    "vehicle_land_detected": (1000 * MS, _land_detected, lambda s: s.landed_state),
-    "home_position": (1000 * MS, _home, lambda s: s.home),
+    "vehicle_land_detected": (1000 * MS, _land_detected, _landed_state),
+    "home_position": (1000 * MS, _home, _home_state),
     "manual_control_setpoint": (200 * MS, _manual, None),
-    "offboard_control_mode": (100 * MS, _offboard_mode, lambda s: s.offboard_control_last),
+    "offboard_control_mode": (100 * MS, _offboard_mode, _offboard_state),
 }
 
 

@@ -18,6 +18,7 @@ messages are built here one by one.
 
 from __future__ import annotations
 
+import operator
 import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -88,6 +89,7 @@ class MessageFormat:
             defaults.extend([zero] * n)
         while codes and codes[-1].endswith("x"):  # PX4 writes a topic without its trailing padding
             codes.pop()  # (logger.cpp: o_size_no_padding)
+        self.written_codes = codes  # the struct code of each field written (trailing padding not)
         self._struct = struct.Struct("<" + "".join(codes))
         self._defaults = defaults
 
@@ -108,6 +110,14 @@ class MessageFormat:
     def pack(self, values: Mapping[str, Any]) -> bytes:
         return self._struct.pack(*self._filled(values))
 
+    def default_bytes(self, index: int) -> bytes:
+        """The bytes of written field `index` (of `fields`) with its default value (padding: zero bytes)."""
+        field, code = self.fields[index], self.written_codes[index]
+        if field.name not in self._slots:
+            return struct.pack("<" + code)
+        start, count = self._slots[field.name]
+        return struct.pack("<" + code, *self._defaults[start:start + max(count, 1)])
+
     def _filled(self, values: Mapping[str, Any]) -> list[Any]:
         out = self._defaults.copy()
         slots = self._slots
@@ -118,6 +128,54 @@ class MessageFormat:
             else:
                 out[index] = value
         return out
+
+
+class DataPacker:
+    """A topic's 'D' messages as `msg_id`, from the values of the fields `names`: a flat tuple, in the order of
+    `names`, an array's elements in place of the array ((t, t, *q) for "timestamp", "timestamp_sample", "q"). The
+    bytes of data(msg_id, fmt.pack(...)) with the same values, for messages written every tick.
+
+    The work is done once, here: the message header and each run of fields not in `names` (their defaults, the
+    padding) become constant bytes, so a message packs only the named values and those runs, with one struct.
+    """
+
+    def __init__(self, fmt: MessageFormat, msg_id: int, names: Sequence[str]) -> None:
+        counts = {f.name: max(f.count, 1) for f in fmt.fields if not f.name.startswith("_padding")}
+        unknown = set(names) - set(counts)
+        if unknown or len(set(names)) != len(names):
+            raise ValueError(f"{fmt.name}: fields {sorted(unknown)} unknown or named twice in {list(names)}")
+        starts = {}  # name -> index of its first value
+        self._count = 0  # how many values a message takes
+        for name in names:
+            starts[name], self._count = self._count, self._count + counts[name]
+        codes: list[str] = []
+        sources: list[int] = []  # per struct argument: its index in values + constants
+        constants: list[bytes] = []
+        run = _HEAD.pack(_DATA_ID.size + fmt.size, ord("D")) + _DATA_ID.pack(msg_id)
+        for i, code in enumerate(fmt.written_codes):
+            name = fmt.fields[i].name
+            if name not in starts:
+                run += fmt.default_bytes(i)
+                continue
+            if run:
+                codes.append(f"{len(run)}s")
+                sources.append(self._count + len(constants))
+                constants.append(run)
+                run = b""
+            codes.append(code)
+            sources.extend(range(starts[name], starts[name] + counts[name]))
+        if run:
+            codes.append(f"{len(run)}s")
+            sources.append(self._count + len(constants))
+            constants.append(run)
+        self._struct = struct.Struct("<" + "".join(codes))
+        self._constants = tuple(constants)
+        self._gather = operator.itemgetter(*sources)  # (the header's run and one field at least: 2 or more)
+
+    def __call__(self, values: tuple[Any, ...]) -> bytes:
+        if len(values) != self._count:
+            raise ValueError(f"{len(values)} values for {self._count}")
+        return self._struct.pack(*self._gather(values + self._constants))
 
 
 def message(kind: bytes, body: bytes) -> bytes:

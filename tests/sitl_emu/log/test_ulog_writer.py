@@ -58,6 +58,20 @@ def test_defaults_texts_and_bad_fields():
         fmt.pack({"nope": 1})
 
 
+def test_a_data_packer_writes_the_bytes_of_data_and_pack_with_defaults_arrays_and_padding():
+    fmt = ulog.MessageFormat("t", "uint64_t timestamp;float[3] xyz;float a;bool ok;uint8_t c;uint8_t[2] _padding0;"
+                                  "float b;uint8_t[4] _padding1")
+    fmt.set_defaults({"b": 7.0, "c": 3})
+    pack = ulog.DataPacker(fmt, 5, ("timestamp", "xyz", "ok"))
+    assert pack((2000, 1.0, 2.0, 3.0, True)) == ulog.data(5, fmt.pack({"timestamp": 2000, "xyz": (1.0, 2.0, 3.0),
+                                                                      "ok": True}))
+    assert ulog.DataPacker(fmt, 1, ("b", "a"))((1.5, -2.0)) == ulog.data(1, fmt.pack({"a": -2.0, "b": 1.5}))
+    with pytest.raises(ValueError):
+        pack((2000, (1.0, 2.0, 3.0), True))  # an array goes in as its elements
+    with pytest.raises(ValueError):
+        ulog.DataPacker(fmt, 0, ("timestamp", "nope"))
+
+
 def test_a_log_is_read_over_mavlink_ftp_when_the_log_directory_is_under_the_ftp_root(tmp_path):
     vehicle = Vehicle(seed=0)
     h = Harness(vehicle, handler_classes=[FtpProtocol.with_root(tmp_path)])
