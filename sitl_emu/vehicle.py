@@ -293,7 +293,7 @@ class Vehicle:
             time_us=self._time_us, armed=c.armed, nav_state=c.nav_state,
             user_intended_nav_state=c.intention.user_intended, failsafe=c.failsafe, landed_state=self.landed_state(),
             pre_flight_checks_pass=c.pre_flight_checks_pass(),
-            position_valid=c.estimator_ready and not c.fault_flags.position_lost,
+            position_valid=self.position_valid(),
             takeoff_detected=c.have_taken_off, offboard_control=c.offboard_mode,
             pos_ned_m=s.pos_ned_m, vel_ned_m_s=s.vel_ned_m_s, acc_ned_m_s2=s.acc_ned_m_s2, q_wxyz=s.q_wxyz,
             rates_frd_rad_s=s.rates_frd_rad_s, euler_rad=euler, lat_deg=lat, lon_deg=lon,
