@@ -7,7 +7,6 @@ the navigator task at the position controller's rate (ModeExecutor), attitude/ra
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import Final
 
@@ -102,14 +101,6 @@ def published_setpoints(ctrl: MulticopterControl, nav_state: NavState, armed: bo
     """
     if armed or not _position_controlled(nav_state, offboard_last):
         return ctrl.local_setpoint, ctrl.attitude_setpoint_q_wxyz, ctrl.rates_setpoint_rad_s, ctrl.thrust_setpoint
-    # the sign tells -0.0 from 0.0 (equal as keys of the cache, not on the wire)
-    return _idle_setpoints(yaw_rad, math.copysign(1.0, yaw_rad))
-
-
-@functools.lru_cache(maxsize=1)
-def _idle_setpoints(yaw_rad: float, _sign: float) -> Setpoints:
-    """The idle setpoints at heading `yaw_rad`, kept for the last heading: a vehicle at rest keeps its heading, and
-    a snapshot is taken on most ticks."""
     idle = TrajectorySetpoint(NAN3, NAN3, (0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad, 0.0)
     half = 0.5 * yaw_rad
     return idle, (math.cos(half), 0.0, 0.0, math.sin(half)), ZERO3, 0.0
