@@ -32,7 +32,6 @@ INITIALIZE_US: Final = 2_000_000  # battery.cpp: _battery_initialized 2 s after 
 @dataclass(frozen=True, slots=True)
 class BatterySettings:
     enabled: bool  # SIM_BAT_ENABLE
-    drain_s: float  # SIM_BAT_DRAIN
     min_fraction: float  # SIM_BAT_MIN_PCT / 100
     cells: int  # BAT1_N_CELLS
     v_charged: float  # BAT1_V_CHARGED
@@ -45,10 +44,9 @@ class BatterySettings:
     @classmethod
     def from_params(cls, p: ParamRegistry) -> BatterySettings:
         g = p.get
-        drain_s = g("SIM_BAT_DRAIN")
-        return cls(bool(p["SIM_BAT_ENABLE"]), drain_s, g("SIM_BAT_MIN_PCT") / 100.0,
+        return cls(bool(p["SIM_BAT_ENABLE"]), g("SIM_BAT_MIN_PCT") / 100.0,
                    int(p["BAT1_N_CELLS"]), g("BAT1_V_CHARGED"), g("BAT1_V_EMPTY"), g("BAT_LOW_THR"),
-                   g("BAT_CRIT_THR"), g("BAT_EMERGEN_THR"), max(drain_s, 1.0) * 1e6)
+                   g("BAT_CRIT_THR"), g("BAT_EMERGEN_THR"), max(g("SIM_BAT_DRAIN"), 1.0) * 1e6)
 
 
 def determine_warning(soc: float, s: BatterySettings) -> int:
