@@ -140,7 +140,7 @@ class MissionStore:
     def mission_valid(self) -> bool:
         """mission_result.valid: PX4 main's feasibility checks refuse none of the reference's plans (a first waypoint
         beyond MIS_DIST_1WP still flies); a waypoint outside the geofence does (checkMissionAgainstGeofence)."""
-        return self.fence_violation is None and bool(self.plans[PLAN_MISSION].items)
+        return self.fence_violation is None and self.count(PLAN_MISSION) > 0
 
     def mission_state(self, mode_active: bool = False) -> int:
         """MISSION_CURRENT.mission_state (mavlink_mission.cpp update_mission_state): COMPLETE once the navigator
