@@ -151,23 +151,24 @@ class DataPacker:
         codes: list[str] = []
         sources: list[int] = []  # per struct argument: its index in values + constants
         constants: list[bytes] = []
+
+        def add_constant(run: bytes) -> None:
+            if run:
+                codes.append(f"{len(run)}s")
+                sources.append(self._count + len(constants))
+                constants.append(run)
+
         run = _HEAD.pack(_DATA_ID.size + fmt.size, ord("D")) + _DATA_ID.pack(msg_id)
         for i, code in enumerate(fmt.written_codes):
             name = fmt.fields[i].name
             if name not in starts:
                 run += fmt.default_bytes(i)
                 continue
-            if run:
-                codes.append(f"{len(run)}s")
-                sources.append(self._count + len(constants))
-                constants.append(run)
-                run = b""
+            add_constant(run)
+            run = b""
             codes.append(code)
             sources.extend(range(starts[name], starts[name] + counts[name]))
-        if run:
-            codes.append(f"{len(run)}s")
-            sources.append(self._count + len(constants))
-            constants.append(run)
+        add_constant(run)
         self._struct = struct.Struct("<" + "".join(codes))
         self._constants = tuple(constants)
         self._gather = operator.itemgetter(*sources)  # (the header's run and one field at least: 2 or more)
