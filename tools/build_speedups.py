@@ -79,6 +79,20 @@ DEFAULT_MODULES = (
     "sitl_emu/flight/geofence_monitor.py",
     "sitl_emu/flight/heading.py",
     "sitl_emu/flight/mission_store.py",
+    # what those modules read every tick: the enums and the message types (a compiled module reads a member of an enum
+    # compiled with it as a constant, but one of a pure module through Python 3.11's EnumType.__getattr__ hook, ~750
+    # instructions a read), the commander's settings, the navigator's other tasks, the wind and the estimate noise
+    "sitl_emu/types.py",
+    "sitl_emu/px4.py",
+    "sitl_emu/flight/commander_settings.py",
+    "sitl_emu/flight/nav_commands.py",
+    "sitl_emu/flight/mission.py",
+    "sitl_emu/flight/mission_items_nav.py",
+    "sitl_emu/flight/rally.py",
+    "sitl_emu/flight/tasks_follow.py",
+    "sitl_emu/flight/follow_estimator.py",
+    "sitl_emu/disturbance/wind.py",
+    "sitl_emu/disturbance/estimate.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]
