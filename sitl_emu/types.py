@@ -33,15 +33,27 @@ class OffboardControlMode:
         return self.position or self.velocity or self.acceleration or self.attitude or self.body_rate
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class TrajectorySetpoint:
-    """PX4's trajectory_setpoint in the local NED frame; NaN components are not controlled."""
+    """PX4's trajectory_setpoint in the local NED frame; NaN components are not controlled.
+
+    Made several times a tick (the flight tasks, the position controller's output), so not frozen and with its
+    __init__ written out, as flight/failsafe.Decision: `make speedups` compiles only a written-out __init__, and a
+    frozen one sets each field through object.__setattr__. Treat it as read-only: one setpoint is held and shared."""
 
     position_ned_m: Vec3 = NAN3
     velocity_ned_m_s: Vec3 = NAN3
     acceleration_ned_m_s2: Vec3 = NAN3
     yaw_rad: float = NAN
     yawspeed_rad_s: float = NAN
+
+    def __init__(self, position_ned_m: Vec3 = NAN3, velocity_ned_m_s: Vec3 = NAN3,
+                 acceleration_ned_m_s2: Vec3 = NAN3, yaw_rad: float = NAN, yawspeed_rad_s: float = NAN) -> None:
+        self.position_ned_m = position_ned_m
+        self.velocity_ned_m_s = velocity_ned_m_s
+        self.acceleration_ned_m_s2 = acceleration_ned_m_s2
+        self.yaw_rad = yaw_rad
+        self.yawspeed_rad_s = yawspeed_rad_s
 
 
 @dataclass(frozen=True, slots=True)
