@@ -18,7 +18,6 @@ Plain floats are used throughout: for 3-vectors they are several times faster th
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from math import cos, sin, sqrt
 from typing import Final
@@ -92,7 +91,7 @@ class SihConfig:
         return self.mass_kg * GRAVITY_M_S2 / (4.0 * self.t_max_n)
 
 
-def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: SihConfig,
+def step(state: RigidBodyState, motor_cmd: Vec4, dt_s: float, cfg: SihConfig,
          wind_ned_m_s: Vec3 | None = None) -> RigidBodyState:
     """Advance the state by dt_s under the given motor commands (0..1 each); the input state is not changed.
 
@@ -115,7 +114,7 @@ def step(state: RigidBodyState, motor_cmd: Sequence[float], dt_s: float, cfg: Si
                           _rates_step(state.rates_frd_rad_s, u, dt_s, cfg), u, acc, specific_force, False)
 
 
-def _motor_lag(motors: Vec4, cmd: Sequence[float], dt_s: float, tau_s: float) -> Vec4:
+def _motor_lag(motors: Vec4, cmd: Vec4, dt_s: float, tau_s: float) -> Vec4:
     """sih.cpp read_motors: u += dt / tau (u_sp - u) for each motor, the commands clamped to 0..1 (NaN -> 0)."""
     k = 1.0 if tau_s <= dt_s else dt_s / tau_s
     c0, c1, c2, c3 = cmd

@@ -27,7 +27,8 @@ def add_if_not_nan3(setpoint: Vec3, addition: Vec3) -> Vec3:
 
 def constrain_xy(v0: tuple[float, float], v1: tuple[float, float], vmax: float) -> tuple[float, float]:
     """ControlMath::constrainXY: limit |v0 + v1| to vmax, keeping as much of v0 as possible."""
-    (v0x, v0y), (v1x, v1y) = v0, v1
+    v0x, v0y = v0
+    v1x, v1y = v1
     sx, sy = v0x + v1x, v0y + v1y
     if hypot(sx, sy) <= vmax:
         return sx, sy
