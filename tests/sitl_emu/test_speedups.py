@@ -145,7 +145,7 @@ def test_build_records_every_source_the_compiled_modules_import():
     build = _build_script()
     deps = build.dependency_sources(list(build.DEFAULT_MODULES))
     assert "sitl_emu/__init__.py" in deps
-    assert "sitl_emu/types.py" in deps
+    assert "sitl_emu/params/registry.py" in deps
     assert "sitl_emu/params/__init__.py" in deps
     assert not set(deps) & set(build.DEFAULT_MODULES)
     assert all((ROOT / m).is_file() for m in build.DEFAULT_MODULES)

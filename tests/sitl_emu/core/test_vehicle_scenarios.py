@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import pytest
 
-from sitl_emu.px4 import LandedState, MavCmd, MavResult, MavState, NavState, custom_mode, decode_custom_mode
+from sitl_emu.px4 import LandedState, MavCmd, MavResult, MavState, NavState, Severity, custom_mode, decode_custom_mode
 from sitl_emu.types import NAN3, OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
 from sitl_emu.vehicle import Vehicle
 
@@ -253,7 +253,7 @@ def test_report_joins_the_event_stream() -> None:
     f = Flight()
     f.run(2.1)
     last = f.v.events_after(0)[-1].seq
-    f.v.report(4, "mavlink", "SET_POSITION_TARGET_LOCAL_NED invalid")
+    f.v.report(Severity.WARNING, "mavlink", "SET_POSITION_TARGET_LOCAL_NED invalid")
     new = f.v.events_after(last)
     assert [e.text for e in new] == ["SET_POSITION_TARGET_LOCAL_NED invalid"] and new[0].seq == last + 1
 

@@ -7,7 +7,7 @@ import math
 import pytest
 from support.fakes import Client, FakeVehicle, Harness
 
-from sitl_emu.px4 import MavCmd, MavResult, NavState
+from sitl_emu.px4 import MavCmd, MavResult, NavState, Severity
 
 NAN = math.nan
 
@@ -253,20 +253,20 @@ def test_statustext_needs_a_gcs_heartbeat_within_2_5_s(h):
     h.gcs.heartbeat()
     h.api.heartbeat(18)  # an onboard controller (MAVROS) is not a GCS
     h.run(1.0)
-    h.vehicle.report(6, "commander", "Armed by external command")
+    h.vehicle.report(Severity.INFO, "commander", "Armed by external command")
     h.run(0.1)
     assert [m.text for m in h.gcs.of_type("STATUSTEXT")] == ["Armed by external command\t"]
     assert not h.api.of_type("STATUSTEXT")
     h.run(1.5)  # 2.6 s since the GCS heartbeat
-    h.vehicle.report(6, "commander", "Disarmed by external command")
+    h.vehicle.report(Severity.INFO, "commander", "Disarmed by external command")
     h.run(0.1)
     assert len(h.gcs.of_type("STATUSTEXT")) == 1
 
 
 def test_texts_wait_for_a_gcs_up_to_5_s(h):
-    h.vehicle.report(6, "commander", "Ready for takeoff!")
+    h.vehicle.report(Severity.INFO, "commander", "Ready for takeoff!")
     h.run(2.0)
-    h.vehicle.report(6, "commander", "Takeoff detected")
+    h.vehicle.report(Severity.INFO, "commander", "Takeoff detected")
     h.run(3.5)  # the first text is now 5.5 s old, the second 3.5 s
     assert not h.gcs.of_type("STATUSTEXT")
     h.gcs.heartbeat()
@@ -276,8 +276,8 @@ def test_texts_wait_for_a_gcs_up_to_5_s(h):
 
 def test_long_statustext_is_chunked_with_one_id(h):
     h.gcs.heartbeat()
-    h.vehicle.report(4, "commander", "x" * 60 + "y" * 50)
-    h.vehicle.report(6, "commander", "short")
+    h.vehicle.report(Severity.WARNING, "commander", "x" * 60 + "y" * 50)
+    h.vehicle.report(Severity.INFO, "commander", "short")
     h.io()
     msgs = h.gcs.of_type("STATUSTEXT")
     assert [(m.id, m.chunk_seq) for m in msgs] == [(0, 0), (0, 1), (0, 2), (1, 0)]
