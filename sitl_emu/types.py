@@ -163,7 +163,10 @@ class FollowTargetSample:
 class VehicleSnapshot:
     """Everything telemetry needs, at one instant of simulated time. Read-only by convention: not frozen, because a
     frozen dataclass's __init__ sets each of these ~34 fields through object.__setattr__, and `serve` builds a snapshot
-    on most ticks (frozen, that cost 5 % of a vehicle's instructions with its links)."""
+    on most ticks (frozen, that cost 5 % of a vehicle's instructions with its links). Its __init__ is written out
+    (the generated one's parameters, in the same order, with the same defaults; tests/sitl_emu/test_speedups.py checks),
+    because `make speedups` compiles only a written-out one: the generated one cost 20,000 instructions a snapshot
+    in the compiled build."""
 
     time_us: int
     # state machine
@@ -209,3 +212,81 @@ class VehicleSnapshot:
     battery_warning: int = 0  # battery_status_s::WARNING_* (0 none, 1 low, 2 critical, 3 emergency)
     gps_fix_type: int = 3  # SIH's GPS: 3D fix; 0 while a GPS failure is injected
     orbit: OrbitStatus | None = None  # while the orbit flight task runs (ORBIT_EXECUTION_STATUS)
+
+    def __init__(
+        self,
+        time_us: int,
+        armed: bool,
+        nav_state: NavState,
+        user_intended_nav_state: NavState,
+        failsafe: bool,
+        landed_state: LandedState,
+        pre_flight_checks_pass: bool,
+        position_valid: bool,
+        takeoff_detected: bool,
+        offboard_control: OffboardControlMode | None,
+        pos_ned_m: Vec3,
+        vel_ned_m_s: Vec3,
+        acc_ned_m_s2: Vec3,
+        q_wxyz: Vec4,
+        rates_frd_rad_s: Vec3,
+        euler_rad: Vec3,
+        lat_deg: float,
+        lon_deg: float,
+        alt_amsl_m: float,
+        ref_lat_deg: float,
+        ref_lon_deg: float,
+        ref_alt_amsl_m: float,
+        home: HomePosition | None,
+        local_setpoint: TrajectorySetpoint | None,
+        attitude_setpoint_q_wxyz: Vec4 | None,
+        rates_setpoint_rad_s: Vec3,
+        thrust_setpoint: float,
+        motors: Vec4,
+        battery_voltage_v: float = 16.2,
+        battery_remaining: float = 1.0,
+        extras: dict[str, float] | None = None,
+        motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0),
+        offboard_control_last: OffboardControlMode | None = None,
+        manual_control: bool = False,
+        battery_warning: int = 0,
+        gps_fix_type: int = 3,
+        orbit: OrbitStatus | None = None,
+    ) -> None:
+        self.time_us = time_us
+        self.armed = armed
+        self.nav_state = nav_state
+        self.user_intended_nav_state = user_intended_nav_state
+        self.failsafe = failsafe
+        self.landed_state = landed_state
+        self.pre_flight_checks_pass = pre_flight_checks_pass
+        self.position_valid = position_valid
+        self.takeoff_detected = takeoff_detected
+        self.offboard_control = offboard_control
+        self.pos_ned_m = pos_ned_m
+        self.vel_ned_m_s = vel_ned_m_s
+        self.acc_ned_m_s2 = acc_ned_m_s2
+        self.q_wxyz = q_wxyz
+        self.rates_frd_rad_s = rates_frd_rad_s
+        self.euler_rad = euler_rad
+        self.lat_deg = lat_deg
+        self.lon_deg = lon_deg
+        self.alt_amsl_m = alt_amsl_m
+        self.ref_lat_deg = ref_lat_deg
+        self.ref_lon_deg = ref_lon_deg
+        self.ref_alt_amsl_m = ref_alt_amsl_m
+        self.home = home
+        self.local_setpoint = local_setpoint
+        self.attitude_setpoint_q_wxyz = attitude_setpoint_q_wxyz
+        self.rates_setpoint_rad_s = rates_setpoint_rad_s
+        self.thrust_setpoint = thrust_setpoint
+        self.motors = motors
+        self.battery_voltage_v = battery_voltage_v
+        self.battery_remaining = battery_remaining
+        self.extras = {} if extras is None else extras
+        self.motor_commands = motor_commands
+        self.offboard_control_last = offboard_control_last
+        self.manual_control = manual_control
+        self.battery_warning = battery_warning
+        self.gps_fix_type = gps_fix_type
+        self.orbit = orbit

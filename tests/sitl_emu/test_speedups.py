@@ -6,6 +6,7 @@ the manifest is written by hand to match it or not.
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 import hashlib
 import importlib
@@ -171,3 +172,41 @@ def test_the_controllers_isfinite_is_exactly_math_isfinite(x):
     from sitl_emu.control.qmath import isfinite
 
     assert isfinite(x) is math.isfinite(x)
+
+
+def _written_out_dataclass_inits() -> list[tuple[str, ast.ClassDef, ast.FunctionDef]]:
+    """Every @dataclass in sitl_emu that writes its own __init__ (for `make speedups`: mypyc compiles only those)."""
+    found = []
+    for path in sorted((ROOT / "sitl_emu").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if not isinstance(node, ast.ClassDef):
+                continue
+            if not any("dataclass" in ast.unparse(d) for d in node.decorator_list):
+                continue
+            init = next((f for f in node.body if isinstance(f, ast.FunctionDef) and f.name == "__init__"), None)
+            if init is not None:
+                found.append((f"{path.relative_to(ROOT)}:{node.name}", node, init))
+    return found
+
+
+def test_written_out_dataclass_inits_match_the_generated_ones():
+    """A written-out __init__ takes the fields in their order, with their defaults (a default_factory: None)."""
+    checked = _written_out_dataclass_inits()
+    names = {name.split(":")[1] for name, _, _ in checked}
+    assert {"VehicleSnapshot", "TrajectorySetpoint", "Decision", "CheckInputs"} <= names
+    for name, cls, init in checked:
+        fields = [s for s in cls.body if isinstance(s, ast.AnnAssign) and isinstance(s.target, ast.Name)
+                  and "ClassVar" not in ast.unparse(s.annotation)]
+        expected = []
+        for f in fields:
+            value = f.value
+            if isinstance(value, ast.Call) and ast.unparse(value.func) == "field":
+                factory = next((k for k in value.keywords if k.arg == "default_factory"), None)
+                expected.append((f.target.id, "None" if factory is not None else None))
+            else:
+                expected.append((f.target.id, ast.unparse(value) if value is not None else None))
+        args = init.args.args[1:] + init.args.kwonlyargs
+        defaults = [None] * (len(init.args.args) - 1 - len(init.args.defaults)) + init.args.defaults
+        defaults += init.args.kw_defaults
+        written = [(a.arg, ast.unparse(d) if d is not None else None) for a, d in zip(args, defaults, strict=True)]
+        assert written == expected, name
