@@ -67,9 +67,9 @@ def parse_fields(spec: str) -> list[Field]:
 
 
 class MessageFormat:
-    """One topic's format: its 'F' text and how a mapping of field values becomes its 'D' bytes.
+    """One topic's format: its 'F' text, its fields and their defaults (a DataPacker writes its 'D' messages).
 
-    Fields missing from the mapping are zero (PX4's structs are zero-initialised); padding is zero bytes.
+    A field without a default is zero (PX4's structs are zero-initialised); padding is zero bytes.
     """
 
     def __init__(self, name: str, spec: str) -> None:
@@ -104,11 +104,8 @@ class MessageFormat:
         return f"{self.name}:" + "".join(parts)
 
     def set_defaults(self, values: Mapping[str, Any]) -> None:
-        """Values every message has unless `pack` is given others (fields that never change)."""
+        """Values of the fields a DataPacker is not given (fields that never change); the others default to zero."""
         self._defaults = self._filled(values)
-
-    def pack(self, values: Mapping[str, Any]) -> bytes:
-        return self._struct.pack(*self._filled(values))
 
     def default_bytes(self, index: int) -> bytes:
         """The bytes of written field `index` (of `fields`) with its default value (padding: zero bytes)."""
@@ -132,8 +129,9 @@ class MessageFormat:
 
 class DataPacker:
     """A topic's 'D' messages as `msg_id`, from the values of the fields `names`: a flat tuple, in the order of
-    `names`, an array's elements in place of the array ((t, t, *q) for "timestamp", "timestamp_sample", "q"). The
-    bytes of data(msg_id, fmt.pack(...)) with the same values, for messages written every tick.
+    `names`, an array's elements in place of the array ((t, t, *q) for "timestamp", "timestamp_sample", "q"). A
+    message is the 3-byte header, msg_id, then every field in the format's order: a field not in `names` has its
+    default (MessageFormat.set_defaults, else zero), padding is zero bytes, the trailing padding is not written.
 
     The work is done once, here: the message header and each run of fields not in `names` (their defaults, the
     padding) become constant bytes, so a message packs only the named values and those runs, with one struct.
@@ -227,10 +225,6 @@ def parameter_default(name: str, value: float, is_int: bool, kinds: int = DEFAUL
 
 def add_logged(msg_id: int, name: str, multi_id: int = 0) -> bytes:
     return message(b"A", _ADD_LOGGED.pack(multi_id, msg_id) + name.encode())
-
-
-def data(msg_id: int, payload: bytes) -> bytes:
-    return message(b"D", _DATA_ID.pack(msg_id) + payload)
 
 
 def log_text(level: int, timestamp_us: int, text: str) -> bytes:

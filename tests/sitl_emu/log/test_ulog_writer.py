@@ -34,8 +34,8 @@ def test_a_written_file_reads_back_with_its_formats_infos_params_data_and_texts(
     log = _file(tmp_path, ulog.info("sys_name", "PX4"), ulog.info("ver_sw_release", 0x010F04FF, "uint32_t"), defs,
                 ulog.parameter("MPC_XY_VEL_MAX", 12.0, False), ulog.parameter("MAV_SYS_ID", 1, True),
                 ulog.parameter_default("MPC_XY_VEL_MAX", 12.0, False), subs,
-                ulog.data(0, fmt.pack({"timestamp": 2000, "xyz": (1.0, 2.0, 3.0), "ok": True})),
-                ulog.data(0, fmt.pack({"timestamp": 3000})), ulog.log_text(4, 2500, "warn me"), ulog.sync())
+                ulog.DataPacker(fmt, 0, ("timestamp", "xyz", "ok"))((2000, 1.0, 2.0, 3.0, True)),
+                ulog.DataPacker(fmt, 0, ("timestamp",))((3000,)), ulog.log_text(4, 2500, "warn me"), ulog.sync())
     assert not log.file_corruption
     assert log.msg_info_dict["sys_name"] == "PX4" and log.msg_info_dict["ver_sw_release"] == 0x010F04FF
     assert log.initial_parameters == {"MPC_XY_VEL_MAX": 12.0, "MAV_SYS_ID": 1}
@@ -46,26 +46,33 @@ def test_a_written_file_reads_back_with_its_formats_infos_params_data_and_texts(
     assert (text.log_level_str(), text.timestamp, text.message) == ("WARNING", 2500, "warn me")
 
 
+def _data_message(msg_id: int, payload: bytes) -> bytes:
+    """A 'D' message as the ULog format defines it: size (msg_id + payload), 'D', msg_id, payload."""
+    return struct.pack("<HBH", 2 + len(payload), ord("D"), msg_id) + payload
+
+
 def test_defaults_texts_and_bad_fields():
     fmt = ulog.MessageFormat("t", "uint64_t timestamp;float a;float b")
     fmt.set_defaults({"b": 7.0})
-    assert struct.unpack("<Qff", fmt.pack({"a": 1.0})) == (0, 1.0, 7.0)
+    assert ulog.DataPacker(fmt, 3, ("a",))((1.0,)) == _data_message(3, struct.pack("<Qff", 0, 1.0, 7.0))
     long_text = ulog.log_text(6, 0, "x" * 300)
     assert len(long_text) == 3 + 1 + 8 + ulog.MAX_TEXT  # PX4's 128-char message, NUL included
     with pytest.raises(ValueError):
         ulog.parse_fields("quaternion q")
     with pytest.raises(KeyError):
-        fmt.pack({"nope": 1})
+        fmt.set_defaults({"nope": 1})
 
 
-def test_a_data_packer_writes_the_bytes_of_data_and_pack_with_defaults_arrays_and_padding():
+def test_a_data_packer_writes_its_values_with_defaults_arrays_and_padding():
     fmt = ulog.MessageFormat("t", "uint64_t timestamp;float[3] xyz;float a;bool ok;uint8_t c;uint8_t[2] _padding0;"
                                   "float b;uint8_t[4] _padding1")
     fmt.set_defaults({"b": 7.0, "c": 3})
     pack = ulog.DataPacker(fmt, 5, ("timestamp", "xyz", "ok"))
-    assert pack((2000, 1.0, 2.0, 3.0, True)) == ulog.data(5, fmt.pack({"timestamp": 2000, "xyz": (1.0, 2.0, 3.0),
-                                                                      "ok": True}))
-    assert ulog.DataPacker(fmt, 1, ("b", "a"))((1.5, -2.0)) == ulog.data(1, fmt.pack({"a": -2.0, "b": 1.5}))
+    # every field in order, the middle padding as zero bytes, the trailing padding not written
+    assert pack((2000, 1.0, 2.0, 3.0, True)) == _data_message(
+        5, struct.pack("<Q3ff?B2xf", 2000, 1.0, 2.0, 3.0, 0.0, True, 3, 7.0))
+    assert ulog.DataPacker(fmt, 1, ("b", "a"))((1.5, -2.0)) == _data_message(
+        1, struct.pack("<Q3ff?B2xf", 0, 0.0, 0.0, 0.0, -2.0, False, 3, 1.5))
     with pytest.raises(ValueError):
         pack((2000, (1.0, 2.0, 3.0), True))  # an array goes in as its elements
     with pytest.raises(ValueError):
