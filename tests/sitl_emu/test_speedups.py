@@ -190,7 +190,8 @@ def _written_out_dataclass_inits() -> list[tuple[str, ast.ClassDef, ast.Function
 
 
 def test_written_out_dataclass_inits_match_the_generated_ones():
-    """A written-out __init__ takes the fields in their order, with their defaults (a default_factory: None)."""
+    """A written-out __init__ takes the fields in their order, with their defaults (a default_factory: None), and
+    sets each of them."""
     checked = _written_out_dataclass_inits()
     names = {name.split(":")[1] for name, _, _ in checked}
     assert {"VehicleSnapshot", "TrajectorySetpoint", "Decision", "CheckInputs"} <= names
@@ -210,3 +211,6 @@ def test_written_out_dataclass_inits_match_the_generated_ones():
         defaults += init.args.kw_defaults
         written = [(a.arg, ast.unparse(d) if d is not None else None) for a, d in zip(args, defaults, strict=True)]
         assert written == expected, name
+        assigned = [t.attr for stmt in init.body if isinstance(stmt, ast.Assign) for t in stmt.targets
+                    if isinstance(t, ast.Attribute) and ast.unparse(t.value) == "self"]
+        assert assigned == [f.target.id for f in fields], name  # every field set, in order
