@@ -77,15 +77,13 @@ class BatterySimulator:
             self._last_us = now_us
         else:
             self.fraction, self._last_us = 1.0, None
-        if self.fraction < s.min_fraction:
-            self.fraction = s.min_fraction
+        self.fraction = max(self.fraction, s.min_fraction)
         self.voltage_v = ((1.0 - self.fraction) * s.v_empty + self.fraction * s.v_charged) * s.cells
         self.remaining = 0.0 if self.failed else self.fraction
         warning = WARNING_EMERGENCY if self.failed else determine_warning(self.fraction, s)
         if now_us < INITIALIZE_US or not s.enabled:
             warning = WARNING_NONE
-        if warning > self.warning or not armed:  # while armed the warning only rises
-            self.warning = warning
+        self.warning = max(self.warning, warning) if armed else warning  # while armed it only rises
 
 
 # COM_LOW_BAT_ACT -> (action at critical, action at emergency); None: a warning only

@@ -31,7 +31,7 @@ def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_
     b = 4.0 * accel * accel / jerk
     c = -2.0 * accel * distance_m - final_speed * final_speed
     speed = 0.5 * (-b + math.sqrt(b * b - 4.0 * c))
-    return final_speed if final_speed > speed else speed  # max(speed, final_speed)
+    return max(speed, final_speed)
 
 
 def braking_distance(speed: float, jerk: float, accel: float, accel_delay_max: float) -> float:
@@ -146,15 +146,14 @@ class AxisSmoother:
             return
         dv = vel_sp - v
         t1 = self._t1 = self._t1_min_time(a, dv, jerk)
-        t3 = a / jerk + t1
-        t3 = self._t3 = 0.0 if t3 < 0.0 else t3  # max(t3, 0)
+        t3 = self._t3 = max(a / jerk + t1, 0.0)
         # T2 from the velocity the jerk phases leave to the constant-acceleration phase
         den = a + jerk * t1
         if abs(den) <= _EPS:
             self._t2 = 0.0
             return
         t2 = (-0.5 * t1 * t1 * jerk - t1 * t3 * jerk - t1 * a + 0.5 * t3 * t3 * jerk - t3 * a + dv) / den
-        self._t2 = 0.0 if t2 < 0.0 else t2
+        self._t2 = max(t2, 0.0)
 
     def update_durations_given_total_time(self, total_s: float) -> None:
         """Stretch the current plan so that it lasts `total_s` (used to synchronise the axes)."""
@@ -163,30 +162,28 @@ class AxisSmoother:
             self._t1 = self._t2 = self._t3 = 0.0
             return
         t1 = self._t1 = self._t1_given_total(total_s, self.a, self._vel_sp - self.v, jerk)
-        t3 = self.a / jerk + t1
-        t3 = self._t3 = 0.0 if t3 < 0.0 else t3  # max(t3, 0)
-        t2 = total_s - t1 - t3
-        self._t2 = 0.0 if t2 < 0.0 else t2
+        t3 = self._t3 = max(self.a / jerk + t1, 0.0)
+        self._t2 = max(total_s - t1 - t3, 0.0)
 
     def update_traj(self, dt_s: float, time_stretch: float = 1.0) -> None:
-        """Advance the plan by `dt_s` (>= 0) times `time_stretch` (0..1) (VelocitySmoothing::updateTraj): T1 at +jerk,
-        T2 at constant acceleration, T3 at -jerk, then constant velocity; each for min(rest, its duration)."""
+        """Advance along the planned profile by `dt_s` (>= 0) scaled by `time_stretch` (0..1)
+        (VelocitySmoothing::updateTraj): T1 at +jerk, T2 at constant acceleration, T3 at -jerk, then constant
+        velocity."""
         rest = self._time = self._time + dt_s * time_stretch
-        t1, t2, t3 = self._t1, self._t2, self._t3
-        if t1 == 0.0 and t2 == 0.0 and t3 == 0.0:  # nothing planned: constant velocity
+        if self._t1 == 0.0 and self._t2 == 0.0 and self._t3 == 0.0:  # nothing planned: constant velocity
             if rest > 0.0:
                 self.j, self.a, self.v, self.x = 0.0, 0.0, self._v0, self._x0 + self._v0 * rest
             else:
                 self.j, self.a, self.v, self.x = 0.0, self._a0, self._v0, self._x0
             return
-        j, a, v, x = _evaluate_poly(self._dir * self.max_jerk, self._a0, self._v0, self._x0, t1 if t1 < rest else rest)
-        rest -= t1
+        j, a, v, x = _evaluate_poly(self._dir * self.max_jerk, self._a0, self._v0, self._x0, min(rest, self._t1))
+        rest -= self._t1
         if rest > 0.0:
-            j, a, v, x = _evaluate_poly(0.0, a, v, x, t2 if t2 < rest else rest)
-            rest -= t2
+            j, a, v, x = _evaluate_poly(0.0, a, v, x, min(rest, self._t2))
+            rest -= self._t2
         if rest > 0.0:
-            j, a, v, x = _evaluate_poly(-self._dir * self.max_jerk, a, v, x, t3 if t3 < rest else rest)
-            rest -= t3
+            j, a, v, x = _evaluate_poly(-self._dir * self.max_jerk, a, v, x, min(rest, self._t3))
+            rest -= self._t3
         if rest > 0.0:
             j, a, v, x = _evaluate_poly(0.0, 0.0, v, x, rest)
         self.j, self.a, self.v, self.x = j, a, v, x
@@ -212,8 +209,7 @@ class AxisSmoother:
             cand = (-a0 - 0.5 * root) / jerk
             if cand >= 0.0 and a0 / jerk + cand >= 0.0:
                 t1 = cand
-        t1 = self._saturate_t1(a0, jerk, t1)
-        return 0.0 if t1 < 0.0 else t1  # max(t1, 0)
+        return max(self._saturate_t1(a0, jerk, t1), 0.0)
 
     def _t1_given_total(self, total: float, a0: float, dv: float, jerk: float) -> float:
         qa, qb = -jerk, jerk * total - a0
@@ -361,15 +357,13 @@ class PositionSmoother:
         if isfinite(target[0]) and isfinite(target[1]):
             dx, dy = target[0] - ax.x, target[1] - ay.x
             dist = math.hypot(dx, dy)
-            speed = max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0)
-            speed = speed if speed < self.cruise_speed_m_s else self.cruise_speed_m_s  # min(cruise, speed)
+            speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
             out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
             out1 = uy * speed + (ff[1] if isfinite(ff[1]) else 0.0)
         if isfinite(target[2]):
             dz = target[2] - az.x
-            speed = max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0)
-            speed = speed if speed < az.max_vel else az.max_vel  # min(max_vel, speed)
+            speed = min(az.max_vel, max_speed_from_distance(az.max_jerk, az.max_accel, abs(dz), 0.0))
             out2 = _sign(dz) * speed + (ff[2] if isfinite(ff[2]) else 0.0)
         return (out0, out1, out2)
 

@@ -237,7 +237,7 @@ class AutoCore:
         s, sm = self.s, self.smoother
         cruise = wp.cruise_m_s if isfinite(wp.cruise_m_s) and wp.cruise_m_s > 0.0 else s.xy_cruise
         vel_max = s.xy_vel_max
-        sm.cruise_speed_m_s = vel_max if vel_max < cruise else cruise  # min(cruise, vel_max)
+        sm.cruise_speed_m_s = min(cruise, vel_max)
         sm.max_xy_error_m = s.xy_err_max
         if self._unsmoothed_vz < 0.0:  # going up
             acc_z, vel_z = s.acc_up, s.z_v_auto_up
@@ -252,8 +252,7 @@ class AutoCore:
 
     @staticmethod
     def _dist_to_ground(nav: NavInput) -> float:
-        height = -nav.pos_ned_m[2]
-        return 0.0 if height < 0.0 else height  # max(height, 0)
+        return max(-nav.pos_ned_m[2], 0.0)
 
     def _land_speed(self, nav: NavInput) -> float:
         """FlightTaskAuto::_prepareLandSetpoints: MPC_LAND_SPEED below ALT2, MPC_Z_VEL_MAX_DN above ALT1, linear in
