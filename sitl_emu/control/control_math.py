@@ -7,7 +7,7 @@ from __future__ import annotations
 from math import acos, cos, hypot, sin, sqrt
 from typing import Final
 
-from sitl_emu.control.qmath import add, all_finite3, constrain, cross, isfinite, normalized, q_from_dcm_columns
+from sitl_emu.control.qmath import constrain, cross, isfinite, normalized, q_from_dcm_columns
 from sitl_emu.types import Vec3, Vec4
 
 FLT_EPSILON: Final = 1.2e-7
@@ -16,8 +16,6 @@ FLT_EPSILON: Final = 1.2e-7
 def add_if_not_nan3(setpoint: Vec3, addition: Vec3) -> Vec3:
     """ControlMath::addIfNotNanVector3f: setpoint + addition per component, where a NaN term does not count (NaN if
     both are NaN)."""
-    if all_finite3(setpoint) and all_finite3(addition):  # every term counts: the plain sum
-        return add(setpoint, addition)
     s0, s1, s2 = setpoint
     a0, a1, a2 = addition
     return ((s0 + a0 if isfinite(a0) else s0) if isfinite(s0) else a0,

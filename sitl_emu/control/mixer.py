@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from typing import Final
 
-from sitl_emu.control.qmath import all_finite3, constrain, isfinite
+from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3, Vec4
 
 _K: Final = 1.0 / math.sqrt(2.0)
@@ -38,9 +38,8 @@ def mix(torque: Vec3, thrust: float) -> tuple[Vec4, Flags3, Flags3]:
     the rate controller uses to stop integrating into the saturation.
     """
     roll, pitch, yaw = torque
-    if not all_finite3(torque):
-        roll, pitch, yaw = (roll if isfinite(roll) else 0.0, pitch if isfinite(pitch) else 0.0,
-                            yaw if isfinite(yaw) else 0.0)
+    roll, pitch, yaw = (roll if isfinite(roll) else 0.0, pitch if isfinite(pitch) else 0.0,
+                        yaw if isfinite(yaw) else 0.0)
     thrust = thrust if isfinite(thrust) else 0.0
     r, p = _K * roll, _K * pitch  # the ROLL and PITCH columns above, row by row
     u = (thrust - r + p, thrust + r - p, thrust + r + p, thrust - r - p)

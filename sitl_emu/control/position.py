@@ -20,7 +20,7 @@ from typing import Final
 
 from sitl_emu.control.control_math import add_if_not_nan3, bodyz_to_attitude, constrain_xy, limit_tilt
 from sitl_emu.control.filters import LowPassDerivative
-from sitl_emu.control.qmath import all_finite3, constrain, emult, isfinite, norm, normalized, scale, sub
+from sitl_emu.control.qmath import constrain, emult, isfinite, norm, normalized, scale, sub
 from sitl_emu.types import TrajectorySetpoint, Vec3, Vec4
 
 G: Final = 9.80665  # CONSTANTS_ONE_G
@@ -85,8 +85,6 @@ class PositionOutput:
 def input_valid(sp: TrajectorySetpoint) -> bool:
     """PositionControl::_inputValid (the estimate is always valid here)."""
     pos, vel, acc = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
-    if all_finite3(pos) and all_finite3(vel) and all_finite3(acc):  # everything given (the auto modes' setpoints)
-        return True
     pos_x, vel_x, acc_x = isfinite(pos[0]), isfinite(vel[0]), isfinite(acc[0])
     in_pairs = pos_x == isfinite(pos[1]) and vel_x == isfinite(vel[1]) and acc_x == isfinite(acc[1])
     # every axis needs some setpoint (with x and y in pairs, x stands for both)

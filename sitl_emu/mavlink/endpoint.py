@@ -230,8 +230,7 @@ class Endpoint:
             self.streams.emit_due(self, self.node.snapshot)
         if events:
             self._pending_texts.extend(e for e in events if e.statustext)
-        # texts wait for a GCS; while none has ever been heard, without a call per tick
-        if self._pending_texts and self.last_gcs_heartbeat_us is not None and self.gcs_connected():
+        if self._pending_texts and self.gcs_connected():  # texts wait for a GCS
             self.streams.send_statustexts(self, list(self._pending_texts))
             self._pending_texts.clear()
         if self._watches_vehicle:  # news of the vehicle since the last emit wakes the handlers
