@@ -89,7 +89,7 @@ class Endpoint:
     GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
 
     def __init__(self, name: str, link: UdpLink, node: NodeServices, mode: StreamMode,
-                 handler_classes: Sequence[type] = ()) -> None:
+                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0) -> None:
         self.link_name = name
         self.link = link
         self.node = node
@@ -101,7 +101,7 @@ class Endpoint:
         self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/fastpack.py): same calls, cheaper messages
         self._parser = _new_parser()
         self.stats = EndpointStats()
-        self.streams = Streams(mode)
+        self.streams = Streams(mode, stream_delay_us)
         self.receiver = Receiver(CommandHandler(self.streams))
         self.seen_components: set[tuple[int, int]] = set()
         self.last_gcs_heartbeat_us: int | None = None

@@ -108,8 +108,12 @@ def _interval_us(hz: float) -> int:
 class Streams:
     """One link's stream table: interval per message id (None = off) and the next due time, in simulated µs."""
 
-    def __init__(self, mode: StreamMode) -> None:
+    def __init__(self, mode: StreamMode, start_delay_us: int = 0) -> None:
         self.mode = mode
+        # the streams (heartbeat included) begin this long after the first pass: runtime/swarm.py staggers its
+        # vehicles' links, as separately started PX4 instances are out of phase with each other
+        self.start_delay_us = start_delay_us
+        self._starting = True  # no pass yet since construction or restart
         rates = ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else NORMAL_RATES_HZ
         self._default_us: dict[int, int] = {mid: _interval_us(hz) for mid, hz in rates.items()}
         self._interval_us: dict[int, int] = dict(self._default_us)
@@ -129,6 +133,7 @@ class Streams:
         self._schedule_stale = True
         self._next_heartbeat_us = 0
         self.next_due_us = 0
+        self._starting = True
 
     # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
     def known(self, msg_id: int) -> bool:
@@ -179,6 +184,11 @@ class Streams:
         now = ctx.now_us
         if now < self.next_due_us:
             return 0
+        if self._starting:
+            self._starting = False
+            if self.start_delay_us > 0:
+                self._begin_at(now + self.start_delay_us)
+                return 0
         snap = get_snapshot()
         sent = 0
         if now >= self._next_heartbeat_us:
@@ -211,6 +221,13 @@ class Streams:
             earliest = heap[0][0]
         self.next_due_us = earliest
         return sent
+
+    def _begin_at(self, start_us: int) -> None:
+        """Nothing goes out before `start_us`; then the heartbeat and every stream are due at once."""
+        self._next_heartbeat_us = start_us
+        self._next_us = {mid: start_us for mid in self._interval_us}  # none is kept before the first pass
+        self._schedule_stale = True
+        self.next_due_us = start_us
 
     def _rebuild_schedule(self, now: int) -> None:
         """A stream without a kept due time is due now (new, re-configured, or after a restart)."""

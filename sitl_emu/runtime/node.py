@@ -50,7 +50,8 @@ class VehicleNode:
     """A Vehicle plus its endpoints. `step_io(now_us)` is all a runner calls besides stepping the vehicle."""
 
     def __init__(self, vehicle: Any, settings: LinkSettings = LinkSettings(), epoch_unix_us: int = 0,
-                 handler_classes: Sequence[type] | None = None) -> None:
+                 handler_classes: Sequence[type] | None = None, stream_delay_us: int = 0) -> None:
+        """`stream_delay_us`: both links start streaming this long after the first step_io (runtime/swarm.py)."""
         self.vehicle = vehicle
         self.settings = settings
         self.epoch_unix_us = epoch_unix_us
@@ -61,8 +62,8 @@ class VehicleNode:
         except OSError:
             api_link.close()
             raise
-        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes)
-        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes)
+        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us)
+        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us)
         self.endpoints: tuple[Endpoint, ...] = (self.api, self.gcs)
         self._event_seq = -1
         self._snapshot: VehicleSnapshot | None = None

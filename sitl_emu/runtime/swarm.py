@@ -28,6 +28,10 @@ log = logging.getLogger(__name__)
 
 DEFAULT_HOME = (47.397742, 8.545594, 488.0)  # Vehicle's default home (PX4 SIH default, Zurich)
 DEFAULT_SPACING_M = 3.0  # gazebo-classic sitl_multiple_run.sh: instance N spawned at 3*N m
+# Vehicle i of a swarm starts streaming i ticks after the first (wrapping at 1 s), as PX4 instances started one after
+# another are out of phase. In phase, every vehicle's 1 Hz messages would go out in the same tick: with 64 vehicles
+# that tick took about 40 ms, late by ten ticks (measured with bench/scale.py).
+STREAM_STAGGER_US = 4000
 SWARM_IO_BUDGET = 20  # datagrams read per link per tick (4 ms of simulated time) in the swarm runner
 
 VehicleFactory = Callable[[int, tuple[float, float, float]], Any]  # (instance, home) -> Vehicle
@@ -57,12 +61,18 @@ def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory
             instance = first_instance + i
             vehicle = make_vehicle(instance, instance_home(home, i, spacing_m))
             classes = handlers_for(instance) if handlers_for is not None else handler_classes
-            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, classes))
+            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, classes,
+                                     stream_delay_us(i)))
     except BaseException:
         for node in nodes:
             node.close()
         raise
     return nodes
+
+
+def stream_delay_us(index: int) -> int:
+    """How long after the first tick the `index`-th vehicle of a swarm starts its streams."""
+    return index * STREAM_STAGGER_US % 1_000_000
 
 
 def _offset(settings: LinkSettings, instance: int) -> LinkSettings:

@@ -11,12 +11,16 @@ from __future__ import annotations
 import random
 from typing import Any
 
+import pytest
+
 from sitl_emu.mavlink import telemetry
 from sitl_emu.mavlink.telemetry import HEARTBEAT_ID, HEARTBEAT_INTERVAL_US, StreamMode, Streams
 
 
 class _Reference:
-    def __init__(self, mode: StreamMode) -> None:
+    def __init__(self, mode: StreamMode, start_delay_us: int = 0) -> None:
+        self.start_delay_us = start_delay_us
+        self.starting = True
         rates = telemetry.ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else telemetry.NORMAL_RATES_HZ
         self.default = {mid: round(1e6 / hz) for mid, hz in rates.items()}
         self.interval = dict(self.default)
@@ -38,8 +42,15 @@ class _Reference:
     def restart(self) -> None:
         self.next.clear()
         self.next_hb = 0
+        self.starting = True
 
     def due(self, now: int) -> list[int]:
+        if self.starting and now >= self.next_hb:  # the first pass: everything begins start_delay_us later
+            self.starting = False
+            if self.start_delay_us:
+                self.next_hb = now + self.start_delay_us
+                self.next = {msg_id: self.next_hb for msg_id in self.interval}
+                return []
         out = []
         if now >= self.next_hb:
             out.append(HEARTBEAT_ID)
@@ -66,10 +77,10 @@ class _Ctx:
         self.sent.append(msg)
 
 
-def _run(mode: StreamMode, seed: int) -> tuple[list[list[int]], list[list[int]]]:
+def _run(mode: StreamMode, seed: int, start_delay_us: int = 0) -> tuple[list[list[int]], list[list[int]]]:
     """(what Streams sent, what the reference sends) per pass, for a random history of passes and changes."""
     rng = random.Random(seed)
-    streams, reference, ctx = Streams(mode), _Reference(mode), _Ctx()
+    streams, reference, ctx = Streams(mode, start_delay_us), _Reference(mode, start_delay_us), _Ctx()
     got, expected = [], []
     for _ in range(4000):
         ctx.now_us += rng.choice((1000, 4000, 4000, 4000, 25_000))
@@ -90,13 +101,31 @@ def _run(mode: StreamMode, seed: int) -> tuple[list[list[int]], list[list[int]]]
     return got, expected
 
 
-def test_streams_send_what_a_table_scan_sends_through_rate_changes_and_reboots(monkeypatch):
-    # every builder returns its message id, so the test sees which streams went out in which order
+@pytest.fixture
+def ids_for_messages(monkeypatch):
+    """Every builder returns its message id, so a test sees which streams went out in which order."""
     monkeypatch.setattr(telemetry.tm, "heartbeat", lambda ctx, snap: HEARTBEAT_ID)
     for msg_id in list(telemetry.BUILDERS):
         monkeypatch.setitem(telemetry.BUILDERS, msg_id, lambda ctx, snap, m=msg_id: m)
+
+
+def test_streams_send_what_a_table_scan_sends_through_rate_changes_and_reboots(ids_for_messages):
     for mode in StreamMode:
         for seed in range(3):
-            got, expected = _run(mode, seed)
-            assert sum(map(len, got)) > 1000
-            assert got == expected
+            for start_delay_us in (0, 12_000):  # a swarm's later vehicles begin streaming later (runtime/swarm.py)
+                got, expected = _run(mode, seed, start_delay_us)
+                assert sum(map(len, got)) > 1000
+                assert got == expected
+
+
+def test_a_start_delay_holds_back_every_stream_and_the_heartbeat_until_it_has_passed(ids_for_messages):
+    ctx = _Ctx()
+    streams = Streams(StreamMode.NORMAL, start_delay_us=8000)
+    ctx.now_us = 100_000  # the first pass
+    assert streams.emit_due(ctx, lambda: None) == 0
+    ctx.now_us = 104_000
+    assert streams.emit_due(ctx, lambda: None) == 0
+    ctx.now_us = 108_000
+    sent = streams.emit_due(ctx, lambda: None)
+    assert sent == len(ctx.sent) == 1 + len(telemetry.NORMAL_RATES_HZ)  # the heartbeat and every stream at once
+    assert ctx.sent[0] == HEARTBEAT_ID
