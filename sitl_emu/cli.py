@@ -39,7 +39,7 @@ from sitl_emu.cli_options import (
 from sitl_emu.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
-from sitl_emu.mavlink.link import PortInUseError
+from sitl_emu.mavlink.link_errors import PortInUseError
 from sitl_emu.runtime.node import LinkSettings
 from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
 from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-COMPILED_FOLDERS = tuple(Path(__file__).parent / "sitl_emu" / name for name in ("core", "testing", "mavlink"))
+COMPILED_FOLDERS = tuple(Path(__file__).parent / "sitl_emu" / name
+                         for name in ("core", "testing", "mavlink", "runtime"))
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -93,6 +93,18 @@ DEFAULT_MODULES = (
     "sitl_emu/flight/follow_estimator.py",
     "sitl_emu/disturbance/wind.py",
     "sitl_emu/disturbance/estimate.py",
+    # the link's per-message path, most of `serve`'s own cost: the streams and their builders, the framing, the
+    # endpoint, the socket and the node
+    "sitl_emu/mavlink/telemetry.py",
+    "sitl_emu/mavlink/telemetry_msgs.py",
+    "sitl_emu/mavlink/telemetry_actuators.py",
+    "sitl_emu/mavlink/telemetry_health.py",
+    "sitl_emu/mavlink/telemetry_sensors.py",
+    "sitl_emu/mavlink/endpoint.py",
+    "sitl_emu/mavlink/link.py",
+    "sitl_emu/mavlink/fastpack.py",
+    "sitl_emu/mavlink/context.py",
+    "sitl_emu/runtime/node.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]

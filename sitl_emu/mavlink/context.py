@@ -21,8 +21,22 @@ if TYPE_CHECKING:
 
     from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
 
-    from sitl_emu.mavlink.fastpack import Encoder, Packed
-    from sitl_emu.types import VehicleSnapshot
+    from sitl_emu.flight.mission_store import MissionStore
+    from sitl_emu.mavlink.encoding import MessageEncoder
+    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.params import ParamRegistry
+    from sitl_emu.px4 import Severity
+    from sitl_emu.types import (
+        AttitudeSetpoint,
+        CommandAck,
+        FollowTargetSample,
+        ManualControlSetpoint,
+        OffboardControlMode,
+        TrajectorySetpoint,
+        VehicleCommand,
+        VehicleEvent,
+        VehicleSnapshot,
+    )
     from sitl_emu.vehicle import Vehicle
 
     # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
@@ -61,6 +75,44 @@ class EndpointStats:
         return self._tx_rate & 0xFFFFFFFF, self._rx_rate & 0xFFFFFFFF
 
 
+class LinkVehicle(Protocol):
+    """The vehicle as the links see it: all that the endpoint, its parts and the protocol handlers ask of it.
+
+    sitl_emu/vehicle.py's Vehicle is one (checked below); the link's unit tests drive it with a recording stand-in
+    (tests/support/fakes.py). Typed as this protocol, the compiled build does not insist on the Vehicle class.
+    """
+
+    sysid: int
+    params: ParamRegistry
+
+    @property
+    def time_us(self) -> int: ...
+
+    def snapshot(self) -> VehicleSnapshot: ...
+
+    def events_after(self, seq: int) -> list[VehicleEvent]: ...
+
+    def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None: ...
+
+    def handle_command(self, cmd: VehicleCommand) -> CommandAck | None: ...
+
+    def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
+                       attitude: AttitudeSetpoint | None = None) -> None: ...
+
+    def manual_control_input(self, setpoint: ManualControlSetpoint) -> None: ...
+
+    def follow_target_input(self, sample: FollowTargetSample) -> None: ...
+
+    def gcs_heartbeat(self) -> None: ...
+
+    def mission_store(self) -> MissionStore: ...
+
+
+if TYPE_CHECKING:
+    def _a_vehicle_is_a_link_vehicle(vehicle: Vehicle) -> LinkVehicle:
+        return vehicle  # mypy checks that Vehicle has all of LinkVehicle
+
+
 class LinkContext(Protocol):
     mav: MAVLink  # encoder with this vehicle's sysid/compid: ctx.mav.param_value_encode(...)
     link_name: str  # "api" or "gcs"
@@ -68,7 +120,7 @@ class LinkContext(Protocol):
     compid: int
 
     @property
-    def vehicle(self) -> Vehicle: ...
+    def vehicle(self) -> LinkVehicle: ...
 
     @property
     def now_us(self) -> int: ...
@@ -99,7 +151,11 @@ class NodeView(Protocol):
 
 
 class EndpointContext(LinkContext, Protocol):
-    encoder: Encoder  # fastpack.ENCODER: the same calls as ctx.mav, cheaper messages (telemetry streams)
+    @property
+    def encoder(self) -> MessageEncoder:
+        """fastpack.ENCODER: the same calls as ctx.mav, cheaper messages (the telemetry streams)."""
+        ...
+
     last_gcs_heartbeat_us: int | None  # the receiver sets it on a GCS heartbeat
     stats: EndpointStats  # this link's counters (LINK_NODE_STATUS)
 
@@ -123,7 +179,7 @@ class Handler(Protocol):
         it until then. None or True: tick it again next time."""
 
 
-def vehicle_news(vehicle: Vehicle) -> tuple[int, int, bool, int]:
+def vehicle_news(vehicle: LinkVehicle) -> tuple[int, int, bool, int]:
     """What protocol handlers act on between messages: the parameters' version (params_protocol sends changed
     values, as PX4's parameter_update subscription) and the navigator's mission progress (mission_protocol reports
     it, as PX4's mission_result subscription)."""

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink.context import EndpointStats, NodeView, vehicle_news
+from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, vehicle_news
 from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
@@ -28,7 +28,6 @@ if TYPE_CHECKING:
 
     from sitl_emu.mavlink.context import Handler, OutMessage
     from sitl_emu.types import VehicleEvent
-    from sitl_emu.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +61,7 @@ def load_handler_classes(spec: Iterable[tuple[str, str]] = HANDLER_CLASSES) -> l
 class NodeServices(NodeView, Protocol):
     """What an endpoint needs from the node that owns it: what its parts use (NodeView) and the links' plumbing."""
 
-    vehicle: Vehicle
+    vehicle: LinkVehicle
 
     @property
     def sysid(self) -> int: ...
@@ -123,7 +122,7 @@ class Endpoint:
 
     # --- LinkContext ---------------------------------------------------------------------------------------------
     @property
-    def vehicle(self) -> Vehicle:
+    def vehicle(self) -> LinkVehicle:
         return self.node.vehicle
 
     @property

@@ -169,14 +169,18 @@ def _encode_defaults(cls: Any) -> tuple[Any, ...] | None:
 class Encoder:
     """`ENCODER.attitude_encode(...)` -> Packed, the same call as pymavlink's `mav.attitude_encode(...)`."""
 
+    def __init__(self) -> None:
+        self._encoders: dict[str, Callable[..., Packed]] = {}  # by attribute name, built on first use
+
     def __getattr__(self, attr: str) -> Callable[..., Packed]:
         if not attr.endswith("_encode"):
             raise AttributeError(attr)
-        cls = dialect.__dict__.get(f"MAVLink_{attr[:-len('_encode')]}_message")
-        if cls is None:
-            raise AttributeError(attr)
-        encode = spec_for_class(cls).encode
-        setattr(self, attr, encode)  # later look-ups are plain attribute hits
+        encode = self._encoders.get(attr)
+        if encode is None:
+            cls = dialect.__dict__.get(f"MAVLink_{attr[:-len('_encode')]}_message")
+            if cls is None:
+                raise AttributeError(attr)
+            encode = self._encoders[attr] = spec_for_class(cls).encode
         return encode
 
 

@@ -14,15 +14,13 @@ import logging
 import socket
 from dataclasses import dataclass
 
+from sitl_emu.mavlink.link_errors import PortInUseError
+
 log = logging.getLogger(__name__)
 
 Address = tuple[str, int]
 _MAX_DATAGRAM = 65535
 _RCVBUF_BYTES = 1 << 20
-
-
-class PortInUseError(OSError):
-    """The local UDP port is taken; str(err) is one sentence for the user."""
 
 
 @dataclass(slots=True)

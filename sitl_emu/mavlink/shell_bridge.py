@@ -26,8 +26,7 @@ from sitl_emu.shell import Shell
 if TYPE_CHECKING:
     from pymavlink.dialects.v20.development import MAVLink_message, MAVLink_serial_control_message
 
-    from sitl_emu.mavlink.context import LinkContext
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.mavlink.context import LinkContext, LinkVehicle
 
 SERIAL_CONTROL_DEV_SHELL = 10
 SERIAL_CONTROL_FLAG_REPLY = 1
@@ -147,6 +146,6 @@ def _accepted(msg: MAVLink_serial_control_message, ctx: LinkContext) -> bool:
     return not msg.flags & SERIAL_CONTROL_FLAG_REPLY and msg.device == SERIAL_CONTROL_DEV_SHELL
 
 
-def _latest_event_seq(vehicle: Vehicle) -> int:
+def _latest_event_seq(vehicle: LinkVehicle) -> int:
     events = vehicle.events_after(-1)
     return events[-1].seq if events else -1

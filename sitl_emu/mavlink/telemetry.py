@@ -176,51 +176,52 @@ class Streams:
         return builder(ctx, snap) if builder is not None else None
 
     def emit_due(self, ctx: EndpointContext, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
-        """Send every stream due at ctx.now_us; the snapshot is only taken when something is due.
-
-        Hot path (every link, every tick): one comparison when nothing is due; otherwise only the due streams are
-        touched (heap), their next due times set first, then their messages built and sent in table order.
-        """
+        """Build and send what is due at ctx.now_us (due()); the snapshot is only taken when something is due."""
         now = ctx.now_us
-        if now < self.next_due_us:
+        if now < self.next_due_us:  # the common case, on every link every tick
             return 0
-        if self._starting:
+        due = self.due(now)
+        if not due:
+            return 0
+        snap = get_snapshot()
+        sent = 0
+        for msg_id in due:
+            try:
+                msg = tm.heartbeat(ctx, snap) if msg_id == HEARTBEAT_ID else BUILDERS[msg_id](ctx, snap)
+            except Exception as err:  # a bad snapshot value must cost one message, not the link
+                self._build_failed(msg_id, err)
+                continue
+            if msg is not None:
+                ctx.send(msg)
+                sent += 1
+        return sent
+
+    def due(self, now: int) -> list[int]:
+        """The message ids due at `now`: HEARTBEAT_ID first if due, then the due streams in table order. Each one's
+        next due time is set. Only the due streams are touched (the schedule is a heap)."""
+        if now < self.next_due_us:
+            return []
+        if self._starting:  # the first pass since construction or restart
             self._starting = False
             if self.start_delay_us > 0:
                 self._begin_at(now + self.start_delay_us)
-                return 0
-        snap = get_snapshot()
-        sent = 0
+                return []
+        due_ids = []
         if now >= self._next_heartbeat_us:
-            ctx.send(tm.heartbeat(ctx, snap))
-            sent += 1
+            due_ids.append(HEARTBEAT_ID)
             self._next_heartbeat_us = _next_due(self._next_heartbeat_us, HEARTBEAT_INTERVAL_US, now)
         if self._schedule_stale:
             self._rebuild_schedule(now)
         heap = self._schedule
-        if heap and heap[0][0] <= now:
-            due_now: list[tuple[int, int]] = []
-            while heap and heap[0][0] <= now:
-                due, order, msg_id, interval = heap[0]
-                nxt = due + interval  # _next_due(), inline
-                heapreplace(heap, (nxt if nxt > now else now + interval, order, msg_id, interval))
-                due_now.append((order, msg_id))
-            if len(due_now) > 1:
-                due_now.sort()
-            for _, msg_id in due_now:
-                try:
-                    msg = BUILDERS[msg_id](ctx, snap)
-                except Exception as err:  # a bad snapshot value must cost one message, not the link
-                    self._build_failed(msg_id, err)
-                    continue
-                if msg is not None:
-                    ctx.send(msg)
-                    sent += 1
-        earliest = self._next_heartbeat_us
-        if heap and heap[0][0] < earliest:
-            earliest = heap[0][0]
-        self.next_due_us = earliest
-        return sent
+        streams: list[tuple[int, int]] = []  # (place in the table, msg_id)
+        while heap and heap[0][0] <= now:
+            due_us, order, msg_id, interval = heap[0]
+            heapreplace(heap, (_next_due(due_us, interval, now), order, msg_id, interval))
+            streams.append((order, msg_id))
+        streams.sort()
+        due_ids.extend(msg_id for _, msg_id in streams)
+        self.next_due_us = min(self._next_heartbeat_us, heap[0][0]) if heap else self._next_heartbeat_us
+        return due_ids
 
     def _begin_at(self, start_us: int) -> None:
         """Nothing goes out before `start_us`; then the heartbeat and every stream are due at once."""

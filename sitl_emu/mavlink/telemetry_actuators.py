@@ -22,8 +22,7 @@ from sitl_emu.px4 import NavState
 from sitl_emu.types import Vec4, VehicleSnapshot
 
 if TYPE_CHECKING:
-    from sitl_emu.mavlink.context import EndpointContext
-    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
 PWM_DISARMED, PWM_MIN, PWM_MAX, PWM_FAILSAFE = 900, 1000, 2000, 600
 SERVO_CHANNELS: Final = 16
@@ -52,7 +51,7 @@ def _pwm(u: float) -> int:
     return int(PWM_MIN + (PWM_MAX - PWM_MIN) * min(max(u, 0.0), 1.0))
 
 
-def servo_output_raw(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def servo_output_raw(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.servo_output_raw_encode(snap.time_us & 0xFFFFFFFF, 0, *servo_outputs(snap))
 
 
@@ -60,7 +59,7 @@ def _levels(motors: Vec4) -> tuple[float, float, float, float]:
     return tuple(abs(u) if math.isfinite(u) else 0.0 for u in motors)  # type: ignore[return-value]
 
 
-def esc_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def esc_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     u = _levels(snap.motors)
     rpm = [int(6000.0 * x) for x in u]
     voltage = [11.1 + 3.0 * x for x in u]
@@ -68,7 +67,7 @@ def esc_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return EXTRA.esc_status_encode(0, snap.time_us, rpm, voltage, current)
 
 
-def esc_info(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def esc_info(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     temperature_cdeg = [int((20.0 + 40.0 * x) * 100.0) for x in _levels(snap.motors)]
     counter = (snap.time_us // ESC_PUBLISH_PERIOD_US) & 0xFFFF
     return EXTRA.esc_info_encode(0, snap.time_us, counter, ESC_COUNT, ESC_CONNECTION_TYPE_PPM, ESC_ONLINE, _ZERO4,

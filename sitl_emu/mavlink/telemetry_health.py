@@ -16,8 +16,7 @@ from sitl_emu.mavlink.telemetry_msgs import UINT16_MAX
 from sitl_emu.types import VehicleSnapshot
 
 if TYPE_CHECKING:
-    from sitl_emu.mavlink.context import EndpointContext
-    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
 # MAV_SYS_STATUS_SENSOR bits (common.xml)
 S_GYRO, S_ACCEL, S_MAG, S_ABS_PRESSURE, S_DIFF_PRESSURE, S_GPS = 0x01, 0x02, 0x04, 0x08, 0x10, 0x20
@@ -60,7 +59,7 @@ def sensor_bits(snap: VehicleSnapshot) -> tuple[int, int, int]:
     return present, enabled, health
 
 
-def sys_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def sys_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/SYS_STATUS.hpp; MAVSDK reads health from these bits (reference 9a.5). The parachute (recovery system,
     an extended bit) has no fault, so it reads healthy, neither present nor enabled."""
     present, enabled, health = sensor_bits(snap)
@@ -85,7 +84,7 @@ EKF_TEST_RATIOS: Final = (0.02, 0.01, 0.04, 0.02, 0.01, 0.0)  # velocity, horiz.
 EKF_ACCURACY_M: Final = (0.3, 0.4)  # horizontal, vertical
 
 
-def estimator_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def estimator_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/ESTIMATOR_STATUS.hpp: estimator_status.solution_status_flags, test ratios and accuracies."""
     flags = EKF_FLAGS_READY if snap.position_valid else EKF_FLAGS_ALIGNING
     return ctx.encoder.estimator_status_encode(snap.time_us, flags, *EKF_TEST_RATIOS, *EKF_ACCURACY_M)
@@ -100,14 +99,14 @@ _FUSION_ACTIVE_ALIGNING: Final = (0, 0, 0, 0, 1, 1, 1, 0, 0)
 _NAN9: Final = (math.nan,) * 9
 
 
-def estimator_sensor_fusion_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def estimator_sensor_fusion_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/ESTIMATOR_SENSOR_FUSION_STATUS.hpp (not in pymavlink: extra_messages.py): per source, the instances
     EKF2 intends to fuse and those it fuses; the test ratios are NaN, as PX4 sends them."""
     active = _FUSION_ACTIVE if snap.position_valid else _FUSION_ACTIVE_ALIGNING
     return EXTRA.estimator_sensor_fusion_status_encode(_FUSION_INTENDED, active, _NAN9)
 
 
-def mission_current(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def mission_current(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """mavlink_mission.cpp send_mission_current, about once a second on every link: the stored mission's current item
     and count (total UINT16_MAX with none), its state (NO_MISSION, or NOT_STARTED while stored and not flown) and
     whether the vehicle is in a mode that flies it (mission_items.mission_current_fields). The plan ids (a CRC32 per
@@ -140,14 +139,14 @@ def rtl_time_estimate_s(snap: VehicleSnapshot) -> float:
     return _TIME_FACTOR * seconds + _TIME_MARGIN_S
 
 
-def time_estimate_to_target(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def time_estimate_to_target(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/TIME_ESTIMATE_TO_TARGET.hpp (not in pymavlink: extra_messages.py): the safe RTL time; the other
     estimates are not supported by PX4 (-1). Sent when rtl_time_estimate updates (every 2 s: telemetry.py)."""
     safe = rtl_time_estimate_s(snap)
     return EXTRA.time_estimate_to_target_encode(int(safe) if math.isfinite(safe) else -1, -1, -1, -1, -1)
 
 
-def link_node_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def link_node_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/LINK_NODE_STATUS.hpp (not in pymavlink: extra_messages.py): this link's counters (telemetry_status).
     Buffer levels are not reported (PX4: TODO, 0); losses and overflows are not tracked here (0)."""
     stats = ctx.stats

@@ -17,7 +17,6 @@ from sitl_emu.types import VehicleSnapshot
 
 if TYPE_CHECKING:
     from sitl_emu.mavlink.context import EndpointContext, OutMessage
-    from sitl_emu.mavlink.fastpack import Packed
 
 NAN = math.nan
 UINT16_MAX = 0xFFFF
@@ -75,34 +74,34 @@ def system_status(snap: VehicleSnapshot) -> int:
     return MavState.STANDBY if snap.pre_flight_checks_pass else MavState.UNINIT
 
 
-def heartbeat(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def heartbeat(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.heartbeat_encode(MAV_TYPE_QUADROTOR, MAV_AUTOPILOT_PX4, base_mode(snap),
                                     px4.custom_mode(snap.nav_state), system_status(snap), 3)
 
 
-def extended_sys_state(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def extended_sys_state(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.extended_sys_state_encode(0, int(snap.landed_state))
 
 
-def attitude(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def attitude(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     r, p, y = snap.euler_rad
     wx, wy, wz = snap.rates_frd_rad_s
     return ctx.encoder.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
 
 
-def attitude_quaternion(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def attitude_quaternion(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     w, x, y, z = snap.q_wxyz
     wx, wy, wz = snap.rates_frd_rad_s
     return ctx.encoder.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
 
 
-def local_position_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def local_position_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     x, y, z = snap.pos_ned_m
     vx, vy, vz = snap.vel_ned_m_s
     return ctx.encoder.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
 
 
-def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     """streams/GLOBAL_POSITION_INT.hpp: only with a global position; relative_alt against home (reference 9a.6)."""
     if not snap.position_valid:
         return None
@@ -114,7 +113,7 @@ def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed |
         _cm_s(vx), _cm_s(vy), _cm_s(vz), hdg_cdeg)
 
 
-def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     """streams/POSITION_TARGET_LOCAL_NED.hpp: the controller's setpoint, a type_mask bit for every NaN (ref 4.9)."""
     sp = snap.local_setpoint
     if sp is None:
@@ -132,7 +131,7 @@ def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Pa
                                                     sp.yawspeed_rad_s)
 
 
-def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     q = snap.attitude_setpoint_q_wxyz
     if q is None:
         return None
@@ -140,7 +139,7 @@ def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | Non
     return ctx.encoder.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
 
 
-def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     """streams/HOME_POSITION.hpp: only while home is valid."""
     home = snap.home
     if home is None:
@@ -152,7 +151,7 @@ def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
                                         0.0, 0.0, 0.0, snap.time_us)
 
 
-def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot; no fix and no satellites while failed."""
     vn, ve, _ = snap.vel_ned_m_s
     vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
@@ -163,7 +162,7 @@ def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
                                       0)
 
 
-def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     cells = 4  # BAT1_N_CELLS in SITL
     cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
     voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
@@ -173,7 +172,7 @@ def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
                                              [0, 0, 0, 0], 0, 0)
 
 
-def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/VFR_HUD.hpp (reference 11.5)."""
     vn, ve, vd = snap.vel_ned_m_s
     heading_deg = int(math.degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
@@ -181,14 +180,14 @@ def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
     return ctx.encoder.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
 
 
-def altitude(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def altitude(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else NAN
     local_m = -snap.pos_ned_m[2]
     return ctx.encoder.altitude_encode(snap.time_us, snap.alt_amsl_m, snap.alt_amsl_m, local_m, rel_m, NAN,
                                    max(local_m, 0.0))
 
 
-def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
     v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
     cov = [NAN] + [0.0] * 20
@@ -196,27 +195,27 @@ def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
                                    snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
 
 
-def timesync(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def timesync(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/TIMESYNC.hpp: PX4's own sync request, tc1=0, ts1=boot time in ns."""
     return ctx.encoder.timesync_encode(0, snap.time_us * 1000)
 
 
-def ping(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def ping(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/PING.hpp: PX4 pings everyone (target 0/0) with its boot time and a sequence; replies are ignored."""
     seq = snap.time_us // 100_000  # unique per ping at any rate up to 10 Hz, from simulated time
     return ctx.encoder.ping_encode(snap.time_us, seq & 0xFFFFFFFF, 0, 0)
 
 
-def system_time(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def system_time(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
 
 
-def current_mode(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def current_mode(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.current_mode_encode(STANDARD_MODE.get(snap.nav_state, 0), px4.custom_mode(snap.nav_state),
                                        px4.custom_mode(snap.user_intended_nav_state))
 
 
-def orbit_execution_status(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def orbit_execution_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     """ORBIT_EXECUTION_STATUS.hpp: only while the orbit task publishes orbit_status; frame 0 (MAV_FRAME_GLOBAL),
     x/y the centre in degE7 (the double times 1e7 stored in an int32: truncated), z the altitude AMSL."""
     o = snap.orbit

@@ -16,8 +16,7 @@ from sitl_emu.mavlink.telemetry_msgs import rotate_ned_to_body
 from sitl_emu.types import Vec3, VehicleSnapshot
 
 if TYPE_CHECKING:
-    from sitl_emu.mavlink.context import EndpointContext
-    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
 GRAVITY_M_S2 = 9.80665
 # Earth magnetic field near the SIH default home (Zurich), gauss, NED: ~0.48 G, inclination ~63.5°, declination ~2.5°
@@ -37,7 +36,7 @@ def specific_force_frd(snap: VehicleSnapshot) -> tuple[float, float, float]:
     return rotate_ned_to_body(snap.q_wxyz, (ax, ay, az - GRAVITY_M_S2))
 
 
-def highres_imu(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def highres_imu(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     acc = specific_force_frd(snap)
     mag = rotate_ned_to_body(snap.q_wxyz, MAG_NED_GAUSS)
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
@@ -45,7 +44,7 @@ def highres_imu(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
                                       snap.alt_amsl_m, TEMPERATURE_C, HIGHRES_FIELDS_ALL, 0)
 
 
-def scaled_pressure(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def scaled_pressure(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
     if not math.isfinite(pressure):
         return None
@@ -71,7 +70,7 @@ def range_m(snap: VehicleSnapshot) -> float:
     return max(distance, 0.0)
 
 
-def distance_sensor(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def distance_sensor(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/DISTANCE_SENSOR.hpp: metres to centimetres (truncated), instance 0, no variance."""
     return ctx.encoder.distance_sensor_encode((snap.time_us // 1000) & 0xFFFFFFFF, int(DIST_MIN_M * 100),
                                               int(DIST_MAX_M * 100), int(range_m(snap) * 100.0),
@@ -100,7 +99,7 @@ VIBRATION_METRICS = tuple((_coning_metric(g), _diff_metric(g), _diff_metric(a))
                           for a, g in zip(ACCEL_NOISE, GYRO_NOISE, strict=True))
 
 
-def vibration(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def vibration(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """vibration_x: gyro coning, vibration_y: gyro high-frequency, vibration_z: accel high-frequency metric (PX4's
     own use of the fields), as SIH's noise makes them settle; no accelerometer clipping."""
     spinning = any(u > 1e-6 for u in snap.motors)
@@ -113,7 +112,7 @@ GPS_DEVICE_ID = 0xAF0004  # DRV_GPS_DEVTYPE_SIM on the simulation bus (device_id
 GPS_EPH_M, GPS_EPV_M, GPS_SPEED_VARIANCE_M_S = 0.5, 0.8, 0.2  # what GPS_RAW_INT reports (telemetry_msgs.gps_raw_int)
 
 
-def gnss_integrity(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def gnss_integrity(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/GNSS_INTEGRITY.hpp: the simulated receiver reports no errors, no authentication, jamming or spoofing
     state and no RAIM (horizontal/vertical figures of merit UINT16_MAX). The id field is a uint8: PX4 assigns the
     32-bit device id to it, which keeps its low byte."""
@@ -132,7 +131,7 @@ def _utc_us(ctx: EndpointContext, snap: VehicleSnapshot) -> int:
     return ctx.node.epoch_unix_us + snap.time_us
 
 
-def open_drone_id_location(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed:
+def open_drone_id_location(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/OPEN_DRONE_ID_LOCATION.hpp from the GPS fix, the barometer, the land detector and home."""
     vn, ve, vd = snap.vel_ned_m_s
     status = ODID_STATUS_GROUND if snap.landed_state == 1 else ODID_STATUS_AIRBORNE
@@ -150,7 +149,7 @@ def open_drone_id_location(ctx: EndpointContext, snap: VehicleSnapshot) -> Packe
         ODID_VER_ACC_1_METER, 0, ODID_SPEED_ACC_0_3, (utc_ms % 3_600_000) / 1000.0, ODID_TIME_ACC_1_0_SECOND)
 
 
-def open_drone_id_system(ctx: EndpointContext, snap: VehicleSnapshot) -> Packed | None:
+def open_drone_id_system(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     """streams/OPEN_DRONE_ID_SYSTEM.hpp: the operator at the take-off location (home), only once home is valid."""
     home = snap.home
     if home is None:

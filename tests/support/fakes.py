@@ -161,10 +161,11 @@ class Harness:
         self.vehicle = vehicle
         self.api.target = ("127.0.0.1", self.node.api.link.port)
         self.gcs.target = ("127.0.0.1", self.node.gcs.link.port)
+        self.most_read = 0  # the most datagrams one I/O pass read
 
     def io(self) -> None:
         """One I/O pass at the current simulated time, then collect what the clients got."""
-        self.node.step_io(self.vehicle.time_us)
+        self.most_read = max(self.most_read, self.node.step_io(self.vehicle.time_us))
         self.api.drain()
         self.gcs.drain()
 

@@ -7,7 +7,8 @@ import socket
 import pytest
 from support.fakes import Client, FakeVehicle, Harness
 
-from sitl_emu.mavlink.link import PortInUseError, UdpLink
+from sitl_emu.mavlink.link import UdpLink
+from sitl_emu.mavlink.link_errors import PortInUseError
 from sitl_emu.px4 import MavCmd
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
 

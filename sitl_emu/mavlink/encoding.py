@@ -1,0 +1,17 @@
+"""What builds a link's messages, as the type checker sees it (its own module: mypyc cannot compile a protocol with
+__getattr__, and context.py is compiled)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from sitl_emu.mavlink.context import OutMessage
+
+
+class MessageEncoder(Protocol):
+    """Builds messages by name: `encoder.attitude_encode(...)`. The endpoint's is fastpack.ENCODER; pymavlink's
+    MAVLink takes the same calls (the tests compare the two)."""
+
+    def __getattr__(self, name: str) -> Callable[..., OutMessage]: ...
