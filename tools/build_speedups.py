@@ -105,6 +105,10 @@ DEFAULT_MODULES = (
     "sitl_emu/mavlink/fastpack.py",
     "sitl_emu/mavlink/context.py",
     "sitl_emu/runtime/node.py",
+    # the flight log's per-tick path: the topics, their packing, the writer
+    "sitl_emu/log/topics.py",
+    "sitl_emu/log/ulog_writer.py",
+    "sitl_emu/log/flight_log.py",
 )
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]

@@ -7,11 +7,13 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
-    from sitl_emu.mavlink.context import OutMessage
+    from pymavlink.dialects.v20.development import MAVLink_message
+
+    from sitl_emu.mavlink.fastpack import Packed
 
 
 class MessageEncoder(Protocol):
     """Builds messages by name: `encoder.attitude_encode(...)`. The endpoint's is fastpack.ENCODER; pymavlink's
     MAVLink takes the same calls (the tests compare the two)."""
 
-    def __getattr__(self, name: str) -> Callable[..., OutMessage]: ...
+    def __getattr__(self, name: str) -> Callable[..., MAVLink_message | Packed]: ...  # context.OutMessage
