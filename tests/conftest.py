@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 COMPILED_FOLDERS = tuple(Path(__file__).parent / "sitl_emu" / name
-                         for name in ("core", "testing", "mavlink", "runtime"))
+                         for name in ("core", "testing", "mavlink", "runtime", "log", "disturbance"))
 
 
 def pytest_configure(config: pytest.Config) -> None:
