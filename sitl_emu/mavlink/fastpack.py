@@ -20,6 +20,7 @@ every message type the emulator sends.
 from __future__ import annotations
 
 import binascii
+import contextlib
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -173,6 +174,7 @@ class Encoder:
         self._encoders: dict[str, Callable[..., Packed]] = {}  # by attribute name, built on first use
 
     def __getattr__(self, attr: str) -> Callable[..., Packed]:
+        """Only called for a name that is not an attribute yet: build its encoder once."""
         if not attr.endswith("_encode"):
             raise AttributeError(attr)
         encode = self._encoders.get(attr)
@@ -181,6 +183,10 @@ class Encoder:
             if cls is None:
                 raise AttributeError(attr)
             encode = self._encoders[attr] = spec_for_class(cls).encode
+            # In pure Python later look-ups are then plain attribute hits, which never reach this method (reaching
+            # it costs a failed look-up first). The compiled Encoder has no instance __dict__: the dict above serves.
+            with contextlib.suppress(AttributeError):
+                setattr(self, attr, encode)
         return encode
 
 
