@@ -101,6 +101,9 @@ NORMAL_RATES_HZ: dict[int, float] = {
 SOURCE_PERIOD_US: dict[int, int] = {380: 2_000_000}
 
 
+MAX_INTERVAL_US = 1e12  # set_interval: from here on, PX4's rate is 1e-6 Hz or less, which stops the stream
+
+
 def _interval_us(hz: float) -> int:
     return round(1e6 / hz)
 
@@ -140,10 +143,13 @@ class Streams:
         return msg_id in BUILDERS
 
     def set_interval(self, msg_id: int, interval_us: float) -> bool:
-        """mavlink_receiver.cpp set_message_interval: <0 stop, 0 default rate, >0 that interval. False: no stream."""
+        """mavlink_receiver.cpp set_message_interval: <0 stop, 0 default rate, >0 that interval. False: no stream.
+
+        PX4 turns the interval into a rate (1e6 / interval) and configure_stream deletes a stream whose rate is not
+        above 1e-6 Hz, so an interval of 1e12 µs or more (infinity too) stops the stream as well."""
         if msg_id == HEARTBEAT_ID or msg_id not in BUILDERS:
             return False
-        if interval_us < -1e-5:
+        if interval_us < -1e-5 or interval_us >= MAX_INTERVAL_US:
             self._interval_us.pop(msg_id, None)
         elif interval_us <= 1e-5:
             if msg_id in self._default_us:

@@ -140,6 +140,19 @@ def test_set_and_get_message_interval_apply_to_their_own_link(h):
     assert h.gcs.of_type("MESSAGE_INTERVAL")[-1].interval_us == 20_000
 
 
+@pytest.mark.parametrize("interval_us", [math.inf, -math.inf, 2e12])
+def test_an_endless_interval_stops_the_stream_as_px4_does(h, interval_us):
+    """set_message_interval: rate = 1e6 / interval; configure_stream deletes a stream whose rate is not above 1e-6."""
+    h.run(0.5)
+    assert _ask(h, MavCmd.SET_MESSAGE_INTERVAL, 30, interval_us)[0] == [0]
+    h.gcs.command_long(MavCmd.GET_MESSAGE_INTERVAL, 30)
+    h.io()
+    assert h.gcs.of_type("MESSAGE_INTERVAL")[-1].interval_us == 0
+    n = len(h.gcs.received)
+    h.run(1.0)
+    assert not [m for m in h.gcs.received[n:] if m.get_type() == "ATTITUDE"]
+
+
 @pytest.mark.parametrize("params", [(9999, 1000), (30, 1000, 1), (30, 1000, 0, 2), (30, 1000, 0, 0, 0, 0, 1)])
 def test_set_message_interval_failures(h, params):
     assert _ask(h, MavCmd.SET_MESSAGE_INTERVAL, *params)[0] == [4]
