@@ -13,64 +13,11 @@ from __future__ import annotations
 
 import asyncio
 import math
-import time
-from collections.abc import Awaitable, Callable
-from pathlib import Path
 from typing import Any
 
 import pytest
-from support.serve_process import load_mavsdk, serve
-
-SPEED = 4.0  # simulated seconds per wall second
-CALL_TIMEOUT_S = 15.0  # no single MAVSDK call may hang the test
-
-
-
-
-@pytest.fixture()
-def server(tmp_path: Path):
-    """`sitl-emu serve` on free ports, in tmp_path (the parameters it sets are saved there, not in the repository);
-    yields the UDP port MAVSDK must listen on (the API link's remote)."""
-    with serve(tmp_path, tmp_path / "serve.log", SPEED) as ports:
-        yield ports.api_remote
-
-
-class Session:
-    """Runs MAVSDK calls with a timeout each and records every call and its outcome."""
-
-    def __init__(self) -> None:
-        self.calls: list[tuple[str, str]] = []
-
-    async def call(self, name: str, awaitable: Awaitable[Any], timeout_s: float = CALL_TIMEOUT_S) -> Any:
-        try:
-            result = await asyncio.wait_for(awaitable, timeout_s)
-        except Exception as err:
-            self.calls.append((name, f"FAILED: {type(err).__name__}: {err}"))
-            raise
-        self.calls.append((name, "ok" if result is None else f"ok -> {_short(result)}"))
-        return result
-
-    async def wait_for(self, what: str, probe: Callable[[], Awaitable[Any]], accept: Callable[[Any], bool],
-                       timeout_s: float) -> Any:
-        """Poll `probe` until `accept(value)`; fail with the last value seen."""
-        deadline = time.monotonic() + timeout_s
-        value: Any = None
-        while time.monotonic() < deadline:
-            value = await asyncio.wait_for(probe(), CALL_TIMEOUT_S)
-            if accept(value):
-                self.calls.append((f"wait: {what}", f"ok -> {_short(value)}"))
-                return value
-            await asyncio.sleep(0.1)
-        self.calls.append((f"wait: {what}", f"TIMED OUT, last {_short(value)}"))
-        raise AssertionError(f"timed out after {timeout_s} s waiting for {what}; last value: {value}")
-
-    def table(self) -> str:
-        return "\n".join(f"  {name:<48} {outcome}" for name, outcome in self.calls)
-
-
-def _short(value: Any) -> str:
-    text = str(value).replace("\n", " ")
-    return text if len(text) <= 110 else text[:107] + "..."
+from support.mavsdk_waits import MAVSDK_SPEED, Session, connect
+from support.serve_process import load_mavsdk
 
 
 def _dist(a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
@@ -78,11 +25,11 @@ def _dist(a: tuple[float, float, float], b: tuple[float, float, float]) -> float
 
 
 @pytest.mark.timeout(420)
-def test_mavsdk_flies_the_emulator(server: int) -> None:
+def test_mavsdk_flies_the_emulator(mavsdk_port: int) -> None:
     mavsdk_asyncio = load_mavsdk()
     session = Session()
     try:
-        asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, server, session), timeout=360))
+        asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, mavsdk_port, session), timeout=360))
     finally:
         print("\nMAVSDK calls and outcomes:\n" + session.table())
 
@@ -95,7 +42,7 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
 
     config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
     async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
-        system = await _connect(mavsdk, port, s)
+        system = await connect(mavsdk, port, s)
         assert (await s.call("System.autopilot_type", system.autopilot_type())).name == "PX4"
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
         await s.call("Telemetry.health", telemetry.health())
@@ -105,17 +52,6 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
         await _take_off(telemetry, action, s)
         await _offboard(telemetry, OffboardAsync(system), s)
         await _return_and_land(telemetry, action, s)
-
-
-async def _connect(mavsdk: Any, port: int, s: Session) -> Any:
-    """The autopilot on udpin PORT, once its health is all good."""
-    from mavsdk.asyncio.plugins.telemetry import TelemetryAsync
-
-    await s.call("Mavsdk.add_any_connection(udpin)", mavsdk.add_any_connection(f"udpin://0.0.0.0:{port}"))
-    system = await s.call("Mavsdk.first_autopilot", mavsdk.first_autopilot(timeout_s=20.0), timeout_s=25.0)
-    assert system is not None, "MAVSDK found no autopilot"
-    await s.wait_for("health_all_ok", TelemetryAsync(system).health_all_ok, bool, timeout_s=30)
-    return system
 
 
 async def _check_shell(system: Any, s: Session) -> None:
@@ -270,13 +206,13 @@ async def _return_and_land(telemetry: Any, action: Any, s: Session) -> None:
 
 
 @pytest.mark.timeout(300)
-def test_mavsdk_manual_control_flies_position_mode(server: int) -> None:
+def test_mavsdk_manual_control_flies_position_mode(mavsdk_port: int) -> None:
     """MAVSDK's manual_control example: stream set_manual_control_input, take off, start_position_control, then fly
     forward and back with the sticks; PX4 accepts and flies it (the reference's px4-manual cases)."""
     mavsdk_asyncio = load_mavsdk()
     session = Session()
     try:
-        asyncio.run(asyncio.wait_for(_fly_manual(mavsdk_asyncio, server, session), timeout=240))
+        asyncio.run(asyncio.wait_for(_fly_manual(mavsdk_asyncio, mavsdk_port, session), timeout=240))
     finally:
         print("\nMAVSDK calls and outcomes:\n" + session.table())
 
@@ -289,14 +225,14 @@ async def _fly_manual(mavsdk_asyncio: Any, port: int, s: Session) -> None:
 
     config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
     async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
-        system = await _connect(mavsdk, port, s)
+        system = await connect(mavsdk, port, s)
         telemetry, action, manual = TelemetryAsync(system), ActionAsync(system), ManualControlAsync(system)
         sticks = [0.0, 0.0, 0.5, 0.0]  # x forward, y right, z throttle 0..1 (0.5 centre), r yaw
 
         async def stream() -> None:  # the example sends at 10-20 Hz; COM_RC_LOSS_T is 0.5 s of simulated time
             while True:
                 await manual.set_manual_control_input(*sticks)
-                await asyncio.sleep(0.05 / SPEED)
+                await asyncio.sleep(0.05 / MAVSDK_SPEED)
 
         streamer = asyncio.create_task(stream())
         try:
@@ -328,7 +264,7 @@ async def _fly_manual(mavsdk_asyncio: Any, port: int, s: Session) -> None:
 
 
 @pytest.mark.timeout(300)
-def test_mavsdk_failure_injection_example_gps_off(server: int) -> None:
+def test_mavsdk_failure_injection_example_gps_off(mavsdk_port: int) -> None:
     """MAVSDK's failure_injection example flow (issue 16): with SYS_FAILURE_EN 0 the mavlink module denies the
     injection; with 1 the failure injection manager accepts GPS off, the estimator loses its position after
     EKF2_NOAID_TOUT and the failsafe descends and lands (src/modules/failure_injection_manager/,
@@ -336,7 +272,7 @@ def test_mavsdk_failure_injection_example_gps_off(server: int) -> None:
     mavsdk_asyncio = load_mavsdk()
     session = Session()
     try:
-        asyncio.run(asyncio.wait_for(_failure_injection(mavsdk_asyncio, server, session), timeout=240))
+        asyncio.run(asyncio.wait_for(_failure_injection(mavsdk_asyncio, mavsdk_port, session), timeout=240))
     finally:
         print("\nMAVSDK calls and outcomes:\n" + session.table())
 
@@ -351,7 +287,7 @@ async def _failure_injection(mavsdk_asyncio: Any, port: int, s: Session) -> None
 
     config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
     async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
-        system = await _connect(mavsdk, port, s)
+        system = await connect(mavsdk, port, s)
         param, action, telemetry, failure = (ParamAsync(system), ActionAsync(system), TelemetryAsync(system),
                                              FailureAsync(system))
         await s.call("Param.set_param_int(SYS_FAILURE_EN, 0)", param.set_param_int("SYS_FAILURE_EN", 0))

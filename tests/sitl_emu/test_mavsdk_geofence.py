@@ -12,28 +12,19 @@ from __future__ import annotations
 import asyncio
 import math
 import time
-from pathlib import Path
 from typing import Any
 
 import pytest
 from support.mavsdk_waits import call as _call
 from support.mavsdk_waits import offset as _offset
 from support.mavsdk_waits import wait as _wait
-from support.serve_process import load_mavsdk, serve
-
-SPEED = 4.0
-
-
-@pytest.fixture()
-def server(tmp_path: Path):
-    with serve(tmp_path, tmp_path / "serve.log", SPEED) as ports:
-        yield ports.api_remote
+from support.serve_process import load_mavsdk
 
 
 @pytest.mark.timeout(300)
-def test_mavsdk_geofence_breach_returns(server: int) -> None:
+def test_mavsdk_geofence_breach_returns(mavsdk_port: int) -> None:
     mavsdk_asyncio = load_mavsdk()
-    asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, server), timeout=240))
+    asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, mavsdk_port), timeout=240))
 
 
 async def _fly(mavsdk_asyncio: Any, port: int) -> None:

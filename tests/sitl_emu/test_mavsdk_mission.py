@@ -11,29 +11,21 @@ from __future__ import annotations
 
 import asyncio
 import math
-from pathlib import Path
 from typing import Any
 
 import pytest
 from support.mavsdk_waits import call as _call
 from support.mavsdk_waits import offset as _offset
 from support.mavsdk_waits import wait as _wait
-from support.serve_process import load_mavsdk, serve
+from support.serve_process import load_mavsdk
 
-SPEED = 4.0
 ALT_M = 8.0
 
 
-@pytest.fixture()
-def server(tmp_path: Path):
-    with serve(tmp_path, tmp_path / "serve.log", SPEED) as ports:
-        yield ports.api_remote
-
-
 @pytest.mark.timeout(300)
-def test_mavsdk_mission_upload_download_fly_to_the_end_and_clear(server: int) -> None:
+def test_mavsdk_mission_upload_download_fly_to_the_end_and_clear(mavsdk_port: int) -> None:
     mavsdk_asyncio = load_mavsdk()
-    asyncio.run(asyncio.wait_for(_session(mavsdk_asyncio, server), timeout=240))
+    asyncio.run(asyncio.wait_for(_session(mavsdk_asyncio, mavsdk_port), timeout=240))
 
 
 async def _session(mavsdk_asyncio: Any, port: int) -> None:

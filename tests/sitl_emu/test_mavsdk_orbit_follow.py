@@ -8,18 +8,17 @@ import asyncio
 import math
 from typing import Any
 
+from support.mavsdk_waits import MAVSDK_SPEED, Session, connect
 from support.serve_process import load_mavsdk
-
-from tests.sitl_emu.test_mavsdk import Session, _connect, server  # noqa: F401  (server: the fixture)
 
 EARTH_M_PER_DEG = math.radians(1.0) * 6371000.0
 
 
-def test_mavsdk_orbits_a_point_and_follows_a_target(server: int) -> None:  # noqa: F811
+def test_mavsdk_orbits_a_point_and_follows_a_target(mavsdk_port: int) -> None:
     mavsdk_asyncio = load_mavsdk()
     session = Session()
     try:
-        asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, server, session), timeout=300))
+        asyncio.run(asyncio.wait_for(_fly(mavsdk_asyncio, mavsdk_port, session), timeout=300))
     finally:
         print("\nMAVSDK calls and outcomes:\n" + session.table())
 
@@ -31,7 +30,7 @@ async def _fly(mavsdk_asyncio: Any, port: int, s: Session) -> None:
 
     config = mavsdk_asyncio.Configuration.create_with_component_type(mavsdk_asyncio.ComponentType.GROUND_STATION)
     async with mavsdk_asyncio.Mavsdk(config) as mavsdk:
-        system = await _connect(mavsdk, port, s)
+        system = await connect(mavsdk, port, s)
         telemetry, action = TelemetryAsync(system), ActionAsync(system)
         await s.call("Action.arm", action.arm())
         await s.call("Action.takeoff", action.takeoff())
@@ -89,7 +88,7 @@ async def _follow(telemetry: Any, follow_me: Any, home: Any, s: Session) -> None
     distances, heights = [], []
     for i in range(60):  # the target walks north at 1.5 m/s for 30 s (of wall time: the server runs faster)
         await asyncio.sleep(0.5)
-        north += speed * 0.5 * 4.0  # the server's SPEED
+        north += speed * 0.5 * MAVSDK_SPEED
         lat, lon = _offset(home, north, 20.0)
         await follow_me.set_target_location(TargetLocation(lat, lon, home.absolute_altitude_m - 2.5, speed, 0, 0))
         if i >= 40:
