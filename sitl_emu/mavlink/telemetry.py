@@ -14,7 +14,7 @@ from __future__ import annotations
 import enum
 import logging
 from collections.abc import Callable, Sequence
-from heapq import heapify, heapreplace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink import telemetry_actuators as ta
@@ -108,6 +108,18 @@ def _interval_us(hz: float) -> int:
     return round(1e6 / hz)
 
 
+UNSET = -1  # _Stream.next_us: due at the next pass (a new, re-configured or restarted stream)
+
+
+@dataclass(slots=True)
+class _Stream:
+    """One row of a link's stream table (PX4's MavlinkStream): its interval and when it is next due, simulated µs."""
+
+    msg_id: int
+    interval_us: int  # never shorter than the period of its source topic (SOURCE_PERIOD_US)
+    next_us: int = UNSET
+
+
 class Streams:
     """One link's stream table: interval per message id (None = off) and the next due time, in simulated µs."""
 
@@ -120,20 +132,17 @@ class Streams:
         rates = ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else NORMAL_RATES_HZ
         self._default_us: dict[int, int] = {mid: _interval_us(hz) for mid, hz in rates.items()}
         self._interval_us: dict[int, int] = dict(self._default_us)
-        # The schedule: a heap of (due µs, order, msg_id, interval µs), `order` being the stream's place in
-        # _interval_us, so what is due in one pass goes out in table order, as the table scan PX4-style sent it.
-        # After a configuration change or restart it is rebuilt at the next pass from _next_us (the due times kept).
-        self._schedule: list[tuple[int, int, int, int]] = []
-        self._schedule_stale = True
-        self._next_us: dict[int, int] = {}
+        # the table PX4 scans each pass, in the order of _interval_us; rebuilt at the next pass after a change
+        self._table: list[_Stream] = []
+        self._table_stale = True
         self._next_heartbeat_us = 0
         self.next_due_us = 0  # nothing is due before this (simulated µs)
         self._statustext_id = 0
         self.build_errors = 0
 
     def restart(self) -> None:
-        self._next_us.clear()
-        self._schedule_stale = True
+        for stream in self._table:
+            stream.next_us = UNSET
         self._next_heartbeat_us = 0
         self.next_due_us = 0
         self._starting = True
@@ -158,10 +167,10 @@ class Streams:
                 self._interval_us.pop(msg_id, None)
         else:
             self._interval_us[msg_id] = max(int(interval_us), 1)
-        if not self._schedule_stale:  # keep the other streams' due times
-            self._next_us = {mid: due for due, _, mid, _ in self._schedule}
-            self._schedule_stale = True
-        self._next_us.pop(msg_id, None)
+        for stream in self._table:  # the others keep their due times
+            if stream.msg_id == msg_id:
+                stream.next_us = UNSET
+        self._table_stale = True
         self.next_due_us = 0
         return True
 
@@ -203,10 +212,12 @@ class Streams:
         return sent
 
     def due(self, now: int) -> list[int]:
-        """The message ids due at `now`: HEARTBEAT_ID first if due, then the due streams in table order. Each one's
-        next due time is set. Only the due streams are touched (the schedule is a heap)."""
+        """The message ids due at `now`: HEARTBEAT_ID first if due, then the due streams in table order (a scan of
+        the table, as PX4's mavlink main loop does). Each one's next due time is set."""
         if now < self.next_due_us:
             return []
+        if self._table_stale:
+            self._rebuild_table()
         if self._starting:  # the first pass since construction or restart
             self._starting = False
             if self.start_delay_us > 0:
@@ -216,34 +227,30 @@ class Streams:
         if now >= self._next_heartbeat_us:
             due_ids.append(HEARTBEAT_ID)
             self._next_heartbeat_us = _next_due(self._next_heartbeat_us, HEARTBEAT_INTERVAL_US, now)
-        if self._schedule_stale:
-            self._rebuild_schedule(now)
-        heap = self._schedule
-        streams: list[tuple[int, int]] = []  # (place in the table, msg_id)
-        while heap and heap[0][0] <= now:
-            due_us, order, msg_id, interval = heap[0]
-            heapreplace(heap, (_next_due(due_us, interval, now), order, msg_id, interval))
-            streams.append((order, msg_id))
-        streams.sort()
-        due_ids.extend(msg_id for _, msg_id in streams)
-        self.next_due_us = min(self._next_heartbeat_us, heap[0][0]) if heap else self._next_heartbeat_us
+        earliest = self._next_heartbeat_us
+        for stream in self._table:
+            due_us = now if stream.next_us == UNSET else stream.next_us
+            if due_us <= now:
+                due_us = stream.next_us = _next_due(due_us, stream.interval_us, now)
+                due_ids.append(stream.msg_id)
+            earliest = min(earliest, due_us)
+        self.next_due_us = earliest
         return due_ids
 
     def _begin_at(self, start_us: int) -> None:
         """Nothing goes out before `start_us`; then the heartbeat and every stream are due at once."""
         self._next_heartbeat_us = start_us
-        self._next_us = {mid: start_us for mid in self._interval_us}  # none is kept before the first pass
-        self._schedule_stale = True
+        for stream in self._table:
+            stream.next_us = start_us
         self.next_due_us = start_us
 
-    def _rebuild_schedule(self, now: int) -> None:
-        """A stream without a kept due time is due now (new, re-configured, or after a restart)."""
-        kept = self._next_us
-        self._schedule = [(kept.get(mid, now), order, mid, max(interval, SOURCE_PERIOD_US.get(mid, 0)))
-                          for order, (mid, interval) in enumerate(self._interval_us.items())]
-        heapify(self._schedule)
-        self._next_us = {}
-        self._schedule_stale = False
+    def _rebuild_table(self) -> None:
+        """The table from the configured intervals, in their order; each stream keeps its due time (UNSET for one
+        just configured)."""
+        kept = {stream.msg_id: stream.next_us for stream in self._table}
+        self._table = [_Stream(mid, max(interval, SOURCE_PERIOD_US.get(mid, 0)), kept.get(mid, UNSET))
+                       for mid, interval in self._interval_us.items()]
+        self._table_stale = False
 
     def _build_failed(self, msg_id: int, err: Exception) -> None:
         self.build_errors += 1

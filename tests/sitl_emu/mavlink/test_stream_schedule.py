@@ -2,8 +2,9 @@
 
 The reference below is the plain algorithm (scan the stream table every pass; a stream is due when its time has come,
 its next time is one interval later, or one interval from now if it fell behind; the interval is never shorter than
-its source topic's period). Streams keeps a heap instead; the
-two must agree message for message through rate changes, stopped and restarted streams and reboots.
+its source topic's period), written from the rules with a dict of due times. Streams keeps rows it rebuilds after a
+change and a lazy start; the two must agree message for message through rate changes, stopped and restarted streams,
+reboots and a start delay.
 """
 
 from __future__ import annotations
