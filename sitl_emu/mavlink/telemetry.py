@@ -132,9 +132,9 @@ class Streams:
         rates = ONBOARD_RATES_HZ if mode is StreamMode.ONBOARD else NORMAL_RATES_HZ
         self._default_us: dict[int, int] = {mid: _interval_us(hz) for mid, hz in rates.items()}
         self._interval_us: dict[int, int] = dict(self._default_us)
-        # the table PX4 scans each pass, in the order of _interval_us; rebuilt at the next pass after a change
+        # the table PX4 scans each pass, in the order of _interval_us; rebuilt when an interval is set
         self._table: list[_Stream] = []
-        self._table_stale = True
+        self._rebuild_table()
         self._next_heartbeat_us = 0
         self.next_due_us = 0  # nothing is due before this (simulated µs)
         self._statustext_id = 0
@@ -170,7 +170,7 @@ class Streams:
         for stream in self._table:  # the others keep their due times
             if stream.msg_id == msg_id:
                 stream.next_us = UNSET
-        self._table_stale = True
+        self._rebuild_table()
         self.next_due_us = 0
         return True
 
@@ -216,8 +216,6 @@ class Streams:
         the table, as PX4's mavlink main loop does). Each one's next due time is set."""
         if now < self.next_due_us:
             return []
-        if self._table_stale:
-            self._rebuild_table()
         if self._starting:  # the first pass since construction or restart
             self._starting = False
             if self.start_delay_us > 0:
@@ -250,7 +248,6 @@ class Streams:
         kept = {stream.msg_id: stream.next_us for stream in self._table}
         self._table = [_Stream(mid, max(interval, SOURCE_PERIOD_US.get(mid, 0)), kept.get(mid, UNSET))
                        for mid, interval in self._interval_us.items()]
-        self._table_stale = False
 
     def _build_failed(self, msg_id: int, err: Exception) -> None:
         self.build_errors += 1
