@@ -27,10 +27,6 @@ ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 # mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
 # Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
 POSITION_PERIOD_US: Final = 8000
-_FLIGHT: Final = TakeoffState.FLIGHT
-_RAMPUP: Final = TakeoffState.RAMPUP
-# takeoff_state's names, made once: it is read on every tick, and an enum's .name is a Python-level property
-_TAKEOFF_NAMES: Final = {state: state.name.lower() for state in TakeoffState}
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,8 +94,8 @@ class MulticopterControl:
         return self.position.hover_thrust
 
     @property
-    def takeoff_state(self) -> str:
-        return _TAKEOFF_NAMES[self.takeoff.state]
+    def takeoff_state(self) -> TakeoffState:
+        return self.takeoff.state
 
     @property
     def in_failsafe(self) -> bool:
@@ -198,11 +194,11 @@ class MulticopterControl:
         if want_takeoff is None:
             want_takeoff = landed and _setpoint_wants_takeoff(sp, state.pos_ned_m[2])
         tko = self.takeoff.update_state(True, landed, want_takeoff, now_us)
-        flying = tko >= _FLIGHT
+        flying = tko >= TakeoffState.FLIGHT
         if not flying:
             sp = _without_acc_z(sp)
             self.position.set_hover_thrust(s.thr_hover)
-        if tko < _RAMPUP or (flying and ground_contact):
+        if tko < TakeoffState.RAMPUP or (flying and ground_contact):
             sp = IDLE_SETPOINT
             self.position.reset_integral()
         self._set_limits(flying, dt_s)

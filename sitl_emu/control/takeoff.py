@@ -41,7 +41,7 @@ class TakeoffHandling:
                      skip_takeoff: bool = False) -> TakeoffState:
         """updateTakeoffState: advance the state machine (it may pass several states in one call, as PX4's does)."""
         st = self.state
-        if st is _FLIGHT and armed and not landed and self._armed_since_us is not None:
+        if st is TakeoffState.FLIGHT and armed and not landed and self._armed_since_us is not None:
             return st  # the usual case in the air: nothing below would change it
         if not armed:
             self._armed_since_us = None
@@ -67,7 +67,7 @@ class TakeoffHandling:
 
     def update_ramp(self, dt_s: float, desired_vz_up: float) -> float:
         """updateRamp: the upward velocity limit for this cycle (m/s, positive up)."""
-        if self.state is _FLIGHT:
+        if self.state is TakeoffState.FLIGHT:
             return desired_vz_up
         if self.state < TakeoffState.RAMPUP:
             return self.ramp_vz_init
@@ -80,5 +80,3 @@ class TakeoffHandling:
                 return self.ramp_vz_init + self._ramp_progress * (desired_vz_up - self.ramp_vz_init)
         return desired_vz_up
 
-
-_FLIGHT: Final = TakeoffState.FLIGHT

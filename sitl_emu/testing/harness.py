@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.qmath import tilt_from_q
+from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import cascade_settings, sih_config
 from sitl_emu.physics import RigidBodyState, step
@@ -24,7 +25,7 @@ class Trace:
     t_s: list[float] = field(default_factory=list)
     states: list[RigidBodyState] = field(default_factory=list)
     motors: list[Vec4] = field(default_factory=list)
-    takeoff_state: list[str] = field(default_factory=list)
+    takeoff_state: list[TakeoffState] = field(default_factory=list)
     failsafe: list[bool] = field(default_factory=list)
 
     def column(self, name: str, i: int) -> list[float]:

@@ -12,6 +12,7 @@ from sitl_emu.control.mixer import allocated_torque, mix
 from sitl_emu.control.position import PositionControl, input_valid
 from sitl_emu.control.qmath import all_finite3, euler_from_q, isfinite, q_from_euler, yaw_from_q
 from sitl_emu.control.rate import RateControl
+from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.params import default_registry
 from sitl_emu.params.settings import cascade_settings
 from sitl_emu.physics import RigidBodyState, hover_state
@@ -37,7 +38,7 @@ def test_takeoff_then_hover_holds_altitude(hovering):
     tr = loop.run(10.0, lambda t: HOLD)
     zs = tr.column("pos_ned_m", 2)
     assert max(abs(z + 2.5) for z in zs) < 0.03
-    assert loop.control.takeoff_state == "flight"
+    assert loop.control.takeoff_state is TakeoffState.FLIGHT
     assert loop.control.hover_thrust == pytest.approx(0.49, abs=0.01)  # learned from the SIH default airframe
 
 
@@ -120,12 +121,12 @@ def test_invalid_setpoint_never_reaches_the_motors_and_stops_the_vehicle(hoverin
 def test_takeoff_waits_for_spoolup_then_ramps():
     loop = ClosedLoop()
     tr = loop.run(8.0, lambda t: HOLD)
-    idx = {name: next(i for i, s in enumerate(tr.takeoff_state) if s == name) for name in ("rampup", "flight")}
-    assert tr.takeoff_state[0] == "spoolup"
+    idx = {state: tr.takeoff_state.index(state) for state in (TakeoffState.RAMPUP, TakeoffState.FLIGHT)}
+    assert tr.takeoff_state[0] is TakeoffState.SPOOLUP
     # COM_SPOOLUP_TIME; a setpoint above the vehicle wants takeoff at once, so ready_for_takeoff is passed through
-    assert tr.t_s[idx["rampup"]] == pytest.approx(1.0, abs=0.01)
-    assert tr.t_s[idx["flight"]] == pytest.approx(4.0, abs=0.02)  # + MPC_TKO_RAMP_T
-    assert max(max(m) for m in tr.motors[: idx["rampup"]]) < 0.01  # idle before the ramp
+    assert tr.t_s[idx[TakeoffState.RAMPUP]] == pytest.approx(1.0, abs=0.01)
+    assert tr.t_s[idx[TakeoffState.FLIGHT]] == pytest.approx(4.0, abs=0.02)  # + MPC_TKO_RAMP_T
+    assert max(max(m) for m in tr.motors[: idx[TakeoffState.RAMPUP]]) < 0.01  # idle before the ramp
     liftoff = next(t for t, s in zip(tr.t_s, tr.states, strict=True) if s.pos_ned_m[2] < -0.05)
     assert 1.5 < liftoff < 4.0
     assert loop.state.pos_ned_m[2] == pytest.approx(-2.5, abs=0.15)
@@ -134,7 +135,7 @@ def test_takeoff_waits_for_spoolup_then_ramps():
 def test_no_takeoff_without_a_climbing_setpoint():
     loop = ClosedLoop()
     tr = loop.run(5.0, lambda t: TrajectorySetpoint(position_ned_m=(0.0, 0.0, 0.0)))
-    assert tr.takeoff_state[-1] == "ready_for_takeoff"
+    assert tr.takeoff_state[-1] is TakeoffState.READY_FOR_TAKEOFF
     assert loop.state.on_ground and max(max(m) for m in tr.motors) < 0.01
 
 
@@ -142,7 +143,7 @@ def test_disarmed_motors_are_off_and_idle_setpoint_gives_zero():
     control = MulticopterControl(cascade_settings(default_registry()))
     state = RigidBodyState()
     assert control.update(state, HOLD, None, False, True, 0, 0.004) == (0.0, 0.0, 0.0, 0.0)
-    assert control.takeoff_state == "disarmed"
+    assert control.takeoff_state is TakeoffState.DISARMED
     assert control.update(state, None, None, True, True, 4000, 0.004) == (0.0, 0.0, 0.0, 0.0)
 
 
