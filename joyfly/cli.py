@@ -25,7 +25,7 @@ from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
-from joyfly.session.core import Note
+from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
 from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
@@ -133,7 +133,7 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
-    watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), "warn", text)))
+    watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), Level.WARN, text)))
     session.link.on_message.append(watch.observe)
     return fly_session(session, add_browser_view(view, session, view_options, out), out)
 

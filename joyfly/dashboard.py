@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from typing import TextIO
 
-from joyfly.session.core import FlightStats, Note, Phase, SessionView
+from joyfly.session.core import FlightStats, Level, Note, Phase, SessionView
 from joyfly.term import LiveBlock
 from joyfly.types import StickCommand
 
@@ -101,7 +101,7 @@ class LiveDashboard:
 
     def note(self, note: Note) -> None:
         self._block.erase()
-        mark = {"warn": "! ", "error": "!! "}.get(note.level, "")
+        mark = {Level.WARN: "! ", Level.ERROR: "!! "}.get(note.level, "")
         self.out.write(f"{mark}{note.text}\n")
         if self._last is not None:
             self._block.draw(render(self._last))
@@ -132,7 +132,7 @@ class PlainLog:
         self._t_s = 0.0
 
     def note(self, note: Note) -> None:
-        level = {"warn": "WARNING ", "error": "ERROR "}.get(note.level, "")
+        level = {Level.WARN: "WARNING ", Level.ERROR: "ERROR "}.get(note.level, "")
         self.out.write(f"[{self._t_s:7.2f}] {level}{note.text}\n")
         self.out.flush()
 

@@ -35,13 +35,6 @@ LINK_TIMEOUT_S = 3.0  # as MAVSDK's DEFAULT_HEARTBEAT_TIMEOUT_S (core/mavsdk_imp
 # than this means it restarted: UDP reorders by milliseconds, and PX4's streams stamp samples at most ~0.1 s old.
 RESTART_STEP_S = 1.0
 
-# MAV_CMD numbers (MAVLink common.xml)
-CMD_NAV_RETURN_TO_LAUNCH = 20
-CMD_NAV_LAND = 21
-CMD_DO_SET_MODE = 176
-CMD_COMPONENT_ARM_DISARM = 400
-CMD_REQUEST_MESSAGE = 512
-MSG_ID_HOME_POSITION = 242
 
 # Command retries: 0.5 s timeout, 3 transmissions, as MAVSDK (core/mavlink_command_sender.cpp DEFAULT_TIMEOUT_S,
 # DEFAULT_RETRIES); PX4 ACKs commander commands within one commander cycle (~10-20 ms).
@@ -299,22 +292,22 @@ class VehicleLink:
         return handle
 
     def arm(self, arm: bool = True) -> CommandHandle:
-        return self.command(CMD_COMPONENT_ARM_DISARM, 1.0 if arm else 0.0)
+        return self.command(mavlink2.MAV_CMD_COMPONENT_ARM_DISARM, 1.0 if arm else 0.0)
 
     def set_mode(self, main: int, sub: int = 0) -> CommandHandle:
         """MAV_CMD_DO_SET_MODE: param1 = custom-mode flag (|armed), param2 = main mode, param3 = sub mode, as MAVSDK
         does for PX4 (core/system_impl.cpp make_command_px4_mode)."""
         base = 1 | (128 if self.state.armed else 0)
-        return self.command(CMD_DO_SET_MODE, float(base), float(main), float(sub))
+        return self.command(mavlink2.MAV_CMD_DO_SET_MODE, float(base), float(main), float(sub))
 
     def land(self) -> CommandHandle:
-        return self.command(CMD_NAV_LAND)
+        return self.command(mavlink2.MAV_CMD_NAV_LAND)
 
     def return_to_launch(self) -> CommandHandle:
-        return self.command(CMD_NAV_RETURN_TO_LAUNCH)
+        return self.command(mavlink2.MAV_CMD_NAV_RETURN_TO_LAUNCH)
 
     def request_home(self) -> CommandHandle:
-        return self.command(CMD_REQUEST_MESSAGE, float(MSG_ID_HOME_POSITION))
+        return self.command(mavlink2.MAV_CMD_REQUEST_MESSAGE, float(mavlink2.MAVLINK_MSG_ID_HOME_POSITION))
 
     def send_setpoint(self, sp: Setpoint) -> None:
         """SET_POSITION_TARGET_LOCAL_NED in LOCAL_NED: position + yaw, with velocity feed-forward if it has one."""

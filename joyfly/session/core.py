@@ -67,10 +67,18 @@ class SessionSettings:
     limits: Limits = field(default_factory=Limits)
 
 
+class Level(Enum):
+    """How much a note matters: the dashboard marks warnings and errors, and the log gets the same level."""
+
+    INFO = logging.INFO
+    WARN = logging.WARNING
+    ERROR = logging.ERROR
+
+
 @dataclass(frozen=True, slots=True)
 class Note:
     time_s: float
-    level: str  # info | warn | error
+    level: Level
     text: str
 
 
@@ -227,11 +235,11 @@ class SessionCore:
         """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
         self._set_phase(Phase.DONE)
 
-    def _note(self, level: str, text: str) -> None:
+    def _note(self, level: Level, text: str) -> None:
         note = Note(self.clock.now(), level, text)
         self.notes.append(note)
         del self.notes[:-20]
-        getattr(log, {"info": "info", "warn": "warning"}.get(level, "error"))(text)
+        log.log(level.value, text)
         if self.on_note is not None:
             self.on_note(note)
 
@@ -244,7 +252,7 @@ class SessionCore:
 
     def _fail(self, text: str) -> None:
         self.error = text
-        self._note("error", text)
+        self._note(Level.ERROR, text)
         self._set_phase(Phase.FAILED)
 
     def _streaming_allowed(self) -> bool:
@@ -275,7 +283,7 @@ class SessionCore:
 
     def _note_once(self, text: str) -> None:
         if not any(n.text == text for n in self.notes):
-            self._note("info", text)
+            self._note(Level.INFO, text)
 
     def view(self) -> SessionView:
         st = self.link.state

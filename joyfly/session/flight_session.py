@@ -16,6 +16,7 @@ from dataclasses import replace
 from joyfly.link.vehicle_link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, VehicleState
 from joyfly.session.core import (
     FlightStats,
+    Level,
     Note,
     Phase,
     SessionSettings,
@@ -27,8 +28,8 @@ from joyfly.session.loop import MAV_STATE_STANDBY, READY_WAIT_S, SessionLoop
 from joyfly.session.retry import Retry
 from joyfly.sticks.setpoints import initial_setpoint, next_setpoint
 
-__all__ = ["MAV_STATE_STANDBY", "READY_WAIT_S", "FlightSession", "FlightStats", "Note", "Phase", "SessionSettings",
-           "SessionView", "StickSource"]
+__all__ = ["MAV_STATE_STANDBY", "READY_WAIT_S", "FlightSession", "FlightStats", "Level", "Note", "Phase",
+           "SessionSettings", "SessionView", "StickSource"]
 
 # Arm only in Hold or OFFBOARD: PX4 refuses to arm in Return, Land, Descend... (mode_req_prevent_arming,
 # ModeUtil/mode_requirements.cpp) and in the manual modes without RC (px4-behaviour.md 3.2)
@@ -68,10 +69,10 @@ class FlightSession(SessionLoop):
     def _start_control(self, why: str) -> None:
         st = self.link.state
         if st.armed and not st.on_ground:
-            self._note("info", f"{why}: taking control at the current position.")
+            self._note(Level.INFO, f"{why}: taking control at the current position.")
             self.sp = self._hold_here()
         else:
-            self._note("info", f"{why}: taking off to {self.s.alt_m:g} m.")
+            self._note(Level.INFO, f"{why}: taking off to {self.s.alt_m:g} m.")
             self._home_here()
             self.sp = initial_setpoint(self._vehicle_pos(), st.yaw_rad, self.fence, self.s.alt_m)
         self._prestreamed = 0
@@ -79,7 +80,7 @@ class FlightSession(SessionLoop):
         self._set_phase(Phase.PRESTREAM)
 
     def _take_over(self) -> None:
-        self._note("info", "The vehicle is already in OFFBOARD: taking over at its position.")
+        self._note(Level.INFO, "The vehicle is already in OFFBOARD: taking over at its position.")
         self.sp = self._hold_here()
         self._set_phase(Phase.FLYING)
 
@@ -102,7 +103,7 @@ class FlightSession(SessionLoop):
         handle = self._retry.handle if self._retry is not None else None
         if self.link.state.armed or (handle is not None and handle.accepted):
             # PX4 ACKs ARM_DISARM after the state changed (px4-behaviour.md 11.6); the 1 Hz HEARTBEAT follows later
-            self._note("info", "Armed.")
+            self._note(Level.INFO, "Armed.")
             self._set_phase(Phase.ENTERING)
             return
         if self.link.state.mode not in ARMABLE_MODES and self._hold_requests < 2:
@@ -117,7 +118,7 @@ class FlightSession(SessionLoop):
         """Ask for Hold (as MAVSDK's arm() does from Mission/Return), twice at most, then arm anyway and let the
         vehicle's refusal explain."""
         if now - self._hold_sent_s > 1.5:  # the 1 Hz HEARTBEAT shows the new mode within about a second
-            self._note("info", f"Switching the vehicle from {self.link.state.mode} to Hold before arming.")
+            self._note(Level.INFO, f"Switching the vehicle from {self.link.state.mode} to Hold before arming.")
             self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
             self._hold_sent_s = now
             self._hold_requests += 1
@@ -127,11 +128,11 @@ class FlightSession(SessionLoop):
         self._send(self.sp)
         st = self.link.state
         if st.offboard and st.armed:
-            self._note("info", "OFFBOARD: you have control.")
+            self._note(Level.INFO, "OFFBOARD: you have control.")
             self._set_phase(Phase.FLYING)
             return
         if not st.armed and now - self._phase_s > 2.5:  # the heartbeat should show the arming within ~1 s
-            self._note("warn", "The vehicle disarmed before OFFBOARD was entered.")
+            self._note(Level.WARN, "The vehicle disarmed before OFFBOARD was entered.")
             self._set_phase(Phase.GROUNDED)
             return
         if self._retry is None:
@@ -144,21 +145,22 @@ class FlightSession(SessionLoop):
         assert self.sp is not None
         self._send(self.sp)
         if self.link.state.offboard:
-            self._note("info", "The vehicle is back in OFFBOARD: you have control.")
+            self._note(Level.INFO, "The vehicle is back in OFFBOARD: you have control.")
             self._set_phase(Phase.FLYING)
         elif now - self._phase_s > 2.0:
-            self._note("warn", f"The vehicle stays in {self.link.state.mode}: press OFFBOARD to take control.")
+            self._note(Level.WARN, f"The vehicle stays in {self.link.state.mode}: press OFFBOARD to take control.")
             self._set_phase(Phase.PAUSED)
 
     def _flying(self, now: float) -> None:
         st = self.link.state
         if not st.offboard:
             recent = [t.text for t in self.link.statustexts if self.clock.now() - t.time_s < 3.0]
-            self._note("warn", left_offboard_message(st.mode, recent))
+            self._note(Level.WARN, left_offboard_message(st.mode, recent))
             self._set_phase(Phase.PAUSED if st.armed else Phase.GROUNDED)
             return
         if not st.armed:  # killed, or disarmed by another ground station
-            self._note("warn", "The vehicle disarmed: joyfly stopped sending setpoints; press ARM or TAKEOFF to fly.")
+            self._note(Level.WARN,
+                       "The vehicle disarmed: joyfly stopped sending setpoints; press ARM or TAKEOFF to fly.")
             self._set_phase(Phase.GROUNDED)
             return
         self._send_flight_setpoint()

@@ -11,8 +11,8 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER
-from joyfly.session.core import MIN_SEND_GAP_S, Phase, SessionView, no_vehicle_message
-from joyfly.session.retry import ExitPlan
+from joyfly.session.core import MIN_SEND_GAP_S, Level, Phase, SessionView, no_vehicle_message
+from joyfly.session.retry import ExitPlan, Outcome
 from joyfly.session.watch import SessionWatch
 from joyfly.sticks.mapping import fired
 from joyfly.types import Action
@@ -98,7 +98,7 @@ class SessionLoop(SessionWatch):
         self.link.poll(0.0)
         self.link.tick()
         for text in self.link.take_new_statustexts():
-            self._note("warn" if text.severity <= 4 else "info", f"Vehicle: {text.text}")
+            self._note(Level.WARN if text.severity <= 4 else Level.INFO, f"Vehicle: {text.text}")
         self._update_stats(now)
         self._last_tick_s = now
         if self.exit_requested and self.phase not in (Phase.EXITING, Phase.DONE, Phase.FAILED):
@@ -126,19 +126,20 @@ class SessionLoop(SessionWatch):
     def _on_button(self, action: Action) -> None:
         st = self.link.state
         if action is Action.LAND and st.armed:
-            self._note("info", "LAND pressed: landing.")
+            self._note(Level.INFO, "LAND pressed: landing.")
             self.link.land()
             self._set_phase(Phase.LANDING)
         elif action is Action.RETURN and st.armed:
-            self._note("info", "RETURN pressed: returning to launch.")
+            self._note(Level.INFO, "RETURN pressed: returning to launch.")
             self.link.return_to_launch()
             self._set_phase(Phase.LANDING)
         elif action is Action.HOLD and st.armed:
-            self._note("info", f"HOLD pressed: the vehicle holds in AUTO.LOITER; press OFFBOARD to {self.fly_again}.")
+            self._note(Level.INFO,
+                       f"HOLD pressed: the vehicle holds in AUTO.LOITER; press OFFBOARD to {self.fly_again}.")
             self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
             self._set_phase(Phase.PAUSED)
         elif action is Action.ARM and st.armed and st.on_ground and self.phase in self.disarm_phases:
-            self._note("info", "ARM held: disarming.")
+            self._note(Level.INFO, "ARM held: disarming.")
             self.link.arm(False)
         elif action in (Action.OFFBOARD, Action.TAKEOFF, Action.ARM) and self.phase in (
                 Phase.PAUSED, Phase.GROUNDED, Phase.LANDING):
@@ -172,7 +173,7 @@ class SessionLoop(SessionWatch):
 
     def _on_connected(self) -> None:
         st = self.link.state
-        self._note("info", f"Connected to vehicle {st.sysid} on {self.link.transport.description} ({st.mode}, "
+        self._note(Level.INFO, f"Connected to vehicle {st.sysid} on {self.link.transport.description} ({st.mode}, "
                            f"{'armed' if st.armed else 'disarmed'}).")
         self.link.request_home()
         self._restarts_seen = st.restarts  # a restart before we flew is nothing to report
@@ -184,7 +185,7 @@ class SessionLoop(SessionWatch):
         elif st.armed and self.in_control(st):
             self._take_over()
         elif st.armed and not st.on_ground:
-            self._note("warn", f"The vehicle is already flying in {st.mode}: press OFFBOARD to take control.")
+            self._note(Level.WARN, f"The vehicle is already flying in {st.mode}: press OFFBOARD to take control.")
             self._set_phase(Phase.PAUSED)
         else:
             self._start_control("Start")
@@ -197,12 +198,12 @@ class SessionLoop(SessionWatch):
         self._note_once("Waiting for the vehicle to be ready to arm (its HEARTBEAT does not say STANDBY yet).")
         return False
 
-    def _report_retry(self, outcome: str | None) -> None:
+    def _report_retry(self, outcome: Outcome | None) -> None:
         if outcome is None or self._retry is None:
             return
-        if outcome == "refused":
-            self._note("warn", self._retry.last_refusal)
-        elif outcome == "failed":
+        if outcome is Outcome.REFUSED:
+            self._note(Level.WARN, self._retry.last_refusal)
+        elif outcome is Outcome.FAILED:
             if self.link.state.on_ground and self.link.state.armed:
                 self.link.arm(False)
             self._fail(self._retry.failure_message())
@@ -210,19 +211,19 @@ class SessionLoop(SessionWatch):
     def _paused(self, now: float) -> None:
         st = self.link.state
         if not st.armed:
-            self._note("info", "The vehicle is on the ground and disarmed.")
+            self._note(Level.INFO, "The vehicle is on the ground and disarmed.")
             self._set_phase(Phase.GROUNDED)
 
     def _landing(self, now: float) -> None:
         if not self.link.state.armed:
-            self._note("info", "Landed and disarmed.")
+            self._note(Level.INFO, "Landed and disarmed.")
             self._set_phase(Phase.GROUNDED)
 
     def _grounded(self, now: float) -> None:
         if self.s.exit_when_landed:
             self._set_phase(Phase.DONE)
         elif self._joy.lost:  # a script that ended, a joystick unplugged after the flight: nothing more to fly
-            self._note("info", "The joystick is gone and the vehicle is on the ground, disarmed: joyfly is done.")
+            self._note(Level.INFO, "The joystick is gone and the vehicle is on the ground, disarmed: joyfly is done.")
             self._set_phase(Phase.DONE)
 
     def _idle(self, now: float) -> None:
@@ -234,7 +235,7 @@ class SessionLoop(SessionWatch):
         if self.phase is Phase.CONNECTING or not self._maybe_armed():
             self._set_phase(Phase.DONE)
             return
-        self._note("info", f"Exiting: {self.s.on_exit} (press Ctrl-C again to quit at once).")
+        self._note(Level.INFO, f"Exiting: {self.s.on_exit} (press Ctrl-C again to quit at once).")
         self._set_phase(Phase.EXITING)
 
     def _maybe_armed(self) -> bool:
@@ -249,18 +250,19 @@ class SessionLoop(SessionWatch):
             self._exit = ExitPlan(self.s.on_exit, self.link, now, self.in_control)
         self._keep_fed_while_exiting()
         outcome = self._exit.update(now)
-        if outcome == "done":
-            self._note("info", "Landed and disarmed." if self.s.on_exit != "hold" else "The vehicle holds position.")
+        if outcome is Outcome.DONE:
+            done = "Landed and disarmed." if self.s.on_exit != "hold" else "The vehicle holds position."
+            self._note(Level.INFO, done)
             self._set_phase(Phase.DONE)
             return
-        if outcome:
-            self._note("warn", outcome)
+        if outcome is not None:
+            self._note(Level.WARN, self._exit.retry.last_refusal)
         self._tick_exit_timeout(now)
 
     def _tick_exit_timeout(self, now: float) -> None:
         if self.phase is Phase.EXITING and now - self._phase_s > self.s.exit_timeout_s:
-            self._note("error", f"The vehicle did not finish '{self.s.on_exit}' within {self.s.exit_timeout_s:g} s; "
-                                "it may still be armed: take over with a ground station.")
+            self._note(Level.ERROR, f"The vehicle did not finish '{self.s.on_exit}' within "
+                       f"{self.s.exit_timeout_s:g} s; it may still be armed: take over with a ground station.")
             self._set_phase(Phase.DONE)
 
 

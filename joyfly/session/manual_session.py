@@ -37,7 +37,7 @@ from joyfly.link.vehicle_link import (
     VehicleState,
     main_mode,
 )
-from joyfly.session.core import Note, Phase, SessionSettings, StickSource
+from joyfly.session.core import Level, Note, Phase, SessionSettings, StickSource
 from joyfly.session.loop import SessionLoop
 from joyfly.session.retry import Retry
 from joyfly.sticks.manual import CENTRED, ManualInput, interlock, to_manual
@@ -151,10 +151,10 @@ class ManualSession(SessionLoop):
         self._joy_hold, self._latched = False, True
         self._from_air = st.armed and not st.on_ground
         if self._from_air:
-            self._note("info", f"{why}: switching to {self.mode_words} ({self.mode_name}).")
+            self._note(Level.INFO, f"{why}: switching to {self.mode_words} ({self.mode_name}).")
             self._set_phase(Phase.ENTERING)
             return
-        self._note("info", f"{why}: {self.mode_words} ({self.mode_name}) with MANUAL_CONTROL; arming with the "
+        self._note(Level.INFO, f"{why}: {self.mode_words} ({self.mode_name}) with MANUAL_CONTROL; arming with the "
                            "throttle centred, then the throttle stick takes off.")
         self._home_here()
         self._prestreamed = 0
@@ -166,7 +166,7 @@ class ManualSession(SessionLoop):
                          "(the throttle acts once it has been at the centre).")
 
     def _now_flying(self, text: str) -> None:
-        self._note("info", text)
+        self._note(Level.INFO, text)
         self._joy_hold = False
         self._set_phase(Phase.FLYING)
 
@@ -192,7 +192,7 @@ class ManualSession(SessionLoop):
             if st.armed:
                 self._now_flying(f"{self.mode_words} ({self.mode_name}): you have control.")
             elif self._from_air:
-                self._note("warn", f"The vehicle disarmed before {self.mode_name} was entered.")
+                self._note(Level.WARN, f"The vehicle disarmed before {self.mode_name} was entered.")
                 self._set_phase(Phase.GROUNDED)
             elif self._vehicle_ready(now):
                 self._set_phase(Phase.ARMING)
@@ -220,13 +220,13 @@ class ManualSession(SessionLoop):
             self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
             self._hold_sent = True
         if not st.armed:
-            self._note("warn", "The vehicle disarmed: press ARM or TAKEOFF to fly again.")
+            self._note(Level.WARN, "The vehicle disarmed: press ARM or TAKEOFF to fly again.")
             self._set_phase(Phase.GROUNDED)
         elif not self._joy_hold and not self.in_control(st):
             recent = [t.text for t in self.link.statustexts if now - t.time_s < 3.0]
             why = f" ({recent[-1]})" if recent else ""
-            self._note("warn", f"The vehicle left {self.mode_name} for {st.mode}{why}: press OFFBOARD to take control "
-                               "again (moving the sticks also hands it back, when PX4 allows it).")
+            self._note(Level.WARN, f"The vehicle left {self.mode_name} for {st.mode}{why}: press OFFBOARD to take "
+                       "control again (moving the sticks also hands it back, when PX4 allows it).")
             self._set_phase(Phase.PAUSED)
 
     def _paused(self, now: float) -> None:
@@ -249,7 +249,7 @@ class ManualSession(SessionLoop):
 
     def _hold_for_joystick(self) -> None:
         """Hold (AUTO.LOITER), asked for once the centred sticks have been steady for STEADY_S (_flying)."""
-        self._note("warn", f"Joystick lost: Hold (AUTO.LOITER) with centred sticks; landing in "
+        self._note(Level.WARN, f"Joystick lost: Hold (AUTO.LOITER) with centred sticks; landing in "
                            f"{self.s.joy_timeout_s:g} s unless it comes back.")
         self._joy_hold, self._hold_sent = True, False
 
@@ -263,7 +263,7 @@ class ManualSession(SessionLoop):
         if self.phase in (Phase.PRESTREAM, Phase.ENTERING, Phase.ARMING, Phase.FLYING) and not st.armed:
             self._set_phase(Phase.GROUNDED)
         elif self.phase is Phase.FLYING and not self._joy_hold and not self.in_control(st):
-            self._note("warn", f"The vehicle is in {st.mode} after the outage (PX4's failsafe for the lost "
+            self._note(Level.WARN, f"The vehicle is in {st.mode} after the outage (PX4's failsafe for the lost "
                                "MANUAL_CONTROL): press OFFBOARD to take control again.")
             self._set_phase(Phase.PAUSED)
 
@@ -278,5 +278,5 @@ class ManualSession(SessionLoop):
             return  # centred sticks first (_sticks_to_send), then the exit command
         super()._exiting(now)
         if self.phase is Phase.DONE and self.s.on_exit == "hold" and self.link.state.armed:
-            self._note("warn", "joyfly stops sending MANUAL_CONTROL now: PX4 takes that for a lost RC and, after "
+            self._note(Level.WARN, "joyfly stops sending MANUAL_CONTROL now: PX4 takes that for a lost RC and, after "
                                "holding for COM_FAIL_ACT_T (5 s), returns home (NAV_RCL_ACT).")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from enum import Enum
 
 from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink, VehicleState
 
@@ -14,10 +15,18 @@ REASON_GRACE_S = 0.25
 WARNING = 4  # MAV_SEVERITY_WARNING: CRITICAL "Arming denied: ..." and friends are below it
 
 
+class Outcome(Enum):
+    """What a retried command came to, when there is news (`last_refusal` says why)."""
+
+    REFUSED = "refused"  # refused (or accepted without effect); it will be sent again
+    FAILED = "failed"  # refused and the attempts are used up
+    DONE = "done"  # the exit plan only: the vehicle is where --on-exit puts it
+
+
 class Retry:
     """Send a command until the vehicle's state shows it worked, at most `attempts` times.
 
-    `update()` returns None while in progress, "refused" after a refusal that will be retried, "failed" when the
+    `update()` returns None while in progress, REFUSED after a refusal that will be retried, FAILED when the
     attempts are used up. An ACCEPTED whose effect does not show within `settle_s` counts as a new attempt.
     """
 
@@ -35,7 +44,7 @@ class Retry:
         self.last_refusal = ""
 
     def update(self, now_s: float, link: VehicleLink, send: Callable[[], CommandHandle],
-               done: Callable[[], bool]) -> str | None:
+               done: Callable[[], bool]) -> Outcome | None:
         if done():
             return None
         if self.handle is None:
@@ -46,26 +55,26 @@ class Retry:
             return self._after_accept(now_s)
         return self._after_refusal(now_s, link)
 
-    def _maybe_send(self, now_s: float, send: Callable[[], CommandHandle]) -> str | None:
+    def _maybe_send(self, now_s: float, send: Callable[[], CommandHandle]) -> Outcome | None:
         if now_s < self.next_try_s:
             return None
         if self.attempt >= self.attempts:
-            return "failed"
+            return Outcome.FAILED
         self.attempt += 1
         self.handle = send()
         self.sent_s = now_s
         return None
 
-    def _after_accept(self, now_s: float) -> str | None:
+    def _after_accept(self, now_s: float) -> Outcome | None:
         if self.accepted_s is None:
             self.accepted_s = now_s
         if now_s - self.accepted_s > self.settle_s:
             self.handle, self.accepted_s = None, None
             self.last_refusal = f"{self.what}: the vehicle accepted but its state did not change"
-            return "refused" if self.attempt < self.attempts else "failed"
+            return Outcome.REFUSED if self.attempt < self.attempts else Outcome.FAILED
         return None
 
-    def _after_refusal(self, now_s: float, link: VehicleLink) -> str | None:
+    def _after_refusal(self, now_s: float, link: VehicleLink) -> Outcome | None:
         if self.refused_s is None:
             self.refused_s = now_s
         if now_s - self.refused_s < REASON_GRACE_S:
@@ -76,7 +85,7 @@ class Retry:
             self.last_refusal = f"{self.what}: no answer from the vehicle."
         self.handle, self.refused_s = None, None
         self.next_try_s = now_s + self.pause_s
-        return "refused" if self.attempt < self.attempts else "failed"
+        return Outcome.REFUSED if self.attempt < self.attempts else Outcome.FAILED
 
     def _reason(self, link: VehicleLink) -> str:
         texts = [t for t in link.statustexts if t.time_s >= self.sent_s - 0.05]
@@ -126,13 +135,13 @@ class ExitPlan:
             return not self.in_control(st)
         return not st.armed and st.last_heartbeat_s is not None and st.last_heartbeat_s > self.started_s
 
-    def update(self, now_s: float) -> str | None:
-        """"done", a refusal to report, or None while in progress."""
+    def update(self, now_s: float) -> Outcome | None:
+        """DONE; a refusal to report (`retry.last_refusal`), FAILED only once; or None while in progress."""
         if self.done():
-            return "done"
+            return Outcome.DONE
         outcome = self.retry.update(now_s, self.link, self._send, lambda: False)
-        if outcome == "failed":
+        if outcome is Outcome.FAILED:
             if self._gave_up:
                 return None
             self._gave_up = True
-        return self.retry.last_refusal if outcome else None
+        return outcome

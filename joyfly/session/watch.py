@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from joyfly.session.core import STREAMING_PHASES, Phase, SessionCore, restarted_message
+from joyfly.session.core import STREAMING_PHASES, Level, Phase, SessionCore, restarted_message
 from joyfly.session.watchdogs import Change
 
 
@@ -27,7 +27,7 @@ class SessionWatch(SessionCore):
 
     def _on_restart(self, now: float) -> None:
         quitting = self.exit_requested or self.s.exit_when_landed
-        self._note("warn", restarted_message(self.link.state, quitting))
+        self._note(Level.WARN, restarted_message(self.link.state, quitting))
         self._restart_s = now
         self.sp, self._last_pos, self._home_from_vehicle = None, None, False
         self._set_phase(Phase.DONE if quitting else Phase.GROUNDED)
@@ -37,10 +37,10 @@ class SessionWatch(SessionCore):
         lost_s = self._linkw.lost_s
         change = self._linkw.update(st.link_ok(now), now, st.stamped_s)
         if change is Change.LOST:
-            self._note("warn", f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
+            self._note(Level.WARN, f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
                                f"{self.link.transport.description}.")
         elif change is Change.BACK and (lost_s is None or self._restart_s < lost_s):  # else the restart note said it
-            self._note("info", "Link back: the vehicle answers again.")
+            self._note(Level.INFO, "Link back: the vehicle answers again.")
             self._on_link_back()
         return self._linkw.ok
 
@@ -60,20 +60,20 @@ class SessionWatch(SessionCore):
         if change is Change.LOST and self.phase is Phase.FLYING:
             self._hold_for_joystick()
         elif change is Change.LOST and self.phase is Phase.LANDING:
-            self._note("warn", "Joystick lost: the vehicle keeps landing; joyfly quits once it has disarmed.")
+            self._note(Level.WARN, "Joystick lost: the vehicle keeps landing; joyfly quits once it has disarmed.")
         elif change is Change.LOST and self.phase is not Phase.GROUNDED:  # landed: _grounded says it
-            self._note("warn", "Joystick lost.")
+            self._note(Level.WARN, "Joystick lost.")
         elif change is Change.BACK:
-            self._note("info", "Joystick back: you have control again.")
+            self._note(Level.INFO, "Joystick back: you have control again.")
             self._joystick_back()
         if self._joy.expired(now) and self.phase is Phase.FLYING:
-            self._note("warn", f"Joystick still lost after {self.s.joy_timeout_s:g} s: landing.")
+            self._note(Level.WARN, f"Joystick still lost after {self.s.joy_timeout_s:g} s: landing.")
             self.link.land()
             self._set_phase(Phase.LANDING)
 
     def _hold_for_joystick(self) -> None:
         """The joystick went away in flight: hold until it comes back or the timeout lands the vehicle."""
-        self._note("warn", f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
+        self._note(Level.WARN, f"Joystick lost: holding position; landing in {self.s.joy_timeout_s:g} s "
                            "unless it comes back.")
         self.sp = self._hold_here()
 

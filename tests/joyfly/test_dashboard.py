@@ -6,7 +6,7 @@ import io
 from dataclasses import replace
 
 from joyfly.dashboard import LiveDashboard, PlainLog, bar, make_view, render, summary_lines
-from joyfly.session.flight_session import FlightStats, Note, Phase, SessionView
+from joyfly.session.flight_session import FlightStats, Level, Note, Phase, SessionView
 from joyfly.sticks.setpoints import Fence, Setpoint
 from joyfly.types import Action, StickCommand
 
@@ -45,7 +45,7 @@ def test_live_view_redraws_in_place_at_most_10_times_a_second() -> None:
     for i in range(20):  # 20 views over one second
         live.show(view(t=i * 0.05))
     assert out.getvalue().count("\x1b[J") == 9  # 10 frames, each after the first erases the previous
-    live.note(Note(1.0, "warn", "Joystick lost"))
+    live.note(Note(1.0, Level.WARN, "Joystick lost"))
     assert "! Joystick lost\n" in out.getvalue()
 
 
@@ -55,7 +55,7 @@ def test_plain_log_prints_state_changes_and_at_most_one_line_a_second() -> None:
     for i in range(40):  # 2 s of flying at 20 Hz
         plain.show(view(t=i * 0.05))
     plain.show(view(t=2.0, phase=Phase.PAUSED, mode="AUTO.RTL", streaming=False))
-    plain.note(Note(2.0, "warn", "The vehicle left OFFBOARD"))
+    plain.note(Note(2.0, Level.WARN, "The vehicle left OFFBOARD"))
     lines = out.getvalue().splitlines()
     assert len(lines) == 4
     assert "AUTO.RTL" in lines[2] and "\x1b" not in out.getvalue()
