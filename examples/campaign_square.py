@@ -20,7 +20,7 @@ from typing import Any
 
 from pymavlink import mavutil
 
-from sitl_emu.campaign import MAV_CMD_INJECT_FAILURE, Case, FaultSchedule, Outcome
+from sitl_emu.campaign import Case, FaultSchedule, Outcome
 
 DEFAULTS = {"side_m": 5.0, "alt_m": 3.0, "hold_s": 3.0, "max_error_m": 1.0}
 MASK_POSITION = 0b0000_1111_1111_1000  # SET_POSITION_TARGET_LOCAL_NED: use x, y, z only
@@ -59,7 +59,7 @@ class Pilot:
             self.mav.mav.set_position_target_local_ned_send(
                 0, 1, 1, MAV.MAV_FRAME_LOCAL_NED, MASK_POSITION, *self.setpoint, 0, 0, 0, 0, 0, 0, 0, 0)
         for fault in self.faults.due(self.now()):
-            self.mav.mav.command_long_send(1, 1, MAV_CMD_INJECT_FAILURE, 0, *fault.command_params())
+            self.mav.mav.command_long_send(1, 1, MAV.MAV_CMD_INJECT_FAILURE, 0, *fault.command_params())
         self.sim.run_for(STEP_S)
         while (msg := self.mav.recv_match(blocking=False)) is not None:
             kind = msg.get_type()

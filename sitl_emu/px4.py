@@ -10,6 +10,7 @@ Sources (see ../shared/reference/px4-behaviour.md section 2):
 from __future__ import annotations
 
 from enum import IntEnum
+from typing import Final
 
 
 class NavState(IntEnum):
@@ -82,34 +83,104 @@ class LandedState(IntEnum):
 
 
 class MavCmd(IntEnum):
-    """MAV_CMD numbers (MAVLink common.xml, names without the MAV_CMD_ prefix) of the commands the emulator answers.
+    """MAV_CMD numbers (MAVLink common.xml, names without the MAV_CMD_ prefix): every command the emulator answers or
+    stores, here and nowhere else.
 
-    The commander's (Commander.cpp handle_command) and the mavlink module's (mavlink_receiver.cpp
-    handle_message_command_both). PX4 keeps MAVLink's numbering for vehicle_command internally, and so do we.
+    Answered: the commander's (Commander.cpp handle_command), the navigator's (DO_SET_MISSION_CURRENT) and the
+    mavlink module's (mavlink_receiver.cpp handle_message_command_both); flight/commands.py and
+    mavlink/link_commands.py map them to their handlers. Stored: the mission, geofence and rally items PX4 accepts
+    in an upload (mavlink_mission.cpp parse_mavlink_mission_item; mavlink/mission_items.py). PX4 keeps MAVLink's
+    numbering for vehicle_command and mission_item internally, and so do we.
     """
 
+    NAV_WAYPOINT = 16
+    NAV_LOITER_UNLIM = 17
+    NAV_LOITER_TIME = 19
     NAV_RETURN_TO_LAUNCH = 20
     NAV_LAND = 21
     NAV_TAKEOFF = 22
+    NAV_LOITER_TO_ALT = 31
     DO_ORBIT = 34
+    NAV_ROI = 80
+    NAV_VTOL_TAKEOFF = 84
+    NAV_VTOL_LAND = 85
+    NAV_DELAY = 93
+    CONDITION_DELAY = 112
+    CONDITION_DISTANCE = 114
     DO_SET_MODE = 176
+    DO_JUMP = 177
+    DO_CHANGE_SPEED = 178
     DO_SET_HOME = 179
     DO_FLIGHTTERMINATION = 185
     DO_CHANGE_ALTITUDE = 186
+    DO_SET_ACTUATOR = 187
+    DO_LAND_START = 189
     DO_REPOSITION = 192
-    DO_SET_MISSION_CURRENT = 224  # the navigator answers it (navigator_main.cpp)
+    DO_SET_ROI_LOCATION = 195
+    DO_SET_ROI_WPNEXT_OFFSET = 196
+    DO_SET_ROI_NONE = 197
+    DO_CONTROL_VIDEO = 200
+    DO_SET_ROI = 201
+    DO_DIGICAM_CONTROL = 203
+    DO_MOUNT_CONFIGURE = 204
+    DO_MOUNT_CONTROL = 205
+    DO_SET_CAM_TRIGG_DIST = 206
+    DO_GRIPPER = 211
+    DO_AUTOTUNE_ENABLE = 212
+    DO_SET_CAM_TRIGG_INTERVAL = 214
+    DO_SET_MISSION_CURRENT = 224
     PREFLIGHT_CALIBRATION = 241
     PREFLIGHT_REBOOT_SHUTDOWN = 246
+    OBLIQUE_SURVEY = 260
     MISSION_START = 300
     COMPONENT_ARM_DISARM = 400
     RUN_PREARM_CHECKS = 401
-    INJECT_FAILURE = 420
     GET_HOME_POSITION = 410  # legacy alias of REQUEST_MESSAGE(HOME_POSITION), PX4 <= v1.17
+    INJECT_FAILURE = 420
     GET_MESSAGE_INTERVAL = 510
     SET_MESSAGE_INTERVAL = 511
     REQUEST_MESSAGE = 512
     REQUEST_PROTOCOL_VERSION = 519  # legacy alias of REQUEST_MESSAGE(PROTOCOL_VERSION), PX4 <= v1.17
     REQUEST_AUTOPILOT_CAPABILITIES = 520  # legacy alias of REQUEST_MESSAGE(AUTOPILOT_VERSION), PX4 <= v1.17
+    SET_CAMERA_MODE = 530
+    SET_CAMERA_FOCUS = 532
+    SET_CAMERA_SOURCE = 534
+    DO_GIMBAL_MANAGER_PITCHYAW = 1000
+    DO_GIMBAL_MANAGER_CONFIGURE = 1001
+    IMAGE_START_CAPTURE = 2000
+    IMAGE_STOP_CAPTURE = 2001
+    DO_TRIGGER_CONTROL = 2003
+    VIDEO_START_CAPTURE = 2500
+    VIDEO_STOP_CAPTURE = 2501
+    DO_VTOL_TRANSITION = 3000
+    CONDITION_GATE = 4501
+    NAV_FENCE_RETURN_POINT = 5000
+    NAV_FENCE_POLYGON_VERTEX_INCLUSION = 5001
+    NAV_FENCE_POLYGON_VERTEX_EXCLUSION = 5002
+    NAV_FENCE_CIRCLE_INCLUSION = 5003
+    NAV_FENCE_CIRCLE_EXCLUSION = 5004
+    NAV_RALLY_POINT = 5100
+    DO_WINCH = 42600
+
+
+class MavFrame(IntEnum):
+    """MAV_FRAME numbers (common.xml) of the frames the emulator reads or sends."""
+
+    GLOBAL = 0  # altitude above mean sea level
+    LOCAL_NED = 1
+    MISSION = 2  # a mission item without a position: its params are kept as sent
+    GLOBAL_RELATIVE_ALT = 3  # altitude above home
+    GLOBAL_INT = 5
+    GLOBAL_RELATIVE_ALT_INT = 6
+    BODY_NED = 8
+    GLOBAL_TERRAIN_ALT_INT = 11
+    BODY_FRD = 12
+
+
+# The global frames of a mission, fence or rally item, by what their altitude is measured from
+ABSOLUTE_FRAMES: Final = frozenset({MavFrame.GLOBAL, MavFrame.GLOBAL_INT})
+RELATIVE_FRAMES: Final = frozenset({MavFrame.GLOBAL_RELATIVE_ALT, MavFrame.GLOBAL_RELATIVE_ALT_INT})
+GLOBAL_FRAMES: Final = ABSOLUTE_FRAMES | RELATIVE_FRAMES
 
 
 class MavResult(IntEnum):

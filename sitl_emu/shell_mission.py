@@ -15,13 +15,10 @@ from sitl_emu.flight.mission_store import (
     MissionItem,
     MissionStore,
 )
-from sitl_emu.px4 import NavState
+from sitl_emu.px4 import RELATIVE_FRAMES, MavCmd, MavFrame, NavState
 from sitl_emu.shell_param import log_line
 
 _STATES = {1: "NO_MISSION", 2: "NOT_STARTED", 3: "ACTIVE", 4: "PAUSED", 5: "COMPLETE"}
-_COMMANDS = {16: "WAYPOINT", 17: "LOITER_UNLIM", 19: "LOITER_TIME", 20: "RETURN_TO_LAUNCH", 21: "LAND",
-             22: "TAKEOFF", 31: "LOITER_TO_ALT", 93: "DELAY", 177: "DO_JUMP", 178: "DO_CHANGE_SPEED",
-             195: "DO_SET_ROI_LOCATION", 197: "DO_SET_ROI_NONE"}
 _MISSION_MODES = (NavState.AUTO_MISSION, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND)
 USAGE = "Usage: mission [status]  (the stored plans and the mission's progress)\n"
 
@@ -42,10 +39,18 @@ def mission_command(store: MissionStore, nav_state: NavState, args: list[str]) -
     return 0, "".join(log_line("INFO", "mission", line) for line in lines)
 
 
+def _command_name(command: int) -> str:
+    """MAV_CMD_NAV_WAYPOINT -> WAYPOINT, MAV_CMD_DO_JUMP -> DO_JUMP; a number the emulator does not know as is."""
+    try:
+        return MavCmd(command).name.removeprefix("NAV_")
+    except ValueError:
+        return f"command {command}"
+
+
 def _item_line(item: MissionItem, current: bool) -> str:
-    name = _COMMANDS.get(item.command, f"command {item.command}")
+    name = _command_name(item.command)
     mark = ">" if current else " "
-    if item.frame == 2:  # MAV_FRAME_MISSION: no position
+    if item.frame == MavFrame.MISSION:  # no position
         return f"{mark} {item.seq} {name} {item.param1:g} {item.param2:g}"
-    alt = "rel" if item.frame in (3, 6) else "AMSL"
+    alt = "rel" if item.frame in RELATIVE_FRAMES else "AMSL"
     return f"{mark} {item.seq} {name} {item.lat_deg:.7f} {item.lon_deg:.7f} {item.z:.1f} m {alt}"

@@ -16,9 +16,7 @@ from pymavlink.dialects.v20 import common as mavlink
 
 from sitl_emu.campaign.errors import CaseError
 
-__all__ = ["MAV_CMD_INJECT_FAILURE", "Fault", "FaultSchedule", "parse_fault"]
-
-MAV_CMD_INJECT_FAILURE = mavlink.MAV_CMD_INJECT_FAILURE
+__all__ = ["Fault", "FaultSchedule", "parse_fault"]
 
 
 def _names(enum: str, prefixes: tuple[str, ...]) -> dict[str, int]:

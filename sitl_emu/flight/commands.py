@@ -20,6 +20,7 @@ from sitl_emu.px4 import (
     MODE_FLAG_STABILIZE_ENABLED,
     MainMode,
     MavCmd,
+    MavFrame,
     MavResult,
     NavState,
     Severity,
@@ -151,7 +152,7 @@ def _change_altitude(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandA
     if c.nav_state not in (NavState.AUTO_LOITER, NavState.GUIDED_COURSE) or not isfinite(cmd.param(1)):
         return _ack(cmd, MavResult.DENIED)
     alt = cmd.param(1)
-    if _uint8(cmd.param(2)) == 3 and c.home is not None:  # MAV_FRAME_GLOBAL_RELATIVE_ALT: above home
+    if _uint8(cmd.param(2)) == MavFrame.GLOBAL_RELATIVE_ALT and c.home is not None:  # above home
         alt += c.home.alt_amsl_m
     if c.armed:
         c.nav_commands.append(NavCommand(NavCommandKind.CHANGE_ALTITUDE, alt_amsl_m=alt))

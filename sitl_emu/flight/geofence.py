@@ -29,14 +29,12 @@ from typing import Final
 
 from sitl_emu.flight.mission_store import MissionItem
 from sitl_emu.geo import EARTH_RADIUS_M, GeoRef, global_to_ned
+from sitl_emu.px4 import GLOBAL_FRAMES, RELATIVE_FRAMES, MavCmd
 
-FENCE_RETURN: Final = 5000  # MAV_CMD_NAV_FENCE_RETURN_POINT
-POLY_IN: Final = 5001  # MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION
-POLY_EX: Final = 5002  # MAV_CMD_NAV_FENCE_POLYGON_VERTEX_EXCLUSION
-CIRCLE_IN: Final = 5003  # MAV_CMD_NAV_FENCE_CIRCLE_INCLUSION
-CIRCLE_EX: Final = 5004  # MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION
-_AREA_COMMANDS: Final = frozenset({POLY_IN, POLY_EX, CIRCLE_IN, CIRCLE_EX})
-_GLOBAL_FRAMES: Final = frozenset({0, 3, 5, 6})  # MAV_FRAME_GLOBAL(_INT), GLOBAL_RELATIVE_ALT(_INT)
+_POLYGONS: Final = (MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION, MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION)
+_CIRCLES: Final = (MavCmd.NAV_FENCE_CIRCLE_INCLUSION, MavCmd.NAV_FENCE_CIRCLE_EXCLUSION)
+_INCLUSIONS: Final = (MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION, MavCmd.NAV_FENCE_CIRCLE_INCLUSION)
+_AREA_COMMANDS: Final = frozenset({*_POLYGONS, *_CIRCLES})
 
 # GF_ACTION (geofence_params.yaml)
 GF_ACTION_NONE, GF_ACTION_WARN, GF_ACTION_HOLD, GF_ACTION_RETURN, GF_ACTION_TERMINATE, GF_ACTION_LAND = range(6)
@@ -72,11 +70,11 @@ class FenceArea:
 
     @property
     def inclusion(self) -> bool:
-        return self.command in (POLY_IN, CIRCLE_IN)
+        return self.command in _INCLUSIONS
 
     @property
     def circle(self) -> bool:
-        return self.command in (CIRCLE_IN, CIRCLE_EX)
+        return self.command in _CIRCLES
 
 
 @dataclass(frozen=True, slots=True)
@@ -101,10 +99,10 @@ def parse_areas(items: Sequence[MissionItem]) -> list[FenceArea]:
     seq = 0
     while seq < len(items):
         item = items[seq]
-        if item.command in (CIRCLE_IN, CIRCLE_EX):
+        if item.command in _CIRCLES:
             areas.append(FenceArea(item.command, (_vertex(item),), radius_m=item.param1))
             seq += 1
-        elif item.command in (POLY_IN, POLY_EX):
+        elif item.command in _POLYGONS:
             count = _vertex_count(item)
             if count == 0:  # PX4: "Polygon with 0 vertices. Skipping"
                 seq += 1
@@ -118,7 +116,7 @@ def parse_areas(items: Sequence[MissionItem]) -> list[FenceArea]:
 
 
 def _vertex(item: MissionItem) -> Vertex:
-    return Vertex(item.lat_deg, item.lon_deg, item.frame in _GLOBAL_FRAMES)
+    return Vertex(item.lat_deg, item.lon_deg, item.frame in GLOBAL_FRAMES)
 
 
 def _vertex_count(item: MissionItem) -> int:
@@ -226,8 +224,9 @@ def home_required(s: GeofenceSettings) -> bool:
 
 # mission_item_contains_position (navigator/mission_item_utils.h): waypoint, loiter unlimited / time, land, takeoff,
 # loiter to altitude, VTOL takeoff / land
-_POSITION_COMMANDS: Final = frozenset({16, 17, 19, 21, 22, 31, 84, 85})
-_RELATIVE_FRAMES: Final = frozenset({3, 6})
+_POSITION_COMMANDS: Final = frozenset({
+    MavCmd.NAV_WAYPOINT, MavCmd.NAV_LOITER_UNLIM, MavCmd.NAV_LOITER_TIME, MavCmd.NAV_LAND, MavCmd.NAV_TAKEOFF,
+    MavCmd.NAV_LOITER_TO_ALT, MavCmd.NAV_VTOL_TAKEOFF, MavCmd.NAV_VTOL_LAND})
 
 
 def mission_fence_violation(mission: Sequence[MissionItem], fence: Geofence, s: GeofenceSettings,
@@ -238,11 +237,11 @@ def mission_fence_violation(mission: Sequence[MissionItem], fence: Geofence, s: 
     if home_required(s) and home is None:
         return "Geofence requires valid home position"
     for i, item in enumerate(mission):
-        if item.frame in _RELATIVE_FRAMES and home is None:
+        if item.frame in RELATIVE_FRAMES and home is None:
             return "Geofence requires valid home position"
-        if item.command not in _POSITION_COMMANDS or item.frame not in _GLOBAL_FRAMES:
+        if item.command not in _POSITION_COMMANDS or item.frame not in GLOBAL_FRAMES:
             continue
-        alt = item.z + home.alt_amsl_m if (item.frame in _RELATIVE_FRAMES and home is not None) else item.z
+        alt = item.z + home.alt_amsl_m if (item.frame in RELATIVE_FRAMES and home is not None) else item.z
         if not point_allowed(fence, s, GeoPoint(item.lat_deg, item.lon_deg, alt), home):
             return f"Geofence violation for waypoint {i + 1}"
     return None

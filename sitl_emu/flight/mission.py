@@ -23,9 +23,9 @@ import math
 from dataclasses import dataclass, field
 from enum import Enum
 
-from sitl_emu.flight.mission_items_nav import DO_CHANGE_SPEED, DO_SET_ROI_LOCATION, DO_SET_ROI_NONE, Kind, NavItem
+from sitl_emu.flight.mission_items_nav import Kind, NavItem
 from sitl_emu.flight.tasks_core import NavInput, SetpointType, wrap_pi
-from sitl_emu.px4 import Severity
+from sitl_emu.px4 import MavCmd, Severity
 from sitl_emu.types import NAN, Vec3
 
 MAX_INSTANT_ITEMS = 32  # DO_* items handled in one cycle at most (a DO_JUMP loop without positions stops here)
@@ -137,7 +137,7 @@ class MissionNavigator:
         self._roi, self._cruise = None, NAN
         self.wants_rtl = False
         for done in self.items[:self.result.seq_current]:  # replayCachedSpeedChangeItems: a resume keeps the speed
-            if done.command == DO_CHANGE_SPEED:
+            if done.command == MavCmd.DO_CHANGE_SPEED:
                 self._issue(done)
         if not self.items:
             self._say("No valid mission available, refusing takeoff" if nav.landed
@@ -296,13 +296,13 @@ class MissionNavigator:
         """issue_command and the navigator's handling of the DO_* commands it gets back."""
         if item.kind is Kind.RTL:
             self.wants_rtl = True
-        elif item.command == DO_CHANGE_SPEED:
+        elif item.command == MavCmd.DO_CHANGE_SPEED:
             speed = item.params[1]
             self._cruise = speed if speed > 0.0 else NAN  # -1 (or 0): back to the default cruise speed
             self._apply_cruise()
-        elif item.command == DO_SET_ROI_LOCATION:
+        elif item.command == MavCmd.DO_SET_ROI_LOCATION:
             self._roi = item.target_ned_m
-        elif item.command == DO_SET_ROI_NONE:
+        elif item.command == MavCmd.DO_SET_ROI_NONE:
             self._roi = None
 
     def _apply_cruise(self) -> None:

@@ -15,14 +15,9 @@ from typing import Final
 
 from sitl_emu.flight.mission_store import MissionItem
 from sitl_emu.geo import GeoRef, global_to_ned
+from sitl_emu.px4 import RELATIVE_FRAMES, MavCmd
 from sitl_emu.types import NAN, Vec3
 
-# MAV_CMD numbers the navigator acts on (common.xml)
-WAYPOINT, LOITER_UNLIM, LOITER_TIME, RTL, LAND, TAKEOFF, LOITER_TO_ALT = 16, 17, 19, 20, 21, 22, 31
-DELAY, DO_JUMP, DO_CHANGE_SPEED, DO_SET_ROI_LOCATION, DO_SET_ROI_NONE, DO_SET_ROI = 93, 177, 178, 195, 197, 201
-FRAME_GLOBAL, FRAME_GLOBAL_REL, FRAME_GLOBAL_INT, FRAME_GLOBAL_REL_INT = 0, 3, 5, 6
-_RELATIVE_FRAMES: Final = (FRAME_GLOBAL_REL, FRAME_GLOBAL_REL_INT)
-_ABSOLUTE_FRAMES: Final = (FRAME_GLOBAL, FRAME_GLOBAL_INT)
 MAV_ROI_NONE, MAV_ROI_LOCATION = 0, 3
 
 
@@ -40,9 +35,11 @@ class Kind(Enum):
     ACTION = "action"  # DO_* and the rest: complete at once
 
 
-_KINDS: Final = {WAYPOINT: Kind.WAYPOINT, LOITER_TO_ALT: Kind.WAYPOINT, TAKEOFF: Kind.TAKEOFF, LAND: Kind.LAND,
-                 LOITER_TIME: Kind.LOITER_TIME, LOITER_UNLIM: Kind.LOITER_UNLIM, DELAY: Kind.DELAY, RTL: Kind.RTL,
-                 DO_JUMP: Kind.JUMP}
+# what the navigator does with each command it acts on; any other is an action
+_KINDS: Final[dict[int, Kind]] = {MavCmd.NAV_WAYPOINT: Kind.WAYPOINT, MavCmd.NAV_LOITER_TO_ALT: Kind.WAYPOINT,
+                 MavCmd.NAV_TAKEOFF: Kind.TAKEOFF, MavCmd.NAV_LAND: Kind.LAND, MavCmd.NAV_LOITER_TIME: Kind.LOITER_TIME,
+                 MavCmd.NAV_LOITER_UNLIM: Kind.LOITER_UNLIM, MavCmd.NAV_DELAY: Kind.DELAY,
+                 MavCmd.NAV_RETURN_TO_LAUNCH: Kind.RTL, MavCmd.DO_JUMP: Kind.JUMP}
 POSITION_KINDS: Final = frozenset({Kind.WAYPOINT, Kind.TAKEOFF, Kind.LAND, Kind.LOITER_TIME, Kind.LOITER_UNLIM})
 
 
@@ -72,12 +69,12 @@ def nav_item(item: MissionItem, ref: GeoRef, home_alt_amsl_m: float) -> NavItem:
     params = (item.param1, item.param2, item.param3, item.param4)
     target: Vec3 = (NAN, NAN, NAN)
     rel = NAN
-    if kind in POSITION_KINDS or item.command == DO_SET_ROI_LOCATION:
-        alt_amsl = item.z + home_alt_amsl_m if item.frame in _RELATIVE_FRAMES else item.z
+    if kind in POSITION_KINDS or item.command == MavCmd.DO_SET_ROI_LOCATION:
+        alt_amsl = item.z + home_alt_amsl_m if item.frame in RELATIVE_FRAMES else item.z
         target = global_to_ned(ref, item.lat_deg, item.lon_deg, alt_amsl)
         rel = alt_amsl - home_alt_amsl_m
-    hold = item.param1 if kind in (Kind.WAYPOINT, Kind.LOITER_TIME, Kind.DELAY) and item.command != LOITER_TO_ALT \
-        else 0.0
+    holds = kind in (Kind.WAYPOINT, Kind.LOITER_TIME, Kind.DELAY) and item.command != MavCmd.NAV_LOITER_TO_ALT
+    hold = item.param1 if holds else 0.0
     acceptance = item.param2 if kind is Kind.WAYPOINT else NAN
     yaw = math.radians(item.param4) if kind in (Kind.WAYPOINT, Kind.LOITER_TIME, Kind.LOITER_UNLIM) else NAN
     if math.isfinite(yaw):

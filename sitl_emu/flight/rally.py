@@ -23,12 +23,10 @@ from typing import Final
 
 from sitl_emu.flight.geofence import GeoPoint, distance_m
 from sitl_emu.flight.mission_store import MissionItem
+from sitl_emu.px4 import ABSOLUTE_FRAMES, RELATIVE_FRAMES, MavCmd
 
-RALLY_POINT: Final = 5100  # MAV_CMD_NAV_RALLY_POINT
 MIN_DIST_THRESHOLD_M: Final = 2.0
 NEAR_HOME_M: Final = 10.0  # mission_route::kLandApproachAssociationDistanceM
-_ABSOLUTE_FRAMES: Final = frozenset({0, 5})
-_RELATIVE_FRAMES: Final = frozenset({3, 6})
 RTL_TYPE_HOME_FIRST, RTL_TYPE_SAFE_FIRST, RTL_TYPE_SAFE_ONLY = 0, 1, 5
 
 
@@ -43,11 +41,11 @@ def safe_points(items: Sequence[MissionItem], home_alt_amsl_m: float) -> list[tu
     """(index in the rally plan, position) of every usable rally point."""
     points = []
     for index, item in enumerate(items):
-        if item.command != RALLY_POINT:
+        if item.command != MavCmd.NAV_RALLY_POINT:
             continue
-        if item.frame in _ABSOLUTE_FRAMES:
+        if item.frame in ABSOLUTE_FRAMES:
             alt = item.z
-        elif item.frame in _RELATIVE_FRAMES and math.isfinite(home_alt_amsl_m):
+        elif item.frame in RELATIVE_FRAMES and math.isfinite(home_alt_amsl_m):
             alt = item.z + home_alt_amsl_m
         else:
             continue

@@ -18,7 +18,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from sitl_emu.flight.mission_store import PLAN_FENCE, PLAN_MISSION, MissionItem, MissionStore
-from sitl_emu.px4 import NavState
+from sitl_emu.px4 import MavCmd, MavFrame, NavState
 
 if TYPE_CHECKING:
     from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
@@ -34,34 +34,47 @@ MAV_MISSION_INVALID_PARAM1 = 6
 MAV_MISSION_INVALID_PARAM5_X = 10
 MAV_MISSION_OPERATION_CANCELLED = 15
 
-# MAV_FRAME
-FRAME_GLOBAL, FRAME_MISSION, FRAME_GLOBAL_REL = 0, 2, 3
-FRAME_GLOBAL_INT, FRAME_GLOBAL_REL_INT = 5, 6
-_INT_FRAMES = {FRAME_GLOBAL: FRAME_GLOBAL_INT, FRAME_GLOBAL_REL: FRAME_GLOBAL_REL_INT,
-               FRAME_GLOBAL_INT: FRAME_GLOBAL_INT, FRAME_GLOBAL_REL_INT: FRAME_GLOBAL_REL_INT}
-_FLOAT_FRAMES = {FRAME_GLOBAL_INT: FRAME_GLOBAL, FRAME_GLOBAL_REL_INT: FRAME_GLOBAL_REL}
+# PX4 keeps a global item's altitude reference, which the INT and float variants of a frame share
+_INT_FRAMES: dict[int, MavFrame] = {
+    MavFrame.GLOBAL: MavFrame.GLOBAL_INT, MavFrame.GLOBAL_RELATIVE_ALT: MavFrame.GLOBAL_RELATIVE_ALT_INT,
+    MavFrame.GLOBAL_INT: MavFrame.GLOBAL_INT, MavFrame.GLOBAL_RELATIVE_ALT_INT: MavFrame.GLOBAL_RELATIVE_ALT_INT}
+_FLOAT_FRAMES: dict[int, MavFrame] = {
+    MavFrame.GLOBAL_INT: MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT_INT: MavFrame.GLOBAL_RELATIVE_ALT}
 
-# MAV_CMD numbers used below
-WAYPOINT, LOITER_UNLIM, LOITER_TIME, RTL, LAND, TAKEOFF, LOITER_TO_ALT = 16, 17, 19, 20, 21, 22, 31
-NAV_ROI, DO_SET_ROI, DO_SET_ROI_LOCATION, VTOL_TAKEOFF, VTOL_LAND = 80, 201, 195, 84, 85
-FENCE_RETURN, FENCE_POLY_IN, FENCE_POLY_EX, FENCE_CIRCLE_IN, FENCE_CIRCLE_EX, RALLY_POINT = (
-    5000, 5001, 5002, 5003, 5004, 5100)
-FENCE_POLYGONS = (FENCE_POLY_IN, FENCE_POLY_EX)
-NOT_MISSION_ITEMS = (FENCE_POLY_IN, FENCE_POLY_EX, FENCE_CIRCLE_IN, FENCE_CIRCLE_EX, RALLY_POINT)
+FENCE_POLYGONS = (MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION, MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION)
+NOT_MISSION_ITEMS = (*FENCE_POLYGONS, MavCmd.NAV_FENCE_CIRCLE_INCLUSION, MavCmd.NAV_FENCE_CIRCLE_EXCLUSION,
+                     MavCmd.NAV_RALLY_POINT)
+_ROI_COMMANDS = (MavCmd.NAV_ROI, MavCmd.DO_SET_ROI)
 
 # Positional commands PX4 accepts in a global frame, and which params it keeps of each (1-based; "yaw" = param4 as a
 # heading wrapped to [0, 360); "flag" = param > 0 kept as 0/1).
 _GLOBAL_COMMANDS: dict[int, tuple[str, ...]] = {
-    WAYPOINT: ("1", "2", "yaw"), LOITER_UNLIM: ("3", "yaw"), LOITER_TIME: ("1", "flag2", "3", "flag4"),
-    LAND: ("2", "yaw"), TAKEOFF: ("yaw",), LOITER_TO_ALT: ("flag1", "2", "flag4"),
-    NAV_ROI: (), DO_SET_ROI: (), DO_SET_ROI_LOCATION: (), VTOL_TAKEOFF: ("yaw",), VTOL_LAND: ("yaw",),
-    4501: (), FENCE_RETURN: (), FENCE_POLY_IN: ("count1",), FENCE_POLY_EX: ("count1",),
-    FENCE_CIRCLE_IN: ("1",), FENCE_CIRCLE_EX: ("1",), RALLY_POINT: (), 400: (), 212: (),
+    MavCmd.NAV_WAYPOINT: ("1", "2", "yaw"),
+    MavCmd.NAV_LOITER_UNLIM: ("3", "yaw"),
+    MavCmd.NAV_LOITER_TIME: ("1", "flag2", "3", "flag4"),
+    MavCmd.NAV_LAND: ("2", "yaw"),
+    MavCmd.NAV_TAKEOFF: ("yaw",),
+    MavCmd.NAV_LOITER_TO_ALT: ("flag1", "2", "flag4"),
+    MavCmd.NAV_ROI: (), MavCmd.DO_SET_ROI: (), MavCmd.DO_SET_ROI_LOCATION: (),
+    MavCmd.NAV_VTOL_TAKEOFF: ("yaw",), MavCmd.NAV_VTOL_LAND: ("yaw",),
+    MavCmd.CONDITION_GATE: (),
+    MavCmd.NAV_FENCE_RETURN_POINT: (),
+    MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION: ("count1",), MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION: ("count1",),
+    MavCmd.NAV_FENCE_CIRCLE_INCLUSION: ("1",), MavCmd.NAV_FENCE_CIRCLE_EXCLUSION: ("1",),
+    MavCmd.NAV_RALLY_POINT: (),
+    MavCmd.COMPONENT_ARM_DISARM: (), MavCmd.DO_AUTOTUNE_ENABLE: (),
 }
 # Commands PX4 accepts in MAV_FRAME_MISSION (params kept as sent)
 _MISSION_FRAME_COMMANDS = frozenset({
-    177, NAV_ROI, DO_SET_ROI, 42600, 211, 178, 179, 189, 2003, 203, 204, 205, 1000, 532, 1001, 2000, 2001, 2500,
-    2501, 200, 206, 260, 214, 530, 534, 3000, 93, RTL, 196, 197, 112, 114, 187, 212, 400,
+    MavCmd.DO_JUMP, MavCmd.NAV_ROI, MavCmd.DO_SET_ROI, MavCmd.DO_WINCH, MavCmd.DO_GRIPPER, MavCmd.DO_CHANGE_SPEED,
+    MavCmd.DO_SET_HOME, MavCmd.DO_LAND_START, MavCmd.DO_TRIGGER_CONTROL, MavCmd.DO_DIGICAM_CONTROL,
+    MavCmd.DO_MOUNT_CONFIGURE, MavCmd.DO_MOUNT_CONTROL, MavCmd.DO_GIMBAL_MANAGER_PITCHYAW, MavCmd.SET_CAMERA_FOCUS,
+    MavCmd.DO_GIMBAL_MANAGER_CONFIGURE, MavCmd.IMAGE_START_CAPTURE, MavCmd.IMAGE_STOP_CAPTURE,
+    MavCmd.VIDEO_START_CAPTURE, MavCmd.VIDEO_STOP_CAPTURE, MavCmd.DO_CONTROL_VIDEO, MavCmd.DO_SET_CAM_TRIGG_DIST,
+    MavCmd.OBLIQUE_SURVEY, MavCmd.DO_SET_CAM_TRIGG_INTERVAL, MavCmd.SET_CAMERA_MODE, MavCmd.SET_CAMERA_SOURCE,
+    MavCmd.DO_VTOL_TRANSITION, MavCmd.NAV_DELAY, MavCmd.NAV_RETURN_TO_LAUNCH, MavCmd.DO_SET_ROI_WPNEXT_OFFSET,
+    MavCmd.DO_SET_ROI_NONE, MavCmd.CONDITION_DELAY, MavCmd.CONDITION_DISTANCE, MavCmd.DO_SET_ACTUATOR,
+    MavCmd.DO_AUTOTUNE_ENABLE, MavCmd.COMPONENT_ARM_DISARM,
 })
 MAV_ROI_NONE, MAV_ROI_WPNEXT, MAV_ROI_WPINDEX, MAV_ROI_LOCATION = 0, 1, 2, 3
 
@@ -73,16 +86,16 @@ UINT16_MAX = 0xFFFF
 def parse_item(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
     """(MAV_MISSION_RESULT, the item PX4 would keep) for a MISSION_ITEM(_INT); int_mode: it came as MISSION_ITEM_INT."""
     frame, command = msg.frame, msg.command
-    if frame in (FRAME_GLOBAL, FRAME_GLOBAL_REL) or (int_mode and frame in (FRAME_GLOBAL_INT, FRAME_GLOBAL_REL_INT)):
+    if frame in (MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT) or (int_mode and frame in _FLOAT_FRAMES):
         return _parse_global(msg, int_mode)
-    if frame != FRAME_MISSION:
+    if frame != MavFrame.MISSION:
         return MAV_MISSION_UNSUPPORTED_FRAME, None
     if command not in _MISSION_FRAME_COMMANDS:
         return MAV_MISSION_UNSUPPORTED, None
-    if command in (NAV_ROI, DO_SET_ROI) and int(msg.param1) not in (MAV_ROI_NONE, MAV_ROI_WPNEXT, MAV_ROI_WPINDEX):
+    if command in _ROI_COMMANDS and int(msg.param1) not in (MAV_ROI_NONE, MAV_ROI_WPNEXT, MAV_ROI_WPINDEX):
         return MAV_MISSION_INVALID_PARAM1, None
     x, y = (msg.x, msg.y) if int_mode else (_round(msg.x), _round(msg.y))
-    return MAV_MISSION_ACCEPTED, MissionItem(msg.seq, FRAME_MISSION, command, msg.autocontinue, msg.param1,
+    return MAV_MISSION_ACCEPTED, MissionItem(msg.seq, MavFrame.MISSION, command, msg.autocontinue, msg.param1,
                                              msg.param2, msg.param3, msg.param4, x, y, msg.z)
 
 
@@ -93,7 +106,7 @@ def _parse_global(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
     kept = _GLOBAL_COMMANDS.get(msg.command)
     if kept is None:
         return MAV_MISSION_UNSUPPORTED, None
-    if msg.command in (NAV_ROI, DO_SET_ROI) and int(msg.param1) not in (MAV_ROI_LOCATION, MAV_ROI_NONE):
+    if msg.command in _ROI_COMMANDS and int(msg.param1) not in (MAV_ROI_LOCATION, MAV_ROI_NONE):
         return MAV_MISSION_INVALID_PARAM1, None
     sent = (msg.param1, msg.param2, msg.param3, msg.param4)
     params = [0.0, 0.0, 0.0, 0.0]
@@ -136,8 +149,8 @@ def item_message(mav: MAVLink, target: tuple[int, int], item: MissionItem, curre
     if int_mode:
         return mav.mission_item_int_encode(*target, item.seq, item.frame, item.command, int(current),
                                            item.autocontinue, *p, item.x, item.y, item.z, plan_type)
-    if item.frame == FRAME_MISSION:
-        frame, x, y = FRAME_MISSION, float(item.x), float(item.y)
+    if item.frame == MavFrame.MISSION:
+        frame, x, y = MavFrame.MISSION, float(item.x), float(item.y)
     else:
         frame, x, y = _FLOAT_FRAMES[item.frame], item.lat_deg, item.lon_deg
     return mav.mission_item_encode(*target, item.seq, frame, item.command, int(current), item.autocontinue, *p,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink.telemetry_msgs import rotate_body_to_ned
+from sitl_emu.px4 import MavFrame
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, VehicleSnapshot
 
 if TYPE_CHECKING:
@@ -35,11 +36,6 @@ POS_MASK, VEL_MASK, ACC_MASK = 7, 56, 448
 ROLL_RATE_IGNORE, PITCH_RATE_IGNORE, YAW_RATE_IGNORE_ATT = 1, 2, 4
 THRUST_BODY_SET, THROTTLE_IGNORE, ATTITUDE_IGNORE = 32, 64, 128
 
-MAV_FRAME_GLOBAL_INT = 5
-MAV_FRAME_GLOBAL_RELATIVE_ALT_INT = 6
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_BODY_NED = 8
-MAV_FRAME_GLOBAL_TERRAIN_ALT_INT = 11
 EARTH_RADIUS_M = 6371000.0  # CONSTANTS_RADIUS_OF_EARTH (lib/geo)
 
 
@@ -63,9 +59,9 @@ def decode_local_ned(msg: dialect.MAVLink_set_position_target_local_ned_message,
     pos = (msg.x, msg.y, msg.z)
     vel = (msg.vx, msg.vy, msg.vz)
     acc = (msg.afx, msg.afy, msg.afz)
-    if frame == MAV_FRAME_LOCAL_NED:
+    if frame == MavFrame.LOCAL_NED:
         pos_ned, vel_ned, acc_ned = _masked(pos, mask, 0), _masked(vel, mask, 3), _masked(acc, mask, 6)
-    elif frame == MAV_FRAME_BODY_NED:
+    elif frame == MavFrame.BODY_NED:
         pos_ned = (NAN, NAN, NAN)
         vel_ned = _yaw_rotated(vel, snap.euler_rad[2]) if not mask & VEL_MASK else (NAN, NAN, NAN)
         acc_ned = _finite(rotate_body_to_ned(snap.q_wxyz, acc)) if not mask & ACC_MASK else (NAN, NAN, NAN)
@@ -80,7 +76,7 @@ def decode_global_int(msg: dialect.MAVLink_set_position_target_global_int_messag
     """SET_POSITION_TARGET_GLOBAL_INT: lat/lon projected into the local frame; z per frame as PX4 codes it."""
     frame = int(msg.coordinate_frame)
     mask = int(msg.type_mask)
-    if frame not in (MAV_FRAME_GLOBAL_INT, MAV_FRAME_GLOBAL_RELATIVE_ALT_INT, MAV_FRAME_GLOBAL_TERRAIN_ALT_INT):
+    if frame not in (MavFrame.GLOBAL_INT, MavFrame.GLOBAL_RELATIVE_ALT_INT, MavFrame.GLOBAL_TERRAIN_ALT_INT):
         return Decoded(error=f"SET_POSITION_TARGET_GLOBAL_INT invalid coordinate frame {frame}")
     if not snap.position_valid:  # no global reference: silently dropped
         return DROPPED
@@ -149,9 +145,9 @@ def _trajectory(name: str, mask: int, pos: Vec3, vel: Vec3, acc: Vec3, yaw: floa
 def _global_z(frame: int, alt_m: float, snap: VehicleSnapshot) -> float | None:
     if not math.isfinite(alt_m):
         return None
-    if frame == MAV_FRAME_GLOBAL_INT:
+    if frame == MavFrame.GLOBAL_INT:
         return snap.ref_alt_amsl_m - alt_m
-    if frame == MAV_FRAME_GLOBAL_RELATIVE_ALT_INT:
+    if frame == MavFrame.GLOBAL_RELATIVE_ALT_INT:
         if snap.home is None:
             return None
         return (snap.home.alt_amsl_m - alt_m) - snap.ref_alt_amsl_m  # as PX4 codes it (reference 4.7)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from sitl_emu import px4
 from sitl_emu.mavlink.modes_msgs import STANDARD_MODE
-from sitl_emu.px4 import MavState, NavState
+from sitl_emu.px4 import MavFrame, MavState, NavState
 from sitl_emu.types import VehicleSnapshot
 
 if TYPE_CHECKING:
@@ -24,8 +24,6 @@ INT16_MAX = 0x7FFF
 
 MAV_TYPE_QUADROTOR = 2
 MAV_AUTOPILOT_PX4 = 12
-MAV_FRAME_LOCAL_NED = 1
-MAV_FRAME_BODY_FRD = 12
 
 # Modes whose control mode has flag_control_manual_enabled and attitude (ModeUtil/control_mode.cpp).
 _MANUAL_STABILIZED = frozenset({NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
@@ -127,7 +125,7 @@ def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Ou
         mask |= 1024
     if not math.isfinite(sp.yawspeed_rad_s):
         mask |= 2048
-    return ctx.encoder.position_target_local_ned_encode(_ms(snap), MAV_FRAME_LOCAL_NED, mask, *values, sp.yaw_rad,
+    return ctx.encoder.position_target_local_ned_encode(_ms(snap), MavFrame.LOCAL_NED, mask, *values, sp.yaw_rad,
                                                     sp.yawspeed_rad_s)
 
 
@@ -191,7 +189,7 @@ def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
     v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
     cov = [NAN] + [0.0] * 20
-    return ctx.encoder.odometry_encode(snap.time_us, MAV_FRAME_LOCAL_NED, MAV_FRAME_BODY_FRD, *snap.pos_ned_m,
+    return ctx.encoder.odometry_encode(snap.time_us, MavFrame.LOCAL_NED, MavFrame.BODY_FRD, *snap.pos_ned_m,
                                    snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
 
 

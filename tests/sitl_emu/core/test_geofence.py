@@ -8,17 +8,12 @@ import math
 import pytest
 
 from sitl_emu.flight.geofence import (
-    CIRCLE_EX,
-    CIRCLE_IN,
-    FENCE_RETURN,
     GF_ACTION_HOLD,
     GF_ACTION_LAND,
     GF_ACTION_NONE,
     GF_ACTION_RETURN,
     GF_ACTION_TERMINATE,
     GF_ACTION_WARN,
-    POLY_EX,
-    POLY_IN,
     TEXT_NO_CURRENT,
     TEXT_NO_HOME,
     GeofenceResult,
@@ -34,9 +29,13 @@ from sitl_emu.flight.geofence import (
 from sitl_emu.flight.geofence_failsafe import GeofenceFailsafe
 from sitl_emu.flight.geofence_monitor import GeofenceInputs, GeofenceMonitor
 from sitl_emu.flight.mission_store import MissionItem, Plan, plan_id
-from sitl_emu.flight.rally import RALLY_POINT, choose_destination, safe_points
+from sitl_emu.flight.rally import choose_destination, safe_points
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.px4 import NavState
+from sitl_emu.px4 import MavCmd, NavState
+
+POLY_IN, POLY_EX = MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION, MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION
+CIRCLE_IN, CIRCLE_EX = MavCmd.NAV_FENCE_CIRCLE_INCLUSION, MavCmd.NAV_FENCE_CIRCLE_EXCLUSION
+FENCE_RETURN, RALLY_POINT = MavCmd.NAV_FENCE_RETURN_POINT, MavCmd.NAV_RALLY_POINT
 
 REF = GeoRef(47.397742, 8.545594, 488.0)
 HOME = GeoPoint(REF.lat_deg, REF.lon_deg, REF.alt_amsl_m)
