@@ -168,11 +168,3 @@ def _grounded(state: RigidBodyState, u: Vec4, pos: Vec3) -> RigidBodyState:
         q = q_from_yaw(yaw_from_q(q))
     return RigidBodyState(pos, (0.0, 0.0, 0.0), q, (0.0, 0.0, 0.0), u, (0.0, 0.0, 0.0),
                           (0.0, 0.0, -GRAVITY_M_S2), True)
-
-
-def hover_state(altitude_m: float, cfg: SihConfig | None = None, yaw_rad: float = 0.0) -> RigidBodyState:
-    """A vehicle hovering at `altitude_m` above the ground, motors at the hover command (for tests and tools)."""
-    cfg = cfg or SihConfig()
-    h = cfg.hover_command
-    return RigidBodyState(pos_ned_m=(0.0, 0.0, -altitude_m), q_wxyz=q_from_yaw(yaw_rad), motors=(h, h, h, h),
-                          on_ground=False)

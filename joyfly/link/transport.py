@@ -15,7 +15,6 @@ talks, then answers whoever sent the last datagram (PX4 SITL binds 14580 today; 
 
 from __future__ import annotations
 
-import collections
 import contextlib
 import errno
 import os
@@ -116,32 +115,6 @@ class MavutilTransport:
 
     def close(self) -> None:
         self._conn.close()
-
-
-class MemoryTransport:
-    """One end of an in-memory pair: what one end writes, the other reads. Never waits (simulated time)."""
-
-    def __init__(self, description: str = "memory") -> None:
-        self.description = description
-        self.inbox: collections.deque[bytes] = collections.deque()
-        self.peer: MemoryTransport | None = None
-        self.closed = False
-
-    def write(self, data: bytes) -> None:
-        if self.peer is not None and not self.closed:
-            self.peer.inbox.append(bytes(data))
-
-    def read(self, timeout_s: float) -> bytes:
-        return self.inbox.popleft() if self.inbox else b""
-
-    def close(self) -> None:
-        self.closed = True
-
-
-def memory_pair() -> tuple[MemoryTransport, MemoryTransport]:
-    a, b = MemoryTransport("memory:a"), MemoryTransport("memory:b")
-    a.peer, b.peer = b, a
-    return a, b
 
 
 @dataclass(frozen=True, slots=True)

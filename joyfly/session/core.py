@@ -89,11 +89,6 @@ class FlightStats:
     control_time_s: float = 0.0  # time in joyfly's mode: OFFBOARD, or POSCTL/ALTCTL with --control position/altitude
     max_alt_m: float = 0.0
 
-    @property
-    def offboard_time_s(self) -> float:
-        """The time in OFFBOARD, for an OFFBOARD session (its control_time_s)."""
-        return self.control_time_s
-
 
 @dataclass(frozen=True, slots=True)
 class SessionView:

@@ -55,10 +55,6 @@ class JsEvent:
     type: int
     number: int
 
-    @property
-    def is_init(self) -> bool:
-        return bool(self.type & JS_EVENT_INIT)
-
 
 def pack_event(kind: int, number: int, value: int, time_ms: int = 0) -> bytes:
     """One js_event record; kind is JS_EVENT_AXIS or JS_EVENT_BUTTON (or'ed with JS_EVENT_INIT if wanted)."""

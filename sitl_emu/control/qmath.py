@@ -102,14 +102,6 @@ def q_from_yaw(yaw_rad: float) -> Vec4:
     return math.cos(yaw_rad / 2.0), 0.0, 0.0, math.sin(yaw_rad / 2.0)
 
 
-def q_from_euler(roll_rad: float, pitch_rad: float, yaw_rad: float) -> Vec4:
-    cr, sr = math.cos(roll_rad / 2.0), math.sin(roll_rad / 2.0)
-    cp, sp = math.cos(pitch_rad / 2.0), math.sin(pitch_rad / 2.0)
-    cy, sy = math.cos(yaw_rad / 2.0), math.sin(yaw_rad / 2.0)
-    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy)
-
-
 def euler_from_q(q: Vec4) -> Vec3:
     """(roll, pitch, yaw) in radians, ZYX convention as PX4's Eulerf."""
     w, x, y, z = q

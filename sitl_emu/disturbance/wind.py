@@ -143,17 +143,6 @@ def dryden_transfer_functions(scales: DrydenScales, v_m_s: float) -> list[tuple[
     return tfs
 
 
-def dryden_psd(scales: DrydenScales, v_m_s: float, omega: np.ndarray) -> list[np.ndarray]:
-    """The one-sided Dryden power spectral densities of u, v, w (m^2/s^2 per rad/s) at angular frequencies omega."""
-    from scipy import signal
-
-    out = []
-    for num, den in dryden_transfer_functions(scales, v_m_s):
-        _, h = signal.freqs(num, den, worN=omega)
-        out.append(np.abs(h) ** 2)
-    return out
-
-
 def discrete_filters(scales: DrydenScales, v_m_s: float, dt_s: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """The shaping filters discretised with the bilinear transform (b, a for lfilter)."""
     from scipy import signal

@@ -79,13 +79,6 @@ class Packed:
     def get_type(self) -> str:
         return self.spec.name
 
-    def get_msgId(self) -> int:  # pymavlink's name
-        return self.spec.msg_id
-
-    def get_payload(self) -> bytes:
-        """The whole payload, before MAVLink 2's zero truncation."""
-        return self.spec.pack(*self.values)
-
     def pack(self, mav: MAVLink, force_mavlink1: bool = False) -> bytes:
         if force_mavlink1:
             raise ValueError("Packed messages are MAVLink 2 only")

@@ -79,11 +79,6 @@ def uint32_to_float_bits(value: int) -> float:
     return float(struct.unpack("<f", struct.pack("<I", int(value) & 0xFFFFFFFF))[0])
 
 
-def px4_param_hash(registry: ParamRegistry) -> int:
-    """The _HASH_CHECK value (ParamRegistry.hash_check, PX4's param_hash_check)."""
-    return registry.hash_check()
-
-
 def _param_id(msg: dialect.MAVLink_param_request_read_message | dialect.MAVLink_param_set_message) -> str:
     raw: str | bytes = msg.param_id  # str in newer pymavlink releases, bytes in older ones
     if isinstance(raw, bytes):

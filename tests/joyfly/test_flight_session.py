@@ -10,10 +10,9 @@ from dataclasses import dataclass, field
 
 import pytest
 from support.joyfly_fakes import LAND, LOITER, OFFBOARD, RTL, FakeVehicle, TimedSticks
+from support.joyfly_sim import SimClock, memory_pair
 
-from joyfly.clock import SimClock
 from joyfly.dashboard import render
-from joyfly.link.transport import memory_pair
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.types import Action, StickCommand
@@ -224,7 +223,7 @@ def test_summary_counts_distance_and_offboard_time() -> None:
     world.run_until(12.0)
     stats = world.session.stats
     assert stats.distance_m > 3.0 + 3.0  # the climb plus ~4 m north
-    assert stats.offboard_time_s == pytest.approx(12.0 - 2.5, abs=1.5)
+    assert stats.control_time_s == pytest.approx(12.0 - 2.5, abs=1.5)
     assert 0.0 < stats.min_fence_margin_m < 2.0
 
 
@@ -347,7 +346,7 @@ def test_a_restarted_vehicle_is_reported_as_restarted_and_not_armed_again() -> N
     assert "will not arm it again" in notes
     assert world.session.phase is Phase.GROUNDED
     assert not [t for t, _ in world.vehicle.received("CMD400") if t > 11.0] and not world.vehicle.armed
-    assert world.session.stats.offboard_time_s == pytest.approx(6.0 - 1.05, abs=0.6)  # OFFBOARD at 1.05 s, not after
+    assert world.session.stats.control_time_s == pytest.approx(6.0 - 1.05, abs=0.6)  # OFFBOARD at 1.05 s, not after
 
 
 def test_a_link_outage_does_not_count_as_time_in_offboard() -> None:
@@ -357,7 +356,7 @@ def test_a_link_outage_does_not_count_as_time_in_offboard() -> None:
     world.vehicle.speak = True
     world.run_until(20.0)
     assert "Link back" in world.notes() and "restarted" not in world.notes()
-    assert world.session.stats.offboard_time_s == pytest.approx(6.0 - 1.05 + 20.0 - 16.0, abs=0.6)  # 6 s to 16 s out
+    assert world.session.stats.control_time_s == pytest.approx(6.0 - 1.05 + 20.0 - 16.0, abs=0.6)  # 6 s to 16 s out
 
 
 def test_ctrl_c_while_the_arm_command_is_on_its_way_does_not_leave_the_vehicle_armed() -> None:

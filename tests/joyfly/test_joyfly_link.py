@@ -9,9 +9,10 @@ import time
 import pytest
 from pymavlink.dialects.v20 import common as mavlink2
 from support.joyfly_fakes import FakeVehicle, WallStepper
+from support.joyfly_sim import SimClock, memory_pair
 
-from joyfly.clock import SimClock, WallClock
-from joyfly.link.transport import TransportError, UdpTransport, memory_pair, open_transport, parse_udp_url
+from joyfly.clock import WallClock
+from joyfly.link.transport import TransportError, UdpTransport, open_transport, parse_udp_url
 from joyfly.link.vehicle_link import VehicleLink, is_offboard, mode_name
 from joyfly.sticks.setpoints import Setpoint
 

@@ -11,10 +11,9 @@ from collections.abc import Callable
 from typing import Any
 
 from support.joyfly_fakes import FakeVehicle, TimedSticks
+from support.joyfly_sim import SimClock, memory_pair
 
-from joyfly.clock import SimClock
 from joyfly.dashboard import LiveDashboard, PlainLog
-from joyfly.link.transport import memory_pair
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
 from joyfly.session.flight_session import FlightSession, SessionSettings, SessionView

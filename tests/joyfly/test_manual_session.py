@@ -10,10 +10,9 @@ from typing import Any
 import pytest
 from support.joyfly_fakes import LAND, LOITER, RTL, TimedSticks
 from support.joyfly_manual_fake import ALTCTL, POSCTL, ManualFakeVehicle
+from support.joyfly_sim import SimClock, memory_pair
 
-from joyfly.clock import SimClock
 from joyfly.dashboard import render, summary_lines
-from joyfly.link.transport import memory_pair
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import left_behind
 from joyfly.session.core import Phase, SessionSettings

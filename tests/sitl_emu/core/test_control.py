@@ -5,17 +5,18 @@ import random
 
 import pytest
 from support import REPO_ROOT
+from support.states import hover_state, q_from_euler
 
 from sitl_emu.control.attitude import AttitudeControl
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.mixer import allocated_torque, mix
 from sitl_emu.control.position import PositionControl, input_valid
-from sitl_emu.control.qmath import all_finite3, euler_from_q, isfinite, q_from_euler, yaw_from_q
+from sitl_emu.control.qmath import all_finite3, euler_from_q, isfinite, yaw_from_q
 from sitl_emu.control.rate import RateControl
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.params import default_registry
 from sitl_emu.params.settings import cascade_settings
-from sitl_emu.physics import RigidBodyState, hover_state
+from sitl_emu.physics import RigidBodyState
 from sitl_emu.testing.harness import ClosedLoop, hover_loop
 from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint
 

@@ -4,10 +4,11 @@ import dataclasses
 import math
 
 import pytest
+from support.states import hover_state
 
 from sitl_emu.params import default_registry
 from sitl_emu.params.settings import sih_config
-from sitl_emu.physics import GRAVITY_M_S2, RigidBodyState, SihConfig, hover_state, step
+from sitl_emu.physics import GRAVITY_M_S2, RigidBodyState, SihConfig, step
 
 DT = 0.004
 

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from support.states import hover_state
 
 from sitl_emu.disturbance.estimate import EstimateNoise, EstimateNoiseSettings
-from sitl_emu.physics import hover_state
 from sitl_emu.px4 import MavCmd
 from sitl_emu.types import VehicleCommand
 from sitl_emu.vehicle import Vehicle

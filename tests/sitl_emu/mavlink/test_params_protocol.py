@@ -23,7 +23,6 @@ from sitl_emu.mavlink.params_protocol import (
     ParamProtocol,
     float_bits_to_int32,
     int32_to_float_bits,
-    px4_param_hash,
 )
 from sitl_emu.px4 import Severity
 
@@ -60,7 +59,7 @@ def test_request_list_sends_hash_then_every_param_in_order(setup):
     assert values[0].param_id == "_HASH_CHECK"
     assert values[0].param_index == HASH_CHECK_INDEX
     assert values[0].param_type == MAV_PARAM_TYPE_UINT32
-    assert struct.unpack("<I", struct.pack("<f", values[0].param_value))[0] == px4_param_hash(registry)
+    assert struct.unpack("<I", struct.pack("<f", values[0].param_value))[0] == registry.hash_check()
     rest = values[1:]
     assert [m.param_index for m in rest] == list(range(len(registry)))
     assert [m.param_id for m in rest] == [registry.name_at(i) for i in range(len(registry))]
@@ -190,10 +189,10 @@ def test_mark_used_lists_a_parameter_in_name_order_and_counts_it(setup):
     proto, ctx, client = setup
     registry = ctx.vehicle.params
     count = len(registry)
-    hash_before = px4_param_hash(registry)
+    hash_before = registry.hash_check()
     registry.mark_used("MIS_DIST_1WP")
     registry.mark_used("MIS_TKO_LAND_REQ")
-    assert len(registry) == count + 2 and px4_param_hash(registry) != hash_before
+    assert len(registry) == count + 2 and registry.hash_check() != hash_before
     proto.handle(client.msg("PARAM_REQUEST_LIST", 1, 1), ctx)
     values = _drain(proto, ctx)
     names = [m.param_id for m in values[1:]]
@@ -314,9 +313,9 @@ def test_px4s_stated_range_is_kept_for_a_parameter_the_emulator_only_stores(setu
 
 def test_hash_changes_with_values(setup):
     _, ctx, _ = setup
-    before = px4_param_hash(ctx.vehicle.params)
+    before = ctx.vehicle.params.hash_check()
     ctx.vehicle.params.set("BAT_LOW_THR", 0.3)
-    assert px4_param_hash(ctx.vehicle.params) != before
+    assert ctx.vehicle.params.hash_check() != before
 
 
 def _crc32_part_bitwise(data: bytes, state: int) -> int:
@@ -336,4 +335,4 @@ def test_hash_is_px4s_crc_over_names_and_value_bytes():
     for name, raw in (("A_INT", struct.pack("<i", 7)), ("B_REAL", struct.pack("<f", 2.5))):
         expected = _crc32_part_bitwise(name.encode(), expected)
         expected = _crc32_part_bitwise(raw, expected)
-    assert px4_param_hash(registry) == expected
+    assert registry.hash_check() == expected
