@@ -12,7 +12,7 @@ import signal
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -40,9 +40,17 @@ from sitl_emu.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
 from sitl_emu.mavlink.link_errors import PortInUseError
-from sitl_emu.runtime.node import LinkSettings
+from sitl_emu.runtime.node import LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
 from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
+
+if TYPE_CHECKING:  # imported where used, so that `--help` stays quick
+    from flightview.launch import ViewHandle
+    from sitl_emu.console import Console
+    from sitl_emu.disturbance.wind import WindSettings
+    from sitl_emu.params import ParamRegistry
+    from sitl_emu.params.store import ParamStore
+    from sitl_emu.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -93,7 +101,7 @@ def parse_assignments(assignments: tuple[str, ...]) -> list[tuple[str, float, st
     return entries
 
 
-def apply_params(registry: Any, entries: list[tuple[str, float, str]]) -> None:
+def apply_params(registry: ParamRegistry, entries: list[tuple[str, float, str]]) -> None:
     from sitl_emu.params import ParamError
     from sitl_emu.params.store import apply_entry
 
@@ -104,7 +112,7 @@ def apply_params(registry: Any, entries: list[tuple[str, float, str]]) -> None:
             raise UsageProblem(str(err)) from None
 
 
-def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
+def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> ParamRegistry:
     """A registry with the file's values and then the --param ones (no persistence: see stored_params)."""
     from sitl_emu.params import default_registry
 
@@ -114,7 +122,8 @@ def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Any:
     return registry
 
 
-def stored_params(params_file: Path | None, instance: int, first: int, reset: bool) -> tuple[Any, Any, str | None]:
+def stored_params(params_file: Path | None, instance: int, first: int,
+                  reset: bool) -> tuple[ParamRegistry, ParamStore, str | None]:
     """Vehicle `instance`'s registry with its saved values, its ParamStore, and a warning sentence (or None).
 
     The file is --params FILE, or parameters.params in the working directory (PX4 SITL's parameters.bson);
@@ -141,8 +150,8 @@ def stored_params(params_file: Path | None, instance: int, first: int, reset: bo
     return registry, store, None
 
 
-def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: int, sysid: int,
-                  wind: Any = None) -> Any:
+def build_vehicle(params: ParamRegistry, home: tuple[float, float, float] | None, seed: int, sysid: int,
+                  wind: WindSettings | None = None) -> Vehicle:
     from sitl_emu.vehicle import Vehicle
 
     if "MAV_SYS_ID" in params:  # rcS: param set MAV_SYS_ID $((px4_instance+1))
@@ -156,7 +165,7 @@ def build_vehicle(params: Any, home: tuple[float, float, float] | None, seed: in
     return Vehicle(**kwargs)
 
 
-def _wind_option(text: str | None) -> Any:
+def _wind_option(text: str | None) -> WindSettings | None:
     """--wind SPEED@FROM[,TURBULENCE] -> WindSettings (sitl_emu/disturbance/wind.py), None without it."""
     if text is None:
         return None
@@ -233,9 +242,10 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         wind = _wind_option(wind_text)
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
-        stores: list[Any] = []
+        stores: list[ParamStore] = []
+        vehicles: list[Vehicle] = []
 
-        def vehicle(i: int, h: tuple[float, float, float]) -> Any:
+        def vehicle(i: int, h: tuple[float, float, float]) -> Vehicle:
             registry, store, warning = stored_params(params_file, i, instance, params_reset)
             if warning:
                 click.echo(f"{TOOL}: {warning}", err=True)
@@ -245,6 +255,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             if params_reset and store.path.exists():
                 _save_or_fail(store)  # the saved values are gone: the next start is from the defaults too
             stores.append(store)
+            vehicles.append(built)
             return built
 
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
@@ -259,8 +270,8 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
-    live = _start_view(nodes, view, runner)
-    console = attach_console([node.vehicle for node in nodes], runner, not no_console)
+    live = _start_view(vehicles, nodes, view, runner)
+    console = attach_console(vehicles, runner, not no_console)
     try:
         _run_until_signalled(runner, console)
     finally:
@@ -287,7 +298,8 @@ def _check_view(view: dict[str, Any]) -> None:
             raise UsageProblem(str(err)) from None
 
 
-def _start_view(nodes: list[Any], view: dict[str, Any], runner: RealTimeRunner) -> Any:
+def _start_view(vehicles: list[Vehicle], nodes: list[VehicleNode], view: dict[str, Any],
+                runner: RealTimeRunner) -> ViewHandle | None:
     """--view / --record-view: the live view fed by a runner hook (sitl_emu/view.py), or None; one sentence on a
     problem (the nodes are closed first)."""
     options = view_settings(**view)
@@ -298,24 +310,24 @@ def _start_view(nodes: list[Any], view: dict[str, Any], runner: RealTimeRunner) 
     from sitl_emu.view import ServeView
 
     try:
-        handle = open_view("sitl-emu", ServeView.keys(nodes), options, lambda line: click.echo(f"{TOOL}: {line}"))
+        handle = open_view("sitl-emu", ServeView.keys(vehicles), options, lambda line: click.echo(f"{TOOL}: {line}"))
     except ViewError as err:
         for node in nodes:
             node.close()
         raise UserError(str(err)) from None
     assert handle is not None
-    runner.hooks.append(ServeView(handle, nodes))
+    runner.hooks.append(ServeView(handle, vehicles))
     return handle
 
 
-def _save_or_fail(store: Any) -> None:
+def _save_or_fail(store: ParamStore) -> None:
     try:
         store.save()
     except OSError as err:
         raise UsageProblem(f"Cannot write the parameter file {store.path}: {err.strerror}.") from None
 
 
-def _save_all(stores: list[Any]) -> None:
+def _save_all(stores: list[ParamStore]) -> None:
     for store in stores:
         if store.unsaved:
             try:
@@ -324,7 +336,7 @@ def _save_all(stores: list[Any]) -> None:
                 click.echo(f"{TOOL}: cannot save the parameters to {store.path}: {err.strerror}.", err=True)
 
 
-def _run_until_signalled(runner: RealTimeRunner, console: Any) -> None:
+def _run_until_signalled(runner: RealTimeRunner, console: Console | None) -> None:
     """Run until `shutdown`, SIGTERM or Ctrl-C; on a signal print PX4's "PX4 Exiting..." (main.cpp sig_int_handler,
     with its leading newline that ends the prompt line)."""
     with stop_on_signals(runner) as received:

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
 
 from flightview.launch import ViewHandle
 from flightview.scene import Frame
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.px4 import mode_name
 from sitl_emu.types import VehicleSnapshot
+from sitl_emu.vehicle import Vehicle
 
 
 def vehicle_key(sysid: int) -> str:
@@ -43,7 +43,7 @@ def _shift(v: tuple[float, float, float], by: tuple[float, float, float]) -> tup
     return (v[0] + by[0], v[1] + by[1], v[2] + by[2])
 
 
-def manual_sticks(vehicle: Any, snap: VehicleSnapshot) -> tuple[float, float, float, float] | None:
+def manual_sticks(vehicle: Vehicle, snap: VehicleSnapshot) -> tuple[float, float, float, float] | None:
     """PX4's manual_control_setpoint as forward, right, up, yaw (-1..1) while a MAVLink joystick is present."""
     if not snap.manual_control:
         return None
@@ -54,23 +54,22 @@ def manual_sticks(vehicle: Any, snap: VehicleSnapshot) -> tuple[float, float, fl
 class ServeView:
     """The runner hook feeding the view from the nodes' vehicles."""
 
-    def __init__(self, handle: ViewHandle, nodes: Sequence[Any]) -> None:
+    def __init__(self, handle: ViewHandle, vehicles: Sequence[Vehicle]) -> None:
         self.handle = handle
-        self.nodes = list(nodes)
+        self.vehicles = list(vehicles)
 
     @staticmethod
-    def keys(nodes: Sequence[Any]) -> list[str]:
-        return [vehicle_key(node.sysid) for node in nodes]
+    def keys(vehicles: Sequence[Vehicle]) -> list[str]:
+        return [vehicle_key(vehicle.sysid) for vehicle in vehicles]
 
     def __call__(self) -> None:
         live = self.handle.live
         if not live.due():
             return
         origin = None
-        for node in self.nodes:
-            vehicle = node.vehicle
+        for vehicle in self.vehicles:
             snap = vehicle.snapshot()
-            if origin is None and len(self.nodes) > 1:
+            if origin is None and len(self.vehicles) > 1:
                 origin = GeoRef(snap.ref_lat_deg, snap.ref_lon_deg, snap.ref_alt_amsl_m)
-            live.log(vehicle_key(node.sysid), snapshot_frame(snap, manual_sticks(vehicle, snap), origin))
+            live.log(vehicle_key(vehicle.sysid), snapshot_frame(snap, manual_sticks(vehicle, snap), origin))
         live.end_frame()

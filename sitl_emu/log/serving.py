@@ -10,11 +10,11 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
 
 from sitl_emu.log.flight_log import FlightLogger
 from sitl_emu.mavlink.endpoint import load_handler_classes
 from sitl_emu.mavlink.log_protocol import DirectoryLogSource, LogProtocol
+from sitl_emu.runtime.node import VehicleNode
 
 DEFAULT_LOG_DIR = Path("log")  # PX4 SITL: LOG_ROOT = PX4_STORAGEDIR "/log", the working directory's log/
 
@@ -31,7 +31,7 @@ def handler_classes(directory: str | os.PathLike[str]) -> Sequence[type]:
     return [serving if cls is LogProtocol else cls for cls in load_handler_classes()]
 
 
-def attach_logger(node: Any, directory: str | os.PathLike[str]) -> FlightLogger:
+def attach_logger(node: VehicleNode, directory: str | os.PathLike[str]) -> FlightLogger:
     """A FlightLogger for `node`, run at the start of every step_io."""
     logger = FlightLogger(node, directory)
     node.tick_hooks.append(logger.tick)
@@ -43,6 +43,6 @@ def handlers_by_instance(base: str | os.PathLike[str], first: int = 0) -> Callab
     return lambda instance: handler_classes(instance_log_dir(base, instance, first))
 
 
-def attach_loggers(nodes: Sequence[Any], base: str | os.PathLike[str], first: int = 0) -> list[FlightLogger]:
+def attach_loggers(nodes: Sequence[VehicleNode], base: str | os.PathLike[str], first: int = 0) -> list[FlightLogger]:
     """A logger on each node (node i is instance first + i), each writing its instance's log directory."""
     return [attach_logger(node, instance_log_dir(base, first + i, first)) for i, node in enumerate(nodes)]

@@ -61,7 +61,8 @@ def load_handler_classes(spec: Iterable[tuple[str, str]] = HANDLER_CLASSES) -> l
 class NodeServices(NodeView, Protocol):
     """What an endpoint needs from the node that owns it: what its parts use (NodeView) and the links' plumbing."""
 
-    vehicle: LinkVehicle
+    @property
+    def vehicle(self) -> LinkVehicle: ...
 
     @property
     def sysid(self) -> int: ...

@@ -22,9 +22,8 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from types import FrameType
-from typing import Any
 
-from sitl_emu.runtime.node import READ_API, READ_GCS
+from sitl_emu.runtime.node import READ_API, READ_GCS, VehicleNode
 from sitl_emu.runtime.timeline import Timeline
 
 log = logging.getLogger(__name__)
@@ -48,7 +47,7 @@ class SocketWatch:
     one fd however many sockets), else on the sockets. A datagram wakes the runner at once either way.
     """
 
-    def __init__(self, nodes: Sequence[Any]) -> None:
+    def __init__(self, nodes: Sequence[VehicleNode]) -> None:
         self._selector = selectors.DefaultSelector()
         for index, node in enumerate(nodes):
             for bit, fd in zip((READ_API, READ_GCS), node.filenos(), strict=True):
@@ -87,7 +86,7 @@ def _fine_wait_fds(selector: selectors.BaseSelector) -> list[int]:
 class RealTimeRunner:
     """Run nodes at `speed` x real time until `stop()` (thread-safe) or KeyboardInterrupt."""
 
-    def __init__(self, nodes: Sequence[Any], speed: float = 1.0,
+    def __init__(self, nodes: Sequence[VehicleNode], speed: float = 1.0,
                  hooks: Sequence[Callable[[], None]] = ()) -> None:
         if not speed > 0:
             raise ValueError("speed must be a positive number")

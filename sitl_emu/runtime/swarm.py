@@ -18,10 +18,9 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import Any
 
 from sitl_emu.geo import GeoRef, ned_to_global
-from sitl_emu.runtime.node import LinkSettings, VehicleNode
+from sitl_emu.runtime.node import LinkSettings, NodeVehicle, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner
 
 log = logging.getLogger(__name__)
@@ -34,7 +33,7 @@ DEFAULT_SPACING_M = 3.0  # gazebo-classic sitl_multiple_run.sh: instance N spawn
 STREAM_STAGGER_US = 4000
 SWARM_IO_BUDGET = 20  # datagrams read per link per tick (4 ms of simulated time) in the swarm runner
 
-VehicleFactory = Callable[[int, tuple[float, float, float]], Any]  # (instance, home) -> Vehicle
+VehicleFactory = Callable[[int, tuple[float, float, float]], NodeVehicle]  # (instance, home) -> a Vehicle
 
 
 def instance_home(home: tuple[float, float, float], index: int, spacing_m: float = DEFAULT_SPACING_M
@@ -87,7 +86,7 @@ class SwarmRunner(RealTimeRunner):
     other vehicles' physics are not held back; falling behind is warned at most every 10 s.
     """
 
-    def __init__(self, nodes: Sequence[Any], speed: float = 1.0, hooks: Sequence[Callable[[], None]] = (),
+    def __init__(self, nodes: Sequence[VehicleNode], speed: float = 1.0, hooks: Sequence[Callable[[], None]] = (),
                  io_budget: int = SWARM_IO_BUDGET) -> None:
         super().__init__(nodes, speed, hooks)
         for node in self.nodes:

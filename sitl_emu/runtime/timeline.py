@@ -11,15 +11,36 @@ pace it on the wall clock) and the lockstep `Sim` (testing/sim.py, which advance
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Protocol
 
 Ready = dict[int, int]  # node index -> bit set of its links with datagrams waiting (runner.SocketWatch)
 
 
-class Timeline:
-    """Simulated time shared by `nodes` (anything with `.vehicle` and `.step_io(now_us, readable)`), in µs."""
+class TickVehicle(Protocol):
+    """What the tick loop asks of a vehicle (sitl_emu.vehicle.Vehicle)."""
 
-    def __init__(self, nodes: Sequence[Any], start_us: int = 0) -> None:
+    @property
+    def dt_us(self) -> int: ...
+
+    @property
+    def time_us(self) -> int: ...
+
+    def step(self) -> None: ...
+
+
+class TickNode(Protocol):
+    """What the tick loop asks of a node (runtime/node.py VehicleNode): its vehicle, and its I/O after a tick."""
+
+    @property
+    def vehicle(self) -> TickVehicle: ...
+
+    def step_io(self, now_us: int, readable: int) -> object: ...
+
+
+class Timeline:
+    """Simulated time shared by `nodes`, in µs."""
+
+    def __init__(self, nodes: Sequence[TickNode], start_us: int = 0) -> None:
         self.nodes = list(nodes)
         self.time_us = start_us
         self.steps = 0  # vehicle ticks run, all vehicles together

@@ -110,6 +110,7 @@ class Sim:
 
             def handlers_for(instance: int) -> Sequence[type]:
                 return handler_classes(instance_log_dir(log_dir, instance))
+        self._vehicles: list[Vehicle] = []  # the nodes' vehicles, as built (a reboot keeps the object)
         try:
             self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,
                                                         spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6),
@@ -139,16 +140,18 @@ class Sim:
             registry.set("MAV_SYS_ID", instance + 1)
         for name, value in self._param_values.items():
             registry.set(name, float(value))
-        return Vehicle(params=registry, home=home, seed=self._seed + instance, sysid=instance + 1,
-                       **self._vehicle_options)
+        vehicle = Vehicle(params=registry, home=home, seed=self._seed + instance, sysid=instance + 1,
+                          **self._vehicle_options)
+        self._vehicles.append(vehicle)
+        return vehicle
 
     # --- what a script reads ---------------------------------------------------------------------------------
     @property
     def vehicles(self) -> list[Vehicle]:
-        return [node.vehicle for node in self.nodes]
+        return list(self._vehicles)
 
     def vehicle(self, index: int = 0) -> Vehicle:
-        return self.nodes[index].vehicle
+        return self._vehicles[index]
 
     def ports(self, index: int = 0) -> VehiclePorts:
         node = self.nodes[index]
