@@ -2,7 +2,8 @@
 
 Every mistake ends as one line on stderr, `sitl-emu: <what is wrong and what to do>`, with a non-zero exit status and
 no traceback: click's own usage errors too (`OneLineGroup` turns them into `UserError`). Range errors name the range.
-joyfly/cli_style.py is its twin for `joyfly` (the two packages do not import each other: DESIGN.md); change both.
+joyfly/cli_style.py is its twin for `joyfly` (joyfly imports sitl_emu only to run the demo's emulator, and
+sitl_emu never imports joyfly: ARCHITECTURE.md); change both.
 """
 
 from __future__ import annotations

@@ -24,6 +24,7 @@ from typing import Final
 import numpy as np
 
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
+from sitl_emu.control_chain import ControlChain, published_setpoints
 from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.flight.commander import Commander
@@ -53,7 +54,6 @@ from sitl_emu.types import (
 )
 from sitl_emu.vehicle_faults import VehicleFaults
 from sitl_emu.vehicle_fence import FenceChecks, rtl_destination
-from sitl_emu.vehicle_parts import ControlChain, published_setpoints
 
 EVENT_HISTORY: Final = 1000
 # PX4's commander cycles every 10 ms (COMMANDER_MONITORING_INTERVAL); here every 2 ticks

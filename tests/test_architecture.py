@@ -25,8 +25,8 @@ def sources(*parts: str) -> list[Path]:
 
 
 CORE = sources("sitl_emu/control", "sitl_emu/flight", "sitl_emu/params", "sitl_emu/physics.py", "sitl_emu/vehicle.py",
-               "sitl_emu/vehicle_parts.py", "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py",
-               "sitl_emu/vehicle_faults.py", "sitl_emu/disturbance")
+               "sitl_emu/control_chain.py", "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py",
+               "sitl_emu/vehicle_faults.py", "sitl_emu/vehicle_fence.py", "sitl_emu/disturbance")
 CORE_MAY_NOT = ("pymavlink", "sitl_emu.mavlink", "sitl_emu.runtime", "sitl_emu.testing", "sitl_emu.cli",
                 "sitl_emu.console", "sitl_emu.shell", "time", "socket", "threading", "random")
 

@@ -66,7 +66,7 @@ DEFAULT_MODULES = (
     "sitl_emu/flight/tasks_orbit.py",
     "sitl_emu/flight/tasks_rtl.py",
     "sitl_emu/vehicle.py",
-    "sitl_emu/vehicle_parts.py",
+    "sitl_emu/control_chain.py",
     "sitl_emu/geo.py",
     # the features' per-cycle work: faults, battery, geofence and the stored plans
     "sitl_emu/vehicle_faults.py",

@@ -68,7 +68,8 @@ class LockstepClock:
 class ScaledWallClock:
     """Wall time x `speed`, for a client in another thread or process paired with a vehicle run at that speed.
 
-    joyfly.clock.ScaledClock is its twin on purpose: sitl_emu and joyfly never import each other (DESIGN.md).
+    joyfly.clock.ScaledClock is its twin on purpose: sitl_emu never imports joyfly, and joyfly imports sitl_emu only
+    to run the demo's emulator (ARCHITECTURE.md).
     """
 
     def __init__(self, speed: float = 1.0) -> None:
