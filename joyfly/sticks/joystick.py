@@ -63,6 +63,9 @@ _IOC_READ = 2
 _JS_MAGIC = ord("j")
 NAME_LEN = 128
 REOPEN_INTERVAL_S = 0.5
+# A joystick's kernel queue holds 64 events, one read; a source that never runs dry (raw:/dev/zero, a file still
+# growing fast) is read at most this many times per poll, so the session loop, its timeouts and Ctrl-C keep running.
+MAX_READS_PER_POLL = 16
 
 
 def _ior(nr: int, size: int) -> int:
@@ -286,9 +289,11 @@ class JsDevice:
         return bool(ready)
 
     def _read_available(self) -> bool:
-        """Drain the fd; returns True when at least one whole event was applied."""
+        """Drain the fd, MAX_READS_PER_POLL reads at most; returns True when at least one whole event was applied."""
         got = False
-        while self._fd is not None:
+        for _ in range(MAX_READS_PER_POLL):
+            if self._fd is None:
+                break
             try:
                 data = os.read(self._fd, EVENT_SIZE * 64)
             except BlockingIOError:

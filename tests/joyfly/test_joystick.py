@@ -119,6 +119,16 @@ def test_raw_file_is_read_and_followed(tmp_path):
     src.close()
 
 
+def test_a_source_that_never_runs_dry_is_read_a_bounded_amount_per_poll():
+    """raw:/dev/zero (or /dev/urandom) never reports "nothing more": each poll must still return, so the session's
+    timeouts and Ctrl-C keep working (it used to drain forever)."""
+    src = open_joystick("raw:/dev/zero", FakeClock())
+    for _ in range(3):
+        src.poll(0.0)
+    assert src.state().connected
+    src.close()
+
+
 @pytest.fixture
 def pty_device():
     """A pty slave is a character device: it stands in for /dev/input/jsN (the js ioctls fail on it)."""
