@@ -35,6 +35,8 @@ from sitl_emu.types import Vec3
 FT: Final = 0.3048  # m per foot
 TURBULENCE_LEVELS: Final = {"light": 15 * 0.514444, "moderate": 30 * 0.514444, "severe": 45 * 0.514444}  # W20 m/s
 MIN_TURBULENCE_V_M_S: Final = 1.0
+MAX_WIND_M_S: Final = 100.0  # as SIH_WIND_N/E's range in PX4 (sih_params.yaml)
+MAX_TURBULENCE_W20_M_S: Final = 50.0  # our bound: about twice MIL-F-8785C's "severe" (45 kt)
 ALTITUDE_BAND_M: Final = 2.0
 BLOCK_SAMPLES: Final = 250  # turbulence is generated a block at a time (1 s at 250 Hz)
 
@@ -87,8 +89,8 @@ def parse_wind(text: str) -> WindSettings:
         speed, from_deg = float(parts[0]), float(parts[1])
     except ValueError:
         raise ValueError(f"wind {text!r}: SPEED and FROM_DEG must be numbers, e.g. 5@270") from None
-    if not (math.isfinite(speed) and math.isfinite(from_deg)) or speed < 0.0:
-        raise ValueError(f"wind {text!r}: speed must be >= 0 and both numbers finite")
+    if not (math.isfinite(speed) and math.isfinite(from_deg)) or not 0.0 <= speed <= MAX_WIND_M_S:
+        raise ValueError(f"wind {text!r}: the speed is 0 to {MAX_WIND_M_S:g} m/s (PX4's SIH_WIND_N/E range)")
     if not -360.0 <= from_deg <= 360.0:
         raise ValueError(f"wind {text!r}: the direction it blows from is in degrees, -360 to 360")
     return WindSettings(speed, from_deg % 360.0, turbulence_w20(parts[2]) if len(parts) == 3 else 0.0)
@@ -101,8 +103,9 @@ def turbulence_w20(text: str) -> float:
         value = level if level is not None else float(text)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value >= 0.0):
-        raise ValueError(f"turbulence {text!r}: light, moderate, severe or W20 in m/s >= 0")
+    if not (math.isfinite(value) and 0.0 <= value <= MAX_TURBULENCE_W20_M_S):
+        raise ValueError(f"turbulence {text!r}: light, moderate, severe or W20 from 0 to "
+                         f"{MAX_TURBULENCE_W20_M_S:g} m/s")
     return value
 
 

@@ -98,7 +98,8 @@ def test_parse_wind(text: str, want: tuple[float, float, float]):
     assert (w.speed_m_s, w.from_deg, w.turbulence_w20_m_s) == pytest.approx(want)
 
 
-@pytest.mark.parametrize("text", ["5", "a@b", "-1@0", "5@270,storm", "1,2,3,4", "5@999", "5@-400", "5@nan", "inf@0"])
+@pytest.mark.parametrize("text", ["5", "a@b", "-1@0", "5@270,storm", "1,2,3,4", "5@999", "5@-400", "5@nan", "inf@0",
+                                  "1e9@270", "100.5@0", "5@270,1e9", "5@270,-1"])
 def test_parse_wind_refuses(text: str):
     with pytest.raises(ValueError):
         parse_wind(text)
