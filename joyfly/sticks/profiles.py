@@ -283,7 +283,10 @@ def apply_overrides(profile: Profile, table: Mapping[str, Any]) -> Profile:
             axes.pop(role, None)
         else:
             axes[role] = axis
-    buttons = _button_overrides(dict(profile.buttons), table.get("buttons", {}))
+    button_table = table.get("buttons", {})
+    if not isinstance(button_table, Mapping):
+        raise ProfileError("profile.buttons must be a table such as [profile.buttons] with land = 3: fix the config.")
+    buttons = _button_overrides(dict(profile.buttons), button_table)
     hold = _number("profile", "arm_hold_s", table["arm_hold_s"], 0, 10) if "arm_hold_s" in table else profile.arm_hold_s
     return replace(profile, name=f"{profile.name}+config", axes=axes, buttons=buttons, arm_hold_s=hold)
 
@@ -297,6 +300,8 @@ def read_config(path: str) -> dict[str, Any]:
         raise ProfileError(f"No config file at {path}: check the --config path.") from None
     except tomllib.TOMLDecodeError as exc:
         raise ProfileError(f"{path} is not valid TOML ({exc}): fix that line.") from None
+    except UnicodeDecodeError:
+        raise ProfileError(f"{path} is not a text file (TOML is UTF-8 text): check the --config path.") from None
     except OSError as exc:
         raise ProfileError(f"Cannot read {path} ({os.strerror(exc.errno or 0)}): check its permissions.") from None
 

@@ -104,20 +104,29 @@ class ResultsFile:
             self.columns[-len(TAIL):-len(TAIL)] = new
             self._rewrite()
             return
-        with self.path.open("a", newline="") as f:
-            csv.DictWriter(f, self.columns, restval="").writerow(text)
-            f.flush()
+        try:
+            with self.path.open("a", newline="") as f:
+                csv.DictWriter(f, self.columns, restval="").writerow(text)
+                f.flush()
+        except OSError as err:
+            raise self._cannot_write(err) from None
 
     def _rewrite(self) -> None:
         if self.path is None:
             return
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         tmp = self.path.with_name(self.path.name + ".tmp")
-        with tmp.open("w", newline="") as f:
-            writer = csv.DictWriter(f, self.columns, restval="")
-            writer.writeheader()
-            writer.writerows(self.rows)
-        os.replace(tmp, self.path)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with tmp.open("w", newline="") as f:
+                writer = csv.DictWriter(f, self.columns, restval="")
+                writer.writeheader()
+                writer.writerows(self.rows)
+            os.replace(tmp, self.path)
+        except OSError as err:
+            raise self._cannot_write(err) from None
+
+    def _cannot_write(self, err: OSError) -> CampaignError:
+        return CampaignError(f"cannot write the results file {self.path}: {err.strerror or err}; choose another --out.")
 
 
 def typed(row: Mapping[str, str]) -> dict[str, Any]:

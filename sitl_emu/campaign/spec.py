@@ -60,6 +60,8 @@ def read_spec(path: Path) -> CampaignSpec:
         raise CampaignError(f"cannot read the campaign file {path}: {err.strerror}.") from None
     except tomllib.TOMLDecodeError as err:
         raise CampaignError(f"{path} is not valid TOML: {err}.") from None
+    except UnicodeDecodeError:
+        raise CampaignError(f"{path} is not a text file: a campaign file is TOML (UTF-8 text).") from None
     try:
         return _spec(data, path.parent)
     except CaseError as err:

@@ -55,12 +55,20 @@ def parse_value(name: str, text: str, where: str) -> float:
         raise ParamFileError(f"{where}: parameter {name} needs a number, not '{text}'.") from None
 
 
+MAX_FILE_BYTES = 1 << 20  # every PX4 parameter as a 'NAME VALUE' line takes about 30 kB
+
+
 def read_file(path: Path) -> list[Entry]:
     """The entries of a parameter file; ParamFileError if it cannot be read or is not one."""
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)  # bounded: --params /dev/urandom must not read forever
     except OSError as err:
         raise ParamFileError(f"Cannot read the parameter file {path}: {err.strerror}.") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ParamFileError(f"{path} is over {MAX_FILE_BYTES >> 20} MB: not a parameter file ('NAME VALUE' lines).")
+    try:
+        text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise ParamFileError(f"{path} is not a text file: a parameter file has 'NAME VALUE' lines.") from None
     return parse_lines(text.splitlines(), str(path))

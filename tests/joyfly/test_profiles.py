@@ -104,6 +104,7 @@ land = -1
         ({"buttons": {"fire": 1}}, "Unknown button action 'fire'"),
         ({"forward": 3}, "profile.forward must be a table"),
         ({"throttle_abs": {"invert": True}}, "[profile.throttle_abs] maps no axis yet"),
+        ({"buttons": 5}, "profile.buttons must be a table"),
     ],
 )
 def test_config_mistakes_are_one_sentence(table, fragment):
@@ -126,6 +127,11 @@ def test_bad_toml_is_reported(tmp_path):
     assert "is not valid TOML" in str(info.value)
     with pytest.raises(ProfileError):
         read_config(str(tmp_path / "none.toml"))
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(bytes(range(256)))
+    with pytest.raises(ProfileError) as info:
+        read_config(str(binary))
+    assert "is not a text file" in str(info.value)
 
 
 def test_rest_check_flags_a_stick_role_on_a_trigger():

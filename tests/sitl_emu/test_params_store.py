@@ -17,7 +17,7 @@ from support.ports import free_udp_ports
 from sitl_emu.cli import stored_params
 from sitl_emu.params import default_registry
 from sitl_emu.params import store as store_module
-from sitl_emu.params.store import DEFAULT_FILE, ParamStore, instance_path, read_file
+from sitl_emu.params.store import DEFAULT_FILE, ParamFileError, ParamStore, instance_path, read_file
 
 
 def test_save_and_load_give_back_every_changed_value_bit_for_bit(tmp_path):
@@ -62,6 +62,11 @@ def test_other_garbage_is_refused_too(tmp_path, content):
     reg = default_registry()
     assert "not a usable parameter file" in (ParamStore(reg, path).load() or "")
     assert reg.changed() == {}
+
+
+def test_an_endless_or_huge_file_is_read_only_so_far():
+    with pytest.raises(ParamFileError, match="is over 1 MB: not a parameter file"):
+        read_file(Path("/dev/zero"))
 
 
 def test_unknown_names_and_refused_values_are_skipped_the_rest_loaded(tmp_path):

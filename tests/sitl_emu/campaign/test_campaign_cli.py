@@ -114,6 +114,19 @@ def test_a_toml_error_or_an_unknown_parameter_in_the_file_is_one_line_naming_the
     assert result.stderr.strip() == "sitl-emu: case c0000: Unknown parameter NO_SUCH_PARAM."
     result = run("campaign", str(bad), "--seed", "3")
     assert "give the cases either in CASES.toml or with --seed" in result.stderr
+    bad.write_bytes(bytes(range(256)))
+    lines = run("campaign", str(bad)).stderr.strip().splitlines()
+    assert lines == [f"sitl-emu: {bad} is not a text file: a campaign file is TOML (UTF-8 text)."]
+
+
+def test_a_results_file_that_cannot_be_written_is_one_line(tmp_path: Path) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    out = blocker / "results.csv"  # its folder would be a regular file
+    result = run("campaign", "--scenario", f"{SCENARIOS}:hover", "--seed", "1", "--out", str(out))
+    lines = result.stderr.strip().splitlines()
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    assert lines[0].startswith(f"sitl-emu: cannot write the results file {out}: "), lines[0]
 
 
 def test_the_ray_engine_without_ray_or_with_no_cluster_at_the_address_is_one_line(tmp_path: Path) -> None:
