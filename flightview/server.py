@@ -57,6 +57,9 @@ def check_port_free(port: int, option: str = "--view-port") -> None:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
         try:
             sock.bind((LOOPBACK, port))
+        except PermissionError:
+            raise ViewError(f"Port {port} on {LOOPBACK} needs administrator rights (ports below 1024 do): pick one "
+                            f"above 1023 with {option} or leave it out to use a free one.") from None
         except OSError as err:
             raise ViewError(f"Port {port} on {LOOPBACK} is in use ({err.strerror}): pick another with {option} or "
                             "leave it out to use a free one.") from None

@@ -33,6 +33,7 @@ from sitl_emu.cli_options import (
     WholeRange,
     check_host,
     check_instances,
+    check_own_ports,
     parse_address,
     parse_home,
 )
@@ -241,6 +242,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         home_lla = parse_home(home) if home else DEFAULT_HOME
         wind = _wind_option(wind_text)
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
+        check_own_ports([settings.for_instance(i) for i in range(instance, instance + count)])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
         stores: list[ParamStore] = []
         vehicles: list[Vehicle] = []

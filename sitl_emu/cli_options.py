@@ -10,9 +10,13 @@ from __future__ import annotations
 
 import math
 import socket
-from typing import IO, Any
+from collections.abc import Sequence
+from typing import IO, TYPE_CHECKING, Any
 
 import click
+
+if TYPE_CHECKING:
+    from sitl_emu.runtime.node import LinkSettings
 
 TOOL = "sitl-emu"
 PORT_MAX = 65535
@@ -119,6 +123,27 @@ def parse_home(text: str) -> tuple[float, float, float]:
     if not (-90 <= lat <= 90 and -180 <= lon <= 180 and -500 <= alt <= 9000):
         raise UsageProblem(f"--home {text} is out of range (latitude ±90, longitude ±180, altitude -500..9000 m).")
     return lat, lon, alt
+
+
+THIS_MACHINE = frozenset({"127.0.0.1", "localhost", "0.0.0.0", "::1"})
+
+
+def check_own_ports(links: Sequence[LinkSettings]) -> None:
+    """`links`: every vehicle's (after LinkSettings.for_instance). No two links listen on one port, and no link sends
+    to a port they listen on: it would latch onto itself and talk to itself."""
+    listening: dict[int, str] = {}
+    for s in links:
+        for option, port in (("--port", s.api_port), ("--gcs-port", s.gcs_port)):
+            if port and port in listening:
+                raise UsageProblem(f"{listening[port]} and {option} give two links port {port} (with --count, "
+                                   "vehicle N listens on each port + N): choose ports further apart.")
+            listening[port] = option
+    for s in links:
+        for option, (host, port) in (("--remote", s.api_remote), ("--gcs-remote", s.gcs_remote)):
+            if port in listening and (host in THIS_MACHINE or host == s.bind_host):
+                raise UsageProblem(f"{option} {host}:{port} is a port this emulator listens on ({listening[port]}): "
+                                   "it would talk to itself; point it at the client (PX4 SITL sends the API link "
+                                   "to 14540, the ground station's to 14550).")
 
 
 def check_instances(instance: int, count: int, ports: dict[str, int], api_remote_port: int) -> None:

@@ -63,6 +63,12 @@ def fly_error(*args: str) -> str:
     (("--gcs-port", "65534", "--count", "3"), "--gcs-port 65534 offset by instance 2 is port 65536"),
     (("--remote", "127.0.0.1:65530", "--instance", "9"), "--remote port 65530 offset by instance 9 is above 65535; "
                                                          "use a --remote port at most 65526"),
+    (("--port", "25037", "--gcs-port", "25037"), "--port and --gcs-port give two links port 25037"),
+    (("--count", "3", "--port", "25040", "--gcs-port", "25041"), "--gcs-port and --port give two links port 25041"),
+    (("--port", "25180", "--remote", "127.0.0.1:25180"), "--remote 127.0.0.1:25180 is a port this emulator listens "
+                                                          "on (--port): it would talk to itself"),
+    (("--gcs-port", "25181", "--gcs-remote", "localhost:25181"), "--gcs-remote localhost:25181 is a port this "
+                                                                 "emulator listens on (--gcs-port)"),
     (("--remote", "127.0.0.1:0"), "--remote 127.0.0.1:0: port 0 is out of range; use a port from 1 to 65535"),
     (("--gcs-remote", "127.0.0.1:99999"), "port 99999 is out of range; use a port from 1 to 65535"),
     (("--remote", "nowhere"), "--remote must look like HOST:PORT"),

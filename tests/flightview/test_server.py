@@ -31,3 +31,25 @@ def test_the_page_reads_from_the_loopback_proxy() -> None:
     assert view.url == "http://127.0.0.1:8000/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9000%2Fproxy"
     view.stop()
     assert view.errors.closed
+
+
+def test_a_privileged_port_is_not_called_in_use(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A non-root user's --view-port 80 fails with EACCES: say so, not "in use"."""
+
+    class Refusing:
+        def __init__(self, *args: Any) -> None:
+            pass
+
+        def __enter__(self) -> Refusing:
+            return self
+
+        def __exit__(self, *exc: Any) -> None:
+            pass
+
+        def bind(self, address: Any) -> None:
+            raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(server.socket, "socket", Refusing)
+    with pytest.raises(server.ViewError) as info:
+        server.check_port_free(80)
+    assert "needs administrator rights" in str(info.value) and "in use" not in str(info.value)
