@@ -173,8 +173,11 @@ def _coerce(name: str, value: Any, origins: _Origins) -> Any:
         number = _number(value)
         if number is None:
             bound = BOUNDS[name]
-            raise ConfigError(f"{origins.says(name, value)} is not a number: write a number from {bound.lo:g} to "
-                              f"{bound.hi:g} {bound.unit}, for example {origins.example(name, default)}.")
+            d = FlyOptions()
+            within = (f"between min-alt and max-alt ({d.min_alt:g} and {d.max_alt:g} m unless you change them)"
+                      if name == "alt" else f"from {bound.lo:g} to {bound.hi:g} {bound.unit}")
+            raise ConfigError(f"{origins.says(name, value)} is not a number: write a number {within}, for example "
+                              f"{origins.example(name, default)}.")
         return number
     if value is not None and not isinstance(value, str):
         example = origins.example(name, default if default is not None else "FILE")

@@ -118,6 +118,9 @@ def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Para
     from sitl_emu.params import default_registry
 
     registry = default_registry()
+    if params_file is not None and not params_file.parent.is_dir():
+        raise UsageProblem(f"--params {params_file}: the folder {params_file.parent} does not exist, so the vehicle "
+                           "could not save its parameters there; create it or choose another file.")
     entries = read_params_file(params_file) if params_file is not None and params_file.exists() else []
     apply_params(registry, entries + parse_assignments(assignments))
     return registry

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import io
 import os
 import select
 import socket
@@ -94,8 +95,9 @@ class MavutilTransport:
         if conn is None:
             from pymavlink import mavutil
 
-            try:
-                conn = mavutil.mavlink_connection(spec, source_system=255, source_component=190)
+            try:  # pymavlink prints each refused TCP attempt ("... sleeping"): the one sentence below says it
+                with contextlib.redirect_stdout(io.StringIO()):
+                    conn = mavutil.mavlink_connection(spec, source_system=255, source_component=190)
             except Exception as exc:  # pymavlink raises bare exceptions for refused TCP and the like
                 raise TransportError(f"Cannot open {spec!r} ({exc}): is the vehicle listening there?") from None
         self._conn: Any = conn

@@ -363,6 +363,10 @@ def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/in
     Raises JoystickError (one sentence with the fix) when it cannot be opened or cannot be a joystick.
     """
     clock = clock or WallClock()
+    prefix, _, rest = spec.partition(":")
+    if not spec or (f"{prefix}:" in ("script:", "replay:", RAW_PREFIX) and not rest):
+        raise JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
+                            "script:FILE or replay:FILE, for example --joy script:examples/joystick_script.txt.")
     if spec.startswith("script:"):
         return ScriptSource.from_file(spec[len("script:") :], clock)
     if spec.startswith("replay:"):

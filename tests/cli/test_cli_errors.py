@@ -96,6 +96,9 @@ def test_bad_values_in_a_params_file_name_the_file_and_line(tmp_path: Path, monk
     params.write_bytes(b"\xff\xfe\x00binary")
     assert "is not a text file" in serve_error("--params", str(params), monkeypatch=monkeypatch)
     assert "Cannot read the parameter file" in serve_error("--params", str(tmp_path), monkeypatch=monkeypatch)
+    missing = tmp_path / "no_such_folder" / "vehicle.params"
+    assert f"the folder {missing.parent} does not exist" in serve_error("--params", str(missing),
+                                                                        monkeypatch=monkeypatch)
 
 
 @pytest.mark.parametrize(("args", "words"), [
@@ -142,8 +145,8 @@ def test_a_bad_config_file_value_names_the_file_and_the_key(tmp_path: Path) -> N
     config = tmp_path / "joyfly.toml"
     config.write_text('[fly]\nalt = "high"\n')
     line = fly_error("--config", str(config))
-    assert line == f'joyfly: {config}: alt = "high" is not a number: write a number from 0 to 1000 m, for example ' \
-                   "alt = 3."
+    assert line == f'joyfly: {config}: alt = "high" is not a number: write a number between min-alt and max-alt ' \
+                   "(0.5 and 10 m unless you change them), for example alt = 3."
     config.write_text("[fly]\nurl = 'udp://:14540@127.0.0.1:99999'\n")
     assert f"{config}: url = \"udp://:14540@127.0.0.1:99999\": the vehicle port 99999" in fly_error("--config",
                                                                                                    str(config))

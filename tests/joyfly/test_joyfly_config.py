@@ -68,7 +68,8 @@ def test_bad_options_end_in_one_sentence(options: dict[str, object], fragment: s
 
 
 @pytest.mark.parametrize(("toml", "message"), [
-    ('alt = "high"', 'alt = "high" is not a number: write a number from 0 to 1000 m, for example alt = 3.'),
+    ('alt = "high"', 'alt = "high" is not a number: write a number between min-alt and max-alt (0.5 and 10 m '
+                     'unless you change them), for example alt = 3.'),
     ("[fly]\nmax-speed = 50", "max-speed = 50 is out of range: use 0.1 to 20 m/s"),
     ("speed = nan", "speed = nan is not a number: write a number from 0.1 to 100 times real time, for example "
                     "speed = 1."),

@@ -324,3 +324,9 @@ def test_a_device_replaced_by_something_else_is_not_reopened(pty_device, tmp_pat
     assert src.poll(0.1).connected is False
     assert "is a directory" in str(src.last_error)
     src.close()
+
+
+@pytest.mark.parametrize("spec", ["", "script:", "raw:", "replay:"])
+def test_a_joy_that_names_no_file_is_one_sentence(spec):
+    with pytest.raises(JoystickError, match="names no file: give a device"):
+        open_joystick(spec, FakeClock())
