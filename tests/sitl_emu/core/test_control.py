@@ -5,8 +5,9 @@ import random
 
 import pytest
 from support import REPO_ROOT
-from support.states import hover_state, q_from_euler
+from support.states import hover_state
 
+from flightview.scene import euler_to_q
 from sitl_emu.control.attitude import AttitudeControl
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.mixer import allocated_torque, mix
@@ -150,7 +151,7 @@ def test_disarmed_motors_are_off_and_idle_setpoint_gives_zero():
 
 def test_attitude_setpoint_bypasses_position_control(hovering):
     loop = fresh(hovering)
-    q = q_from_euler(math.radians(10.0), 0.0, 0.0)
+    q = euler_to_q(math.radians(10.0), 0.0, 0.0)
     att = AttitudeSetpoint(q_wxyz=q, thrust_body=(0.0, 0.0, -0.5))
     loop.run(1.0, lambda t: None, attitude=lambda t: att)
     roll, _, _ = euler_from_q(loop.state.q_wxyz)
@@ -198,9 +199,9 @@ def test_mixer_gives_up_yaw_before_roll_when_saturated():
 
 def test_attitude_control_commands_rates_towards_the_setpoint_and_limits_them():
     att = AttitudeControl()
-    rates = att.update((1.0, 0.0, 0.0, 0.0), q_from_euler(0.1, -0.1, 0.0))
+    rates = att.update((1.0, 0.0, 0.0, 0.0), euler_to_q(0.1, -0.1, 0.0))
     assert rates[0] == pytest.approx(0.4, rel=0.05) and rates[1] == pytest.approx(-0.4, rel=0.05)
-    rates = att.update((1.0, 0.0, 0.0, 0.0), q_from_euler(math.pi / 2, 0.0, 0.0))
+    rates = att.update((1.0, 0.0, 0.0, 0.0), euler_to_q(math.pi / 2, 0.0, 0.0))
     assert rates[0] == pytest.approx(math.radians(220.0))
 
 
@@ -296,12 +297,12 @@ def test_attitude_control_gives_finite_limited_rates_for_any_attitude_pair():
     att = AttitudeControl()
     limits = att.settings.rate_max_rad_s
     level = (1.0, 0.0, 0.0, 0.0)
-    half_turns = [(0.0, 0.0, 0.0, 1.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), q_from_euler(math.pi, 0.0, 0.0)]
+    half_turns = [(0.0, 0.0, 0.0, 1.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), euler_to_q(math.pi, 0.0, 0.0)]
     rng = random.Random(4)
     pairs = [(level, q) for q in half_turns] + [(q, level) for q in half_turns] + [((-1.0, 0.0, 0.0, 0.0), level)]
 
     def random_q() -> tuple[float, float, float, float]:
-        return q_from_euler(rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1))
+        return euler_to_q(rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), rng.uniform(-3.1, 3.1))
 
     pairs += [(random_q(), random_q()) for _ in range(500)]
     for q, q_sp in pairs:
