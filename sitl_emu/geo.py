@@ -36,6 +36,11 @@ class GeoRef:
         object.__setattr__(self, "cos_lat", math.cos(lat_rad))
 
 
+def _unit_clamped(x: float) -> float:
+    """x limited to -1..1 for asin/acos (rounding can take a cosine past 1); NaN stays NaN."""
+    return -1.0 if x < -1.0 else (1.0 if x > 1.0 else x)
+
+
 def ned_to_global(ref: GeoRef, pos_ned_m: Vec3) -> tuple[float, float, float]:
     """(lat_deg, lon_deg, alt_amsl_m) of a local NED position."""
     x_rad = pos_ned_m[0] / EARTH_RADIUS_M
@@ -44,9 +49,7 @@ def ned_to_global(ref: GeoRef, pos_ned_m: Vec3) -> tuple[float, float, float]:
     if c > 0.0:
         sin_c, cos_c = math.sin(c), math.cos(c)
         sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
-        arg = cos_c * sin_ref + x_rad * sin_c * cos_ref / c
-        arg = arg if arg < 1.0 else 1.0  # max(-1.0, min(1.0, arg)), NaN kept
-        lat = math.asin(arg if arg > -1.0 else -1.0)
+        lat = math.asin(_unit_clamped(cos_c * sin_ref + x_rad * sin_c * cos_ref / c))
         lon = ref.lon_rad + math.atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
     else:
         lat, lon = ref.lat_rad, ref.lon_rad
@@ -61,8 +64,7 @@ def global_to_ned(ref: GeoRef, lat_deg: float, lon_deg: float, alt_amsl_m: float
     sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
     sin_lat, cos_lat = math.sin(lat), math.cos(lat)
     cos_d_lon = math.cos(d_lon)
-    arg = max(-1.0, min(1.0, sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))
-    c = math.acos(arg)
+    c = math.acos(_unit_clamped(sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))
     k = 1.0 if abs(c) < 1e-12 else c / math.sin(c)
     north = k * (cos_ref * sin_lat - sin_ref * cos_lat * cos_d_lon) * EARTH_RADIUS_M
     east = k * cos_lat * math.sin(d_lon) * EARTH_RADIUS_M
