@@ -196,6 +196,7 @@ class SessionCore:
         self.armed_seen = False  # the vehicle was armed at some point of this session: there is a flight to sum up
         self._restarts_seen = 0
         self._restart_s = -math.inf  # when joyfly last reported a restart of the vehicle
+        self._link_note_s = -math.inf  # when joyfly last said the link is lost (LINK_REMINDER_S apart)
         self._home_from_vehicle = False  # True when joyfly took over a flying vehicle: its HOME_POSITION is home
 
     def in_control(self, st: VehicleState) -> bool:

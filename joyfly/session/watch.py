@@ -6,8 +6,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from joyfly.link.vehicle_link import LINK_TIMEOUT_S
 from joyfly.session.core import STREAMING_PHASES, Level, Phase, SessionCore, restarted_message
 from joyfly.session.watchdogs import Change
+
+LINK_REMINDER_S = 30.0  # while the link stays lost, say so again this often (a silent wait looks like a hang)
 
 
 class SessionWatch(SessionCore):
@@ -37,8 +40,15 @@ class SessionWatch(SessionCore):
         lost_s = self._linkw.lost_s
         change = self._linkw.update(st.link_ok(now), now, st.stamped_s)
         if change is Change.LOST:
-            self._note(Level.WARN, f"Link lost: no HEARTBEAT from the vehicle for 3 s; still trying on "
-                               f"{self.link.transport.description}.")
+            self._link_note_s = now
+            self._note(Level.WARN, f"Link lost: no HEARTBEAT from the vehicle for {LINK_TIMEOUT_S:g} s; still trying "
+                                   f"on {self.link.transport.description}.")
+        elif not self._linkw.ok and lost_s is not None and now - self._link_note_s >= LINK_REMINDER_S:
+            self._link_note_s = now
+            silent_s = now - lost_s + LINK_TIMEOUT_S
+            self._note(Level.WARN, f"Still no HEARTBEAT after {silent_s:.0f} s: joyfly keeps trying on "
+                                   f"{self.link.transport.description} (Ctrl-C quits; the vehicle's own link-loss "
+                                   "failsafe acts meanwhile).")
         elif change is Change.BACK and (lost_s is None or self._restart_s < lost_s):  # else the restart note said it
             self._note(Level.INFO, "Link back: the vehicle answers again.")
             self._on_link_back()

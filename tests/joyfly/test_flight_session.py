@@ -189,6 +189,14 @@ def test_exit_request_lands_disarms_and_finishes() -> None:
     assert world.vehicle.pos[2] == pytest.approx(0.0)
 
 
+def test_a_long_link_loss_is_said_again_every_30_s_so_the_wait_does_not_look_like_a_hang() -> None:
+    world = airborne()
+    world.vehicle.speak = False
+    world.run_until(75.0)
+    reminders = [n for n in world.notes().splitlines() if n.startswith("Still no HEARTBEAT after")]
+    assert len(reminders) == 2 and "keeps trying" in reminders[0] and "Ctrl-C quits" in reminders[0]
+
+
 def test_exit_with_hold_leaves_the_vehicle_holding() -> None:
     world = airborne(on_exit="hold")
     world.session.request_exit()
