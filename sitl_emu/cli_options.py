@@ -134,7 +134,9 @@ def check_own_ports(links: Sequence[LinkSettings]) -> None:
     listening: dict[int, str] = {}
     for s in links:
         for option, port in (("--port", s.api_port), ("--gcs-port", s.gcs_port)):
-            if port and port in listening:
+            if not port:  # 0: any free port
+                continue
+            if port in listening:
                 raise UsageProblem(f"{listening[port]} and {option} give two links port {port} (with --count, "
                                    "vehicle N listens on each port + N): choose ports further apart.")
             listening[port] = option

@@ -42,11 +42,13 @@ class LinkSettings:
     gcs_remote: Address = ("127.0.0.1", 14550)
 
     def for_instance(self, instance: int) -> LinkSettings:
-        """Offset the ports as PX4's `-i N` does (px4-rc.mavlink); the GCS remote stays 14550."""
+        """Offset the ports as PX4's `-i N` does (px4-rc.mavlink); the GCS remote stays 14550, and a local port 0
+        (let the OS pick) stays 0."""
         if instance == 0:
             return self
         api_remote_port = self.api_remote[1] + instance if instance <= 9 else 14549
-        return replace(self, api_port=self.api_port + instance, gcs_port=self.gcs_port + instance,
+        return replace(self, api_port=self.api_port + instance if self.api_port else 0,
+                       gcs_port=self.gcs_port + instance if self.gcs_port else 0,
                        api_remote=(self.api_remote[0], api_remote_port))
 
 

@@ -17,7 +17,6 @@ import logging
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import replace
 
 from sitl_emu.geo import GeoRef, ned_to_global
 from sitl_emu.runtime.node import LinkSettings, NodeVehicle, VehicleNode
@@ -60,7 +59,7 @@ def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory
             instance = first_instance + i
             vehicle = make_vehicle(instance, instance_home(home, i, spacing_m))
             classes = handlers_for(instance) if handlers_for is not None else handler_classes
-            nodes.append(VehicleNode(vehicle, _offset(settings, instance), epoch_unix_us, classes,
+            nodes.append(VehicleNode(vehicle, settings.for_instance(instance), epoch_unix_us, classes,
                                      stream_delay_us(i)))
     except BaseException:
         for node in nodes:
@@ -72,12 +71,6 @@ def build_nodes(count: int, settings: LinkSettings, make_vehicle: VehicleFactory
 def stream_delay_us(index: int) -> int:
     """How long after the first tick the `index`-th vehicle of a swarm starts its streams."""
     return index * STREAM_STAGGER_US % 1_000_000
-
-
-def _offset(settings: LinkSettings, instance: int) -> LinkSettings:
-    """settings.for_instance(instance), except that a local port 0 (let the OS pick) stays 0."""
-    s = settings.for_instance(instance)
-    return replace(s, api_port=s.api_port if settings.api_port else 0, gcs_port=s.gcs_port if settings.gcs_port else 0)
 
 
 class SwarmRunner(RealTimeRunner):
