@@ -51,6 +51,8 @@ def view_process(args: list[str], cwd: Path, timeout_s: float = 60.0) -> Iterato
             url = urls.get(timeout=timeout_s)
         except queue.Empty:
             pytest.fail(f"no `live view:` line within {timeout_s:g} s; output: {''.join(lines)[-2000:]}")
+        if not url:  # its output ended: the command exited first
+            pytest.fail(f"the command ended before its `live view:` line; output: {''.join(lines)[-2000:]}")
         yield ViewProcess(proc, url, lines)
     finally:
         stop_process(proc)
@@ -65,6 +67,7 @@ def _read(proc: subprocess.Popen[str], lines: list[str], urls: queue.Queue[str])
         match = URL_LINE.search(line)
         if match:
             urls.put(match.group(1))
+    urls.put("")  # the output ended
 
 
 def listening_sockets(root_pid: int) -> list[Any]:
