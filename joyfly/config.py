@@ -168,14 +168,16 @@ def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any
 
 
 def _coerce(name: str, value: Any, origins: _Origins) -> Any:
-    default = getattr(FlyOptions(), name)
+    defaults = FlyOptions()
+    default = getattr(defaults, name)
     if isinstance(default, float):
         number = _number(value)
         if number is None:
             bound = BOUNDS[name]
-            d = FlyOptions()
-            within = (f"between min-alt and max-alt ({d.min_alt:g} and {d.max_alt:g} m unless you change them)"
-                      if name == "alt" else f"from {bound.lo:g} to {bound.hi:g} {bound.unit}")
+            within = f"from {bound.lo:g} to {bound.hi:g} {bound.unit}"
+            if name == "alt":  # checked against min-alt and max-alt, once they are known
+                within = (f"between min-alt and max-alt ({defaults.min_alt:g} and {defaults.max_alt:g} m unless you "
+                          "change them)")
             raise ConfigError(f"{origins.says(name, value)} is not a number: write a number {within}, for example "
                               f"{origins.example(name, default)}.")
         return number

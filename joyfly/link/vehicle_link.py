@@ -35,7 +35,6 @@ LINK_TIMEOUT_S = 3.0  # as MAVSDK's DEFAULT_HEARTBEAT_TIMEOUT_S (core/mavsdk_imp
 # than this means it restarted: UDP reorders by milliseconds, and PX4's streams stamp samples at most ~0.1 s old.
 RESTART_STEP_S = 1.0
 
-
 # Command retries: 0.5 s timeout, 3 transmissions, as MAVSDK (core/mavlink_command_sender.cpp DEFAULT_TIMEOUT_S,
 # DEFAULT_RETRIES); PX4 ACKs commander commands within one commander cycle (~10-20 ms).
 COMMAND_TIMEOUT_S = 0.5

@@ -36,10 +36,11 @@ class Kind(Enum):
 
 
 # what the navigator does with each command it acts on; any other is an action
-_KINDS: Final[dict[int, Kind]] = {MavCmd.NAV_WAYPOINT: Kind.WAYPOINT, MavCmd.NAV_LOITER_TO_ALT: Kind.WAYPOINT,
-                 MavCmd.NAV_TAKEOFF: Kind.TAKEOFF, MavCmd.NAV_LAND: Kind.LAND, MavCmd.NAV_LOITER_TIME: Kind.LOITER_TIME,
-                 MavCmd.NAV_LOITER_UNLIM: Kind.LOITER_UNLIM, MavCmd.NAV_DELAY: Kind.DELAY,
-                 MavCmd.NAV_RETURN_TO_LAUNCH: Kind.RTL, MavCmd.DO_JUMP: Kind.JUMP}
+_KINDS: Final[dict[int, Kind]] = {
+    MavCmd.NAV_WAYPOINT: Kind.WAYPOINT, MavCmd.NAV_LOITER_TO_ALT: Kind.WAYPOINT, MavCmd.NAV_TAKEOFF: Kind.TAKEOFF,
+    MavCmd.NAV_LAND: Kind.LAND, MavCmd.NAV_LOITER_TIME: Kind.LOITER_TIME, MavCmd.NAV_LOITER_UNLIM: Kind.LOITER_UNLIM,
+    MavCmd.NAV_DELAY: Kind.DELAY, MavCmd.NAV_RETURN_TO_LAUNCH: Kind.RTL, MavCmd.DO_JUMP: Kind.JUMP,
+}
 POSITION_KINDS: Final = frozenset({Kind.WAYPOINT, Kind.TAKEOFF, Kind.LAND, Kind.LOITER_TIME, Kind.LOITER_UNLIM})
 
 

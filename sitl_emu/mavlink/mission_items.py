@@ -86,7 +86,8 @@ UINT16_MAX = 0xFFFF
 def parse_item(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
     """(MAV_MISSION_RESULT, the item PX4 would keep) for a MISSION_ITEM(_INT); int_mode: it came as MISSION_ITEM_INT."""
     frame, command = msg.frame, msg.command
-    if frame in (MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT) or (int_mode and frame in _FLOAT_FRAMES):
+    int_frames = (MavFrame.GLOBAL_INT, MavFrame.GLOBAL_RELATIVE_ALT_INT)
+    if frame in (MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT) or (int_mode and frame in int_frames):
         return _parse_global(msg, int_mode)
     if frame != MavFrame.MISSION:
         return MAV_MISSION_UNSUPPORTED_FRAME, None

@@ -52,7 +52,6 @@ class LinkSettings:
                        api_remote=(self.api_remote[0], api_remote_port))
 
 
-
 class NodeVehicle(LinkVehicle, TickVehicle, Protocol):
     """A node's vehicle: what its links ask of it, and what the tick loop asks (sitl_emu.vehicle.Vehicle; a protocol,
     so that the compiled build takes the tests' stand-ins too)."""
