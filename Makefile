@@ -13,7 +13,7 @@ STAMP := $(VENV)/.installed-test
 $(DEMO_STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e .
+	$(BIN)/python -m pip install --quiet --no-compile -e .
 	touch $(DEMO_STAMP)
 
 $(STAMP): $(DEMO_STAMP)

@@ -29,7 +29,7 @@ def clone(tmp_path: Path) -> Path:
 
 def test_demo_installs_the_package_without_the_test_extra(clone: Path) -> None:
     commands = planned(clone, "demo")
-    assert "pip install --quiet -e ." in commands
+    assert "pip install --quiet --no-compile -e ." in commands
     assert "[test]" not in commands and "[view]" not in commands
     assert commands.rstrip().endswith("joyfly demo")
 
