@@ -2,7 +2,7 @@
 PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-# Two stamps: the demo needs the package only (a venv of about 270 MB, installed in well under a minute), the tests
+# Two stamps: the demo needs the package only (a venv of about 255 MB, installed in about 10 s), the tests
 # the whole [test] extra (MAVSDK, MAVProxy, Ray, Rerun, Selenium...: about 1.7 GB). `make test` after `make demo` adds
 # the test extra to the same venv.
 DEMO_STAMP := $(VENV)/.installed-demo
