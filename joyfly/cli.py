@@ -17,7 +17,7 @@ import click
 from flightview.launch import ViewOptions
 from flightview.options import view_options, view_settings
 from joyfly.cli_joystick import joystick
-from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
+from joyfly.cli_style import CONTEXT, TOOL, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
 from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import BOUNDS, CONTROLS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
@@ -37,7 +37,7 @@ D = FlyOptions()
 
 
 @click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
-@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s")
+@click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output on stderr (-v info, -vv debug).")
 def main(verbose: int) -> None:
     """Fly a PX4 quadrotor (PX4 SITL or `sitl-emu serve`) with a joystick over MAVLink."""

@@ -25,6 +25,7 @@ from sitl_emu.cli_options import (
     SPEED_MAX,
     SPEED_MIN,
     TOOL,
+    VERSION_MESSAGE,
     FiniteRange,
     OneLineGroup,
     UsageProblem,
@@ -182,7 +183,7 @@ def _wind_option(text: str | None) -> WindSettings | None:
 
 
 @click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
-@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s (the joyfly package)")
+@click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
 @click.pass_context
 def main(ctx: click.Context, verbose: int) -> None:

@@ -8,6 +8,7 @@ sitl_emu never imports joyfly: ARCHITECTURE.md); change both.
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 import socket
 from collections.abc import Sequence
@@ -58,8 +59,29 @@ def one_line(err: click.ClickException) -> UserError:
     return UserFailure(text) if err.exit_code == 1 else UserError(text)
 
 
+VERSION_MESSAGE = "%(prog)s %(version)s (the joyfly package)"  # what --version prints, on the tool and its commands
+
+
+def _show_version(ctx: click.Context, param: click.Parameter, value: bool) -> None:
+    if value and not ctx.resilient_parsing:
+        click.echo(VERSION_MESSAGE % {"prog": TOOL, "version": importlib.metadata.version("joyfly")})
+        ctx.exit()
+
+
+def version_option() -> click.Option:
+    """--version as on the tool itself, for one of its commands."""
+    return click.Option(["--version"], is_flag=True, expose_value=False, is_eager=True, callback=_show_version,
+                        help="Show the version and exit.")
+
+
 class OneLineGroup(click.Group):
-    """A click group whose errors, click's usage errors included, are one line (`UserError`)."""
+    """A click group whose errors, click's usage errors included, are one line (`UserError`); each command added to
+    it takes --version too, as the tool does."""
+
+    def add_command(self, cmd: click.Command, name: str | None = None) -> None:
+        if not any("--version" in param.opts for param in cmd.params):
+            cmd.params.append(version_option())
+        super().add_command(cmd, name)
 
     def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
                      **extra: Any) -> click.Context:
