@@ -97,8 +97,8 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
       "vehicle's clock says otherwise.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 @view_options
-def fly(config_path: str | None, view: bool, view_port: int | None, record_view: Path | None,
-        **cli_options: Any) -> None:
+def fly(config_path: str | None, view: bool, view_port: int | None, view_grpc_port: int | None,
+        record_view: Path | None, **cli_options: Any) -> None:
     """Connect, take off to --alt in OFFBOARD (or arm in PX4's Position/Altitude mode with --control position/altitude)
     and fly with the joystick; Ctrl-C lands (see --on-exit)."""
     try:
@@ -106,7 +106,7 @@ def fly(config_path: str | None, view: bool, view_port: int | None, record_view:
         opts = build_options(file_options, cli_options, source=config_path)
     except (ConfigError, JoystickError) as err:
         raise UserError(str(err)) from None
-    view_opts = view_settings(view, view_port, record_view)
+    view_opts = view_settings(view, view_port, record_view, view_grpc_port)
     check_view_options(view_opts)
     sys.exit(run_fly(opts, profile_table, view_options=view_opts))
 
@@ -161,17 +161,22 @@ def throttle_problem(control: str, profile: Any) -> str | None:
 @click.option("--wind", default=None, metavar="SPEED@FROM[,TURBULENCE]",
               help="Wind on the built-in emulator, as `sitl-emu serve --wind`: e.g. 5@270 (5 m/s from the west), "
                    "5@270,light|moderate|severe or a W20 in m/s.")
+@click.option("--gcs-remote", default=None, metavar="HOST:PORT",
+              help="Send the built-in emulator's ground-station telemetry there (127.0.0.1:14550: a QGroundControl "
+                   "on this machine) [default: nowhere until a ground station talks to its port, which the demo "
+                   "prints].")
 @view_options
 def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str, wind: str | None,
-         view: bool, view_port: int | None, record_view: Path | None) -> None:
+         gcs_remote: str | None, view: bool, view_port: int | None, view_grpc_port: int | None,
+         record_view: Path | None) -> None:
     """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
     from joyfly.demo import DemoError, run_demo
 
-    view_opts = view_settings(view, view_port, record_view)
+    view_opts = view_settings(view, view_port, record_view, view_grpc_port)
     check_view_options(view_opts)
     try:
         sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control,
-                          view_options=view_opts, wind=wind))
+                          view_options=view_opts, wind=wind, gcs_remote=gcs_remote))
     except (DemoError, TransportError, JoystickError) as err:
         raise UserError(str(err)) from None
 
