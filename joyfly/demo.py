@@ -98,7 +98,7 @@ class EmbeddedVehicle:
     def __init__(self, joyfly_port: int, speed: float, wind: str | None = None) -> None:
         """`wind` is `sitl-emu serve --wind`'s SPEED@FROM_DEG[,TURBULENCE] text (None: calm air)."""
         try:
-            from sitl_emu.cli import build_params, build_vehicle
+            from sitl_emu.cli.main import build_params, build_vehicle
             from sitl_emu.disturbance.wind import parse_wind
             from sitl_emu.runtime.node import LinkSettings, VehicleNode
             from sitl_emu.runtime.runner import RealTimeRunner

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from sitl_emu.cli import main
+from sitl_emu.cli.main import main
 
 if __name__ == "__main__":
     main(prog_name="sitl-emu")

@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sitl_emu.cli_options import SEED_MAX, FiniteRange, UserError, WholeRange
+from sitl_emu.cli.options import SEED_MAX, FiniteRange, UserError, WholeRange
 
 __all__ = ["campaign"]
 

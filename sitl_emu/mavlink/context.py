@@ -21,9 +21,9 @@ if TYPE_CHECKING:
 
     from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
 
-    from sitl_emu.flight.mission_store import MissionStore
-    from sitl_emu.mavlink.encoding import MessageEncoder
-    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.mavlink.wire.encoding import MessageEncoder
+    from sitl_emu.mavlink.wire.fastpack import Packed
+    from sitl_emu.navigator.mission_store import MissionStore
     from sitl_emu.params import ParamRegistry
     from sitl_emu.px4 import Severity
     from sitl_emu.types import (
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
         VehicleEvent,
         VehicleSnapshot,
     )
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
     OutMessage: TypeAlias = MAVLink_message | Packed

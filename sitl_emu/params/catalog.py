@@ -70,7 +70,7 @@ def emulator_definitions() -> list[ParamDef]:
     """The `defs_*.py` definitions, in domain order."""
     defs: list[ParamDef] = []
     for domain in DOMAINS:
-        module = importlib.import_module(f"sitl_emu.params.defs_{domain}")
+        module = importlib.import_module(f"sitl_emu.params.defs.{domain}")
         defs.extend(module.PARAMS)
     return defs
 

@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 from sitl_emu.mavlink.context import LinkVehicle
 from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
 from sitl_emu.mavlink.link import Address, UdpLink
-from sitl_emu.mavlink.telemetry import StreamMode
+from sitl_emu.mavlink.telemetry.streams import StreamMode
 from sitl_emu.runtime.timeline import TickVehicle
 from sitl_emu.types import VehicleSnapshot
 
 if TYPE_CHECKING:
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from sitl_emu.mavlink.ftp_protocol import MAX_DATA, Err, Op, Payload
+from sitl_emu.mavlink.protocols.ftp import MAX_DATA, Err, Op, Payload
 from support.fakes import Harness
 
 MAX_TICKS = 50  # a reply comes in the tick after the request; bursts take more

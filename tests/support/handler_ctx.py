@@ -12,7 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.flight.mission_store import MissionStore
+from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.px4 import LandedState, MavResult, NavState, Severity
 from sitl_emu.types import CommandAck, VehicleCommand, VehicleEvent, VehicleSnapshot

@@ -8,11 +8,11 @@ import math
 
 import pytest
 
+from sitl_emu.console.shell import Shell
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, MavResult, NavState, Severity
-from sitl_emu.shell import Shell
 from sitl_emu.types import CommandAck, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 GPS, BATTERY, MOTOR, RC_SIGNAL = 4.0, 100.0, 101.0, 104.0

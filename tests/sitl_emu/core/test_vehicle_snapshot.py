@@ -8,7 +8,7 @@ import math
 from sitl_emu.geo import GeoRef, ned_to_global
 from sitl_emu.px4 import MavState, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 

@@ -13,8 +13,8 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink import extra_messages as xm
-from sitl_emu.mavlink import fastpack
+from sitl_emu.mavlink.wire import extra_messages as xm
+from sitl_emu.mavlink.wire import fastpack
 
 # (CRC_EXTRA, payload length) of the C headers generated from mavlink/mavlink's XML
 PUBLISHED = {"LINK_NODE_STATUS": (117, 36), "ESC_INFO": (251, 46), "ESC_STATUS": (10, 57),

@@ -22,7 +22,7 @@ import pytest
 from support.fakes import Client, Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 REF = Path(__file__).parents[2] / "reference" / "px4-mission"
 CASES: dict[str, Any] = json.loads((REF / "cases.json").read_text())
