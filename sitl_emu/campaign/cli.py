@@ -1,4 +1,4 @@
-"""`sitl-emu campaign`: the command line of sitl_emu.campaign (sitl_emu/cli.py only lists this command)."""
+"""`sitl-emu campaign`: the command line of sitl_emu.campaign (sitl_emu/cli/main.py only lists this command)."""
 
 from __future__ import annotations
 

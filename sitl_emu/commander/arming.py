@@ -76,8 +76,8 @@ class CheckInputs:
     home_valid: bool
     offboard_signal: bool  # an offboard_control_mode with a setpoint kind, younger than COM_OF_LOSS_T
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
-    mission_valid: bool = False  # a valid mission is stored (flight/mission_store.py MissionStore.mission_valid)
-    position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle_faults.py)
+    mission_valid: bool = False  # a valid mission is stored (navigator/mission_store.py MissionStore.mission_valid)
+    position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle/faults.py)
 
     def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
                  mission_valid: bool = False, position_lost: bool = False) -> None:

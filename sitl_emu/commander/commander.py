@@ -2,7 +2,7 @@
 
 A pure state machine: simulated time comes in as `now_us`, texts go out through the `emit` callback, requests for
 the navigator (takeoff altitude, reposition, altitude change) queue in `nav_commands`. Commands are handled by
-`sitl_emu.flight.commands.handle_command(commander, ...)`. Sources: src/modules/commander/Commander.cpp (arm ~l.663,
+`sitl_emu.commander.commands.handle_command(commander, ...)`. Sources: src/modules/commander/Commander.cpp (arm ~l.663,
 disarm ~l.744, handleAutoDisarm ~l.2455, takeoff completion ~l.2208, land detector texts ~l.2310),
 UserModeIntention.cpp, failsafe/failsafe.cpp. See ../shared/reference/px4-behaviour.md sections 2-5.
 """
@@ -69,14 +69,14 @@ class Commander:
         self._ready_announced = False
         self._armed_at_us = 0
         self._landed_since_us: int | None = None
-        self._offboard = OffboardSignal()  # flight/offboard.py: what happens when the setpoints stop
-        self.manual = ManualControlSignal()  # flight/manual_control.py: the MAVLink joystick as RC
+        self._offboard = OffboardSignal()  # commander/offboard.py: what happens when the setpoints stop
+        self.manual = ManualControlSignal()  # commander/manual_control.py: the MAVLink joystick as RC
         self._manual_lost_at_arming = True
         self._gestures = GestureDetector()
         self._stick_motion = StickMotion()
         self._last_reject_text_us: int | None = None
-        self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle_faults.py)
-        self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (flight/geofence_monitor.py)
+        self.fault_flags = FaultFlags()  # written by the vehicle's fault monitor (vehicle/faults.py)
+        self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (navigator/geofence_monitor.py)
         self._checks_key: tuple[object, ...] = ()  # what pre_flight_checks_pass last ran for
         self._checks_pass = False
         self.mission_store: MissionStore | None = None  # the stored plans (the Vehicle's), for AUTO.MISSION's checks
@@ -102,7 +102,7 @@ class Commander:
 
     def manual_control_signal(self, now_us: int, setpoint: ManualControlSetpoint) -> bool:
         """A MANUAL_CONTROL arrived (any mode); False if COM_RC_IN_MODE ignores MAVLink input. The sticks' gestures
-        and a pilot's takeover act at once (flight/stick_gestures.py)."""
+        and a pilot's takeover act at once (commander/stick_gestures.py)."""
         regained = not self.manual_control_valid(now_us)
         if not self.manual.refresh(now_us, setpoint, self.settings.rc_in_mode):
             return False

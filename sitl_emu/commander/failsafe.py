@@ -3,7 +3,7 @@
 After src/modules/commander/failsafe/failsafe.cpp (checkModeFallback, fromOffboardLossActParam,
 fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activated", clear conditions):
 - mode fallbacks act at once (no COM_FAIL_ACT_T hold); the manual-control loss action holds first
-  (flight/manual_control.py), and a manual mode left without sticks is its business, not a fallback's;
+  (commander/manual_control.py), and a manual mode left without sticks is its business, not a fallback's;
 - OFFBOARD without a fresh signal -> COM_OBL_RC_ACT; a Position/Altitude/Stabilized fallback without manual control
   (the SITL norm) becomes NAV_RCL_ACT (default Return);
 - a fallback mode that cannot run degrades further: Position -> Altitude -> Stabilized -> NAV_RCL_ACT,
@@ -11,7 +11,7 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
 - the fallback clears as soon as the user's mode can run again (WhenConditionClears), and an explicit mode change
   by the user ends it (the new mode can run, or the change was refused);
 - flight termination (DO_FLIGHTTERMINATION) holds TERMINATION while armed;
-- a geofence breach acts as GF_ACTION says (flight/geofence_failsafe.py), ranked with the others.
+- a geofence breach acts as GF_ACTION says (commander/geofence_failsafe.py), ranked with the others.
 """
 
 from __future__ import annotations
@@ -127,14 +127,14 @@ class Failsafe:
 
     Two kinds of failsafe, combined as framework.cpp does (the worst action wins):
     - mode fallbacks: the user's mode cannot run (no offboard signal, no manual control...): at once;
-    - the manual-control loss action (flight/manual_control.py): after the COM_FAIL_ACT_T Hold.
+    - the manual-control loss action (commander/manual_control.py): after the COM_FAIL_ACT_T Hold.
     The user is told when the action in force gets worse: "Failsafe activated" (or "... entering Hold for N seconds"
     when the Hold before a delayed action begins)."""
 
     def __init__(self) -> None:
         self.active = False
         self.manual_loss = ManualLossFailsafe()
-        self.faults = FaultFailsafes()  # link loss, battery, failure detector (flight/fault_failsafes.py)
+        self.faults = FaultFailsafes()  # link loss, battery, failure detector (commander/fault_failsafes.py)
         self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
 

@@ -7,7 +7,7 @@ FailureTable.cpp isSupported and the mask rules; FailureStrings.hpp the names), 
 (SYS_FAILURE_EN, reboot required: the manager runs only if it was 1 at boot; PX4 SITL's rcS sets it to 1).
 
 What fails here (the rest is accepted and tabled but changes nothing in SIH's emulation):
-- gps off: no GPS: the estimator dead-reckons for EKF2_NOAID_TOUT, then has no horizontal position (vehicle_faults);
+- gps off: no GPS: the estimator dead-reckons for EKF2_NOAID_TOUT, then has no horizontal position (vehicle/faults.py);
 - motor off (instance n = motor n, 0 all): the control allocator stops that output (ControlAllocator.cpp
   motor_stop_mask from the failure detector's FailureInjector);
 - battery off: remaining 0 and the emergency warning (FailureInjection.cpp process_battery).

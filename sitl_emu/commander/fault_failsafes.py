@@ -1,11 +1,11 @@
 """The failsafes of faults: ground-station link loss, low battery, and the failure detector's attitude check.
 
-The commander's Failsafe (flight/failsafe.py) asks `FaultFailsafes.wanted` every cycle for the modes these sources
+The commander's Failsafe (commander/failsafe.py) asks `FaultFailsafes.wanted` every cycle for the modes these sources
 want, and the worst action wins, as framework.cpp combines them. Sources (src/modules/commander/failsafe/):
 - GCS connection loss (failsafe.cpp, gcs_connection_lost): NAV_DLL_ACT (0 disabled, 1 Hold, 2 Return, 3 Land,
   5 Terminate, 6 Disarm) after the COM_FAIL_ACT_T Hold, not in the modes COM_DLL_EXCEPT excepts nor in Land;
-  cleared by a mode change or disarming (the same machinery as manual-control loss: flight/manual_control.py);
-- battery warning (flight/battery.py): COM_LOW_BAT_ACT at critical / emergency, the Hold first on the first action;
+  cleared by a mode change or disarming (the same machinery as manual-control loss: commander/manual_control.py);
+- battery warning (commander/battery.py): COM_LOW_BAT_ACT at critical / emergency, the Hold first on the first action;
 - failure detector (fd_critical_failure, roll or pitch beyond FD_FAIL_R / FD_FAIL_P for FD_FAIL_R_TTRI /
   FD_FAIL_P_TTRI): disarm during the first COM_SPOOLUP_TIME + 3 s after arming, else terminate unless the
   CBRK_FLIGHTTERM circuit breaker is set (121212, PX4's default), then only a warning.

@@ -8,7 +8,7 @@ ManualControlSelector.cpp, commander's manual-control checks):
    (RC and MAVLink by priority; the emulator has no RC, so MAVLink wins) take it, 0 (RC only) and 4 (stick input
    disabled) ignore it.
 3. The input is valid while the last setpoint is younger than COM_RC_LOSS_T; manual modes (POSCTL, ALTCTL,
-   STABILIZED...) need it to run (flight/arming.py Req.MANUAL), and the flight tasks read its sticks.
+   STABILIZED...) need it to run (commander/arming.py Req.MANUAL), and the flight tasks read its sticks.
 4. The stream stops while armed (`ManualLossFailsafe` below): NAV_RCL_ACT (Return by default) after holding for
    COM_FAIL_ACT_T ("Failsafe activated: entering Hold for 5 seconds", then "Failsafe activated"), in every mode
    but those COM_RCL_EXCEPT excepts, and not at all if the vehicle was armed without manual control. Sticks coming

@@ -3,11 +3,11 @@
 The story, end to end (PX4: offboardCheck.cpp, mode_requirements.cpp, failsafe.cpp checkModeFallback):
 1. Every accepted SET_POSITION_TARGET_* / SET_ATTITUDE_TARGET (mavlink/receiver.py, mavlink/setpoints.py) becomes an
    offboard_control_mode plus a setpoint: `Vehicle.offboard_input` refreshes the `OffboardSignal` below in ANY mode,
-   and hands the setpoint to the mode executor (flight/mode_executor.py), which flies it only in OFFBOARD.
+   and hands the setpoint to the mode executor (flight_tasks/mode_executor.py), which flies it only in OFFBOARD.
 2. The signal is fresh while a setpoint kind is set and the last one is younger than COM_OF_LOSS_T (1 s). Without a
-   fresh signal OFFBOARD cannot run (flight/arming.py): switching to it while armed is refused, and arming in it is
+   fresh signal OFFBOARD cannot run (commander/arming.py): switching to it while armed is refused, and arming in it is
    refused ("No offboard signal"); while disarmed the switch is accepted, as PX4 does.
-3. Setpoints stop in flight: the signal goes stale, OFFBOARD can no longer run, and the failsafe (flight/failsafe.py)
+3. Setpoints stop in flight: the signal goes stale, OFFBOARD can no longer run, and the failsafe (commander/failsafe.py)
    puts COM_OBL_RC_ACT's fallback in force at once ("Failsafe activated"): without manual control Position cannot
    run either, so NAV_RCL_ACT decides, Return by default. The user's intention stays OFFBOARD.
 4. Setpoints come back: the signal is fresh again and, the intention still being OFFBOARD, the vehicle returns to

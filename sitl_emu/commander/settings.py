@@ -24,7 +24,7 @@ class CommanderSettings:
     manual_loss: ManualLossSettings  # NAV_RCL_ACT, COM_RCL_EXCEPT, COM_FAIL_ACT_T
     arm_gesture: bool  # MAN_ARM_GESTURE
     override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
-    faults: FaultSettings  # NAV_DLL_ACT, COM_LOW_BAT_ACT, CBRK_FLIGHTTERM... (flight/fault_failsafes.py)
+    faults: FaultSettings  # NAV_DLL_ACT, COM_LOW_BAT_ACT, CBRK_FLIGHTTERM... (commander/fault_failsafes.py)
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> CommanderSettings:

@@ -1,6 +1,6 @@
 """The terminal console of `sitl-emu serve`: PX4's pxh> prompt on stdin/stdout.
 
-A daemon thread only reads lines into a queue (sitl_emu/console_input.py: readline on a terminal, in the foreground
+A daemon thread only reads lines into a queue (sitl_emu/console/terminal.py: readline on a terminal, in the foreground
 only); everything else happens in `pump()`, which the server loop calls each iteration on its own thread: run the
 queued command lines through the Shell, print what a running command (`listener -n N`) prints, print the vehicle's
 new events as PX4 console log lines ("INFO  [commander] Armed by internal command"), and show the prompt again.

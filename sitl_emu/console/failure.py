@@ -1,7 +1,7 @@
 """`failure <component> <type> [-i instance | -m mask]` on the pxh> console and the MAVLink shell.
 
 After src/systemcmds/failure/failure.cpp: refused unless SYS_FAILURE_EN is 1; the unit and type by name (the names of
-sitl_emu/flight/failure_injection.py); one internal MAV_CMD_INJECT_FAILURE (param3 the instance, or NaN with the
+sitl_emu/commander/failure_injection.py); one internal MAV_CMD_INJECT_FAILURE (param3 the instance, or NaN with the
 mask in param4), then the ACK: an error line with the result if it is not ACCEPTED, or a timeout if none comes (the
 failure injection manager did not start: SYS_FAILURE_EN was 0 at boot).
 """

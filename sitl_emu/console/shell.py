@@ -3,9 +3,9 @@
 What each command sends and prints follows PX4 (v1.15):
 - `commander ...`: src/modules/commander/Commander.cpp custom_command(): every subcommand publishes an internal
   vehicle_command (from_external false, source = own sysid/compid); results appear later as log lines (events).
-- `param ...`: sitl_emu/shell_param.py (src/systemcmds/param/param.cpp).
-- `mission`: sitl_emu/shell_mission.py (our addition: the stored plans and the mission's progress).
-- `listener ...`: src/systemcmds/topic_listener/listener_main.cpp (see sitl_emu/listener.py). With -n N the messages
+- `param ...`: sitl_emu/console/param.py (src/systemcmds/param/param.cpp).
+- `mission`: sitl_emu/console/mission.py (our addition: the stored plans and the mission's progress).
+- `listener ...`: src/systemcmds/topic_listener/listener_main.cpp (see listener.py). With -n N the messages
   come one by one as the topic is published, so the command keeps running after `execute` returns: the caller prints
   `poll()`'s output each loop and shows the next prompt once `busy` is False, as pxh does when the command returns.
 - line handling and errors: platforms/posix/src/px4/common/px4_daemon/pxh.cpp process_line().

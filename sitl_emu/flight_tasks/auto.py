@@ -2,7 +2,7 @@
 
 Each factory returns a `Task` for one activation of a mode; the commander calls `task.update(nav, dt_s)` every
 cycle and hands the `TrajectorySetpoint` to the controller. Behaviour after PX4's navigator
-(`src/modules/navigator/{takeoff,loiter,land,rtl,rtl_direct}.cpp`) and FlightTaskAuto (see `tasks_core`).
+(`src/modules/navigator/{takeoff,loiter,land,rtl,rtl_direct}.cpp`) and FlightTaskAuto (see `core`).
 """
 
 from __future__ import annotations
@@ -153,7 +153,7 @@ def make_land(nav: NavInput, params: ParamRegistry) -> Task:
 def make_rtl(nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
              loiter_at_ned_m: Vec3 | None = None) -> Task:
     """Return: climb to the return altitude, fly home (or to `destination`: NED position and yaw, a rally point
-    flight/rally.py chose) at MPC_XY_CRUISE, land (RTL_LAND_DELAY: wait first); `loiter_at_ned_m`: climb there (the
+    navigator/rally.py chose) at MPC_XY_CRUISE, land (RTL_LAND_DELAY: wait first); `loiter_at_ned_m`: climb there (the
     loiter a finished mission left)."""
     return RtlTask(nav, params, destination, loiter_at_ned_m)
 

@@ -298,7 +298,7 @@ class Task:
     """One activation of an auto mode. Subclasses implement `_waypoint(nav)`."""
 
     # flight_mode_manager runs the task on each estimator update; sitl_emu runs the auto tasks with the position
-    # controller (125 Hz), the manual ones at FlightModeManager's 50 Hz (tasks_manual.py)
+    # controller (125 Hz), the manual ones at FlightModeManager's 50 Hz (manual.py)
     period_us = 8000
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:

@@ -1,7 +1,7 @@
 """AUTO.FOLLOW_TARGET: PX4's follow-target flight task for a multicopter.
 
 Written from src/modules/flight_mode_manager/tasks/AutoFollowTarget/FlightTaskAutoFollowTarget.{hpp,cpp}:
-- the target estimate (flight/follow_estimator.py) is smoothed by a second-order reference model (1 rad/s, damping
+- the target estimate (flight_tasks/follow_estimator.py) is smoothed by a second-order reference model (1 rad/s, damping
   0.7071) that gives a kinematically feasible target position and velocity;
 - the vehicle keeps FLW_TGT_DST from the target at the angle FLW_TGT_FA (0 in front of the target's course, clockwise,
   180 behind) around it; the orbit angle around the target follows the target's course (tracked only while the

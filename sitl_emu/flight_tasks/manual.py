@@ -1,5 +1,5 @@
 """The manual modes' flight tasks: Altitude (ALTCTL) and Position (POSCTL, MPC_POS_MODE 4), and Stabilized's stick
-mapping. The sticks are the last manual input (flight/manual_control.py), set on the task before each update.
+mapping. The sticks are the last manual input (commander/manual_control.py), set on the task before each update.
 
 After PX4's flight_mode_manager tasks FlightTaskManualAltitude -> FlightTaskManualAltitudeSmoothVel ->
 FlightTaskManualAcceleration (src/modules/flight_mode_manager/tasks/...), motion_planning/ManualVelocitySmoothingZ
@@ -7,7 +7,7 @@ and mc_att_control's generate_attitude_setpoint (Stabilized). Per cycle (FlightM
 - vertical: the throttle around its centre commands a climb rate (deadzone, expo; MPC_Z_VEL_MAX_UP/DN), slowed near
   the ground (MPC_TKO_SPEED up and MPC_LAND_SPEED down below MPC_LAND_ALT2, blended up to MPC_LAND_ALT1), smoothed
   with jerk and acceleration limits; the altitude locks once the climb rate has stopped;
-- heading: the yaw stick commands a yaw rate (flight/sticks.py StickYaw);
+- heading: the yaw stick commands a yaw rate (flight_tasks/sticks.py StickYaw);
 - horizontal: Position mode's acceleration sticks with a position lock, or Altitude mode's tilt sticks;
 - takeoff: the throttle above 0.3 asks for it (vehicle_constraints.want_takeoff); until the controller's takeoff
   ramp has begun the task restarts every cycle from the vehicle, as FlightModeManager re-activates it.

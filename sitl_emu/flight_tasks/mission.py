@@ -1,5 +1,5 @@
-"""AUTO.MISSION as a navigator task: the mission navigator (flight/mission.py) picks the items, this task turns its
-position setpoint triplet into the waypoints FlightTaskAuto flies (tasks_core.AutoCore).
+"""AUTO.MISSION as a navigator task: the mission navigator (navigator/mission.py) picks the items, this task turns its
+position setpoint triplet into the waypoints FlightTaskAuto flies (core.AutoCore).
 
 The navigator itself outlives the task (PX4 keeps one Mission object, so a paused mission resumes at its current
 item): the executor owns it (MissionFlight) and hands it to each activation.

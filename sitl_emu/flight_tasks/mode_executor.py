@@ -7,8 +7,8 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 - Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
   loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
 - OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
-- POSCTL and ALTCTL run the manual flight tasks (flight/tasks_manual.py) on the latest sticks; STABILIZED and
-  MANUAL turn the sticks into an attitude and thrust every tick (flight/stabilized.py); termination has no
+- POSCTL and ALTCTL run the manual flight tasks (flight_tasks/manual.py) on the latest sticks; STABILIZED and
+  MANUAL turn the sticks into an attitude and thrust every tick (flight_tasks/stabilized.py); termination has no
   setpoint (the motors stop).
 """
 
@@ -124,7 +124,7 @@ class ModeExecutor:
                commands: list[NavCommand], ref: GeoRef, dt_s: float,
                sticks: ManualControlSetpoint = CENTRED) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts); `sticks`
-        is the last manual input (the commander's, flight/manual_control.py), for the manual modes."""
+        is the last manual input (the commander's, commander/manual_control.py), for the manual modes."""
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
         if nav_state in _STICK_ATTITUDE_MODES:
             return self._stick_attitude(armed, nav_fn, dt_s, sticks)

@@ -3,7 +3,7 @@
 States as RtlDirect: CLIMBING (to the return altitude above the current position) -> MOVE_TO_LOITER (home at the
 return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise LOITER_DOWN (to RTL_DESCEND_ALT) ->
 LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The destination is home or the rally
-point RTL_TYPE selects (flight/rally.py; "home" below means that destination). The return altitude follows
+point RTL_TYPE selects (navigator/rally.py; "home" below means that destination). The return altitude follows
 RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
 """
 
@@ -51,7 +51,7 @@ class RtlTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
                  loiter_at_ned_m: Vec3 | None = None) -> None:
         """`destination`: where to return (rtl.cpp findRtlDestination: home, or a rally point chosen by
-        flight/rally.py), NED position and yaw. `loiter_at_ned_m`: the loiter the vehicle was established on when RTL
+        navigator/rally.py), NED position and yaw. `loiter_at_ned_m`: the loiter the vehicle was established on when RTL
         began (a finished mission's last setpoint): the climb keeps its centre (rtl_direct.cpp CLIMBING,
         is_established_on_loiter); else the climb is centred where the vehicle is."""
         super().__init__(nav, params)

@@ -3,7 +3,7 @@
 After mc_att_control's generate_attitude_setpoint (src/modules/mc_att_control/mc_att_control_main.cpp) and its
 throttle_curve: no flight task and no position control. Per tick:
 - the right stick tilts the vehicle, full stick = MPC_MAN_TILT_MAX (raw sticks, no deadzone or expo);
-- the yaw stick commands a yaw rate (flight/sticks.py StickYaw), the heading locking once it stops; with the
+- the yaw stick commands a yaw rate (flight_tasks/sticks.py StickYaw), the heading locking once it stops; with the
   throttle fully down the heading lock is dropped (so the arming gesture does not wind up a yaw error);
 - the throttle goes through PX4's curve (MPC_THR_CURVE 0): low stick = the minimum thrust (0 on the ground,
   MPC_MANTHR_MIN in the air, slewed at 0.05/s), centre = the hover thrust, full = MPC_THR_MAX; after arming the

@@ -1,6 +1,6 @@
 """`sitl-emu log FILE.ulg`: a ULog file summarised in the terminal, and with --plot drawn to a PNG (issue 15).
 
-sitl_emu/cli.py only lists this command; summary.py reads the file, plot.py draws it.
+sitl_emu/cli/main.py only lists this command; summary.py reads the file, plot.py draws it.
 """
 
 from __future__ import annotations

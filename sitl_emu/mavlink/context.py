@@ -78,7 +78,7 @@ class EndpointStats:
 class LinkVehicle(Protocol):
     """The vehicle as the links see it: all that the endpoint, its parts and the protocol handlers ask of it.
 
-    sitl_emu/vehicle.py's Vehicle is one (checked below); the link's unit tests drive it with a recording stand-in
+    vehicle/vehicle.py's Vehicle is one (checked below); the link's unit tests drive it with a recording stand-in
     (tests/support/fakes.py). Typed as this protocol, the compiled build does not insist on the Vehicle class.
     """
 
@@ -180,8 +180,8 @@ class Handler(Protocol):
 
 
 def vehicle_news(vehicle: LinkVehicle) -> tuple[int, int, bool, int]:
-    """What protocol handlers act on between messages: the parameters' version (params_protocol sends changed
-    values, as PX4's parameter_update subscription) and the navigator's mission progress (mission_protocol reports
+    """What protocol handlers act on between messages: the parameters' version (protocols/params.py sends changed
+    values, as PX4's parameter_update subscription) and the navigator's mission progress (protocols/mission.py reports
     it, as PX4's mission_result subscription)."""
     store = vehicle.mission_store()
     return vehicle.params.version, store.current_seq, store.finished, store.seq_reached

@@ -98,7 +98,7 @@ class Endpoint:
         # pymavlink's encoder: handlers build messages with it; its `seq` is this link's sequence number, which
         # send() continues (one sequence per link, whichever way a message was built)
         self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
-        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/fastpack.py): same calls, cheaper messages
+        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/wire/fastpack.py): same calls, cheaper messages
         self._parser = _new_parser()
         self.stats = EndpointStats()
         self.streams = Streams(mode, stream_delay_us)

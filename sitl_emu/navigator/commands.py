@@ -13,7 +13,7 @@ class NavCommandKind(Enum):
     TAKEOFF = "takeoff"
     REPOSITION = "reposition"
     CHANGE_ALTITUDE = "change_altitude"
-    ORBIT = "orbit"  # DO_ORBIT: the orbit flight task applies it (flight/tasks_orbit.py)
+    ORBIT = "orbit"  # DO_ORBIT: the orbit flight task applies it (flight_tasks/orbit.py)
 
 
 @dataclass(frozen=True, slots=True)

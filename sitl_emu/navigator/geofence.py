@@ -1,5 +1,5 @@
 """The geofence: the uploaded fence plan as polygons and circles, GF_MAX_HOR_DIST / GF_MAX_VER_DIST around home, and
-PX4's point tests. Pure: no MAVLink, no clock (the breach check over time is flight/geofence_monitor.py).
+PX4's point tests. Pure: no MAVLink, no clock (the breach check over time is navigator/geofence_monitor.py).
 
 After src/modules/navigator/geofence.cpp (PX4 main, 2026-08):
 - _updateFence walks the stored fence items: a polygon starts at a POLYGON_VERTEX_INCLUSION/EXCLUSION item and

@@ -11,7 +11,7 @@ _updateFence when mission.geofence_id changes):
   Hold flies back to where the breach was seen) and latches: while it loiters after the breach the flags can be set
   but not cleared (so hovering at the boundary does not toggle the failsafe), until it leaves Hold (100 ms after);
 - the commander (geofenceCheck.cpp) makes geofence_breached of the flags and GF_ACTION, logs one CRITICAL text per
-  flag when its report changes, and the failsafe acts (flight/geofence_failsafe.py).
+  flag when its report changes, and the failsafe acts (commander/geofence_failsafe.py).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 In PX4 the MAVLink mission manager (src/modules/mavlink/mavlink_mission.cpp) writes uploaded items into dataman and
 publishes the `mission` topic (count, current_seq, a CRC32 of the plan per type) that the navigator flies. Here the
 store is that dataman plus topic, in memory, with no MAVLink: the protocol handler (sitl_emu/mavlink/
-mission_protocol.py) turns wire messages into MissionItem values and replaces a whole plan at once, so a plan is
+protocols/mission.py) turns wire messages into MissionItem values and replaces a whole plan at once, so a plan is
 never half-written (PX4 writes a transfer into the inactive dataman slot and switches slots only when it completes).
 
 Not persistent: PX4 SITL keeps dataman in a `dataman` file in its working directory, so there a plan survives a
@@ -92,11 +92,11 @@ class MissionStore:
     current_seq: int = 0
     transfer_owner: object | None = None  # the link (protocol handler) whose upload is running
     uploads: int = 0  # completed mission uploads (PX4 looks MIS_DIST_1WP etc. up from the first one)
-    # the navigator's mission_result (flight/tasks_mission.py publishes it): the last item reached, the end
+    # the navigator's mission_result (flight_tasks/mission.py publishes it): the last item reached, the end
     seq_reached: int = -1
     finished: bool = False
     current_changes: int = 0  # MISSION_SET_CURRENT / MISSION_START requests, for the navigator to follow
-    fence_violation: str | None = None  # the navigator's mission-vs-geofence check (vehicle_fence.py), None: passes
+    fence_violation: str | None = None  # the navigator's mission-vs-geofence check (vehicle/fence.py), None: passes
 
     def plan(self, plan_type: int) -> Plan:
         return self.plans[plan_type]

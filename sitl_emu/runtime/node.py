@@ -53,7 +53,7 @@ class LinkSettings:
 
 
 class NodeVehicle(LinkVehicle, TickVehicle, Protocol):
-    """A node's vehicle: what its links ask of it, and what the tick loop asks (sitl_emu.vehicle.Vehicle; a protocol,
+    """A node's vehicle: what its links ask of it, and what the tick loop asks (vehicle/vehicle.py Vehicle; a protocol,
     so that the compiled build takes the tests' stand-ins too)."""
 
 

@@ -49,7 +49,7 @@ class ControlChain:
         self._land_armed = False
 
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
-        """What the navigator task sees (tasks_core.NavInput)."""
+        """What the navigator task sees (flight_tasks/core.py NavInput)."""
         home = c.home
         local = self.control.local_setpoint
         return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, yaw_from_q(est.q_wxyz),

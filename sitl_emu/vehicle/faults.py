@@ -2,13 +2,13 @@
 
 Vehicle.step asks `VehicleFaults` for: the motor outputs after injected motor failures, the wind for the physics,
 the estimate (the truth, or with estimator noise), and once per commander cycle `update` turns the battery, the GPS,
-the failure detector and the ground-station link into the commander's failsafe flags (flight/fault_failsafes.py)
+the failure detector and the ground-station link into the commander's failsafe flags (commander/fault_failsafes.py)
 and PX4's texts. With no wind, no noise and nothing injected, nothing here changes what the vehicle does.
 
-- Battery: flight/battery.py (BatterySimulator.cpp; texts: HealthAndArmingChecks/checks/batteryCheck.cpp and the
+- Battery: commander/battery.py (BatterySimulator.cpp; texts: HealthAndArmingChecks/checks/batteryCheck.cpp and the
   failsafe framework's warning events, failsafe/framework.cpp notifyUser).
 - GPS off: the estimator (ekf2) dead-reckons on the IMU for EKF2_NOAID_TOUT, then has no horizontal position; the
-  commander's mode checks (flight/arming.py) then see no position and the failsafe falls back (Hold -> Land ->
+  commander's mode checks (commander/arming.py) then see no position and the failsafe falls back (Hold -> Land ->
   Descend, failsafe.cpp checkModeFallback).
 - Failure detector (commander/failure_detector/FailureDetector.cpp updateAttitudeStatus): while armed, roll beyond
   FD_FAIL_R for FD_FAIL_R_TTRI or pitch beyond FD_FAIL_P for FD_FAIL_P_TTRI -> fd_critical_failure.

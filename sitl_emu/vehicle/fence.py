@@ -1,5 +1,5 @@
 """The vehicle's geofence and rally-point glue: the stored plans, the parameters and the estimate turned into the
-navigator's geofence check (flight/geofence_monitor.py) and RTL's destination (flight/rally.py).
+navigator's geofence check (navigator/geofence_monitor.py) and RTL's destination (navigator/rally.py).
 
 Vehicle.step calls `FenceChecks.check_commands` on the navigator's new requests (DO_REPOSITION and
 DO_CHANGE_ALTITUDE targets outside the fence are refused, navigator_main.cpp geofence_allows_position) and

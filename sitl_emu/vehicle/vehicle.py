@@ -2,12 +2,12 @@
 
 Vehicle.step() runs, in this fixed order, at now_us = previous time + dt_us (4000 us, 250 Hz):
  1. pending reboot (PREFLIGHT_REBOOT_SHUTDOWN param1=1, acknowledged before): back to the boot state, time 0;
- 2. commander (every COMMANDER_PERIOD_US), after the navigator's geofence check (vehicle_fence.py): readiness
+ 2. commander (every COMMANDER_PERIOD_US), after the navigator's geofence check (fence.py): readiness
     ("Ready for takeoff!"), home, auto-disarm, takeoff completion, failsafes, mode in force;
  3. mode executor: the navigator task of the mode in force (none while disarmed), or the offboard setpoint;
  4. control cascade: setpoint -> motor commands (zero when disarmed or terminated), then injected motor failures;
  5. physics: rigid-body step by dt in the wind; the new truth state (plus optional seeded noise) becomes the
-    estimate (wind, noise, failures, battery and link watchdog: vehicle_faults.py, once per commander cycle too);
+    estimate (wind, noise, failures, battery and link watchdog: faults.py, once per commander cycle too);
  6. land detector on the new estimate (50 Hz, and at once when arming changes) -> commander ("Takeoff detected" /
     "Landing detected");
  7. events: the task's messages join the event stream; a mission's RTL item asks the commander for Return.
@@ -73,7 +73,7 @@ class Vehicle:
 
         `ready_delay_s` is the simulated estimator warm-up before arming is possible; `position_noise_m` (default 0)
         adds seeded Gaussian noise to the position estimate; `wind` (mean, turbulence, gusts) and `estimate_noise`
-        (white noise and bias walk on position, velocity, attitude) are off by default (vehicle_faults.py).
+        (white noise and bias walk on position, velocity, attitude) are off by default (faults.py).
         """
         self.params: ParamRegistry = params if params is not None else default_registry()
         self.sysid = sysid
@@ -103,10 +103,10 @@ class Vehicle:
         self._task_finished = False
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
-        self._missions = MissionStore()  # in memory only: a reboot empties it (flight/mission_store.py)
+        self._missions = MissionStore()  # in memory only: a reboot empties it (navigator/mission_store.py)
         self.faults = VehicleFaults(self.params, self.commander.fault_flags, self._emit, seed=self._seed,
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
-        self._fence = FenceChecks(self.params)  # the navigator's geofence check (vehicle_fence.py)
+        self._fence = FenceChecks(self.params)  # the navigator's geofence check (fence.py)
         self.chain.executor.rtl_destination = self._rtl_destination
         self.commander.mission_store = self._missions
         self.chain.executor.attach_missions(self._missions)
@@ -125,7 +125,7 @@ class Vehicle:
             return
         now = self._time_us = self._time_us + self.dt_us
         self._snap = None
-        if c.nav_commands:  # the navigator refuses targets outside the geofence (vehicle_fence.py)
+        if c.nav_commands:  # the navigator refuses targets outside the geofence (fence.py)
             self._fence.check_commands(c, self.ref, self._estimate.pos_ned_m, self._emit)
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
@@ -190,12 +190,12 @@ class Vehicle:
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:
         """Act on a command now; the ACK to send, or None where PX4 sends no ACK (ARM_DISARM param1 not 0/1)."""
         self._snap = None
-        if cmd.command == MavCmd.INJECT_FAILURE:  # the failure injection manager (flight/failure_injection.py)
+        if cmd.command == MavCmd.INJECT_FAILURE:  # the failure injection manager (commander/failure_injection.py)
             return self.faults.inject(cmd, self._time_us)
         return handle_command(self.commander, cmd, self._time_us)
 
     def gcs_heartbeat(self) -> None:
-        """A ground station's HEARTBEAT arrived (the COM_DL_LOSS_T data-link watchdog, vehicle_faults.py)."""
+        """A ground station's HEARTBEAT arrived (the COM_DL_LOSS_T data-link watchdog, faults.py)."""
         self.faults.gcs_heartbeat(self._time_us)
 
     def offboard_input(self, mode: OffboardControlMode, trajectory: TrajectorySetpoint | None = None,
@@ -207,7 +207,7 @@ class Vehicle:
 
     def manual_control_input(self, setpoint: ManualControlSetpoint) -> None:
         """A MAVLink joystick's sticks (MANUAL_CONTROL): the vehicle's manual input per COM_RC_IN_MODE, in any mode
-        (flight/manual_control.py)."""
+        (commander/manual_control.py)."""
         self._snap = None
         self.commander.manual_control_signal(self._time_us, setpoint)
 

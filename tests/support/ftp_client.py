@@ -1,6 +1,6 @@
 """A MAVLink FTP client for the tests: real FILE_TRANSFER_PROTOCOL datagrams to a node stepped in lockstep (Harness).
 
-It speaks the payload layout of sitl_emu/mavlink/ftp_protocol.py (which MAVSDK's and QGC's clients share) and
+It speaks the payload layout of sitl_emu/mavlink/protocols/ftp.py (which MAVSDK's and QGC's clients share) and
 waits, tick by tick of simulated time, for the reply whose seq is the request's + 1.
 """
 

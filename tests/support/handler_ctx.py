@@ -100,7 +100,7 @@ def make_snapshot(**overrides: Any) -> VehicleSnapshot:
 
 
 class FakeVehicle:
-    """The attributes of sitl_emu.vehicle.Vehicle the handlers and shells use, with scripted command results.
+    """The attributes of sitl_emu.vehicle.vehicle.Vehicle the handlers and shells use, with scripted command results.
 
     `results` maps a MAV_CMD number to the MavResult to answer (default ACCEPTED); `on_command` lets a test react
     (e.g. report an event) when a command arrives.

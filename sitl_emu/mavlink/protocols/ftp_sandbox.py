@@ -1,4 +1,4 @@
-"""The file system a MAVLink FTP client sees: one root directory, and nothing outside it (ftp_protocol.py uses it).
+"""The file system a MAVLink FTP client sees: one root directory, and nothing outside it (ftp.py uses it).
 
 PX4 prepends its root directory to every requested path (src/modules/mavlink/mavlink_ftp.cpp, `_root_dir`: the SITL
 working directory), so "/log" and "log" both name root/log. Older PX4 then let "../" walk out of the root; current

@@ -141,7 +141,7 @@ def rtl_time_estimate_s(snap: VehicleSnapshot) -> float:
 
 def time_estimate_to_target(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/TIME_ESTIMATE_TO_TARGET.hpp (not in pymavlink: extra_messages.py): the safe RTL time; the other
-    estimates are not supported by PX4 (-1). Sent when rtl_time_estimate updates (every 2 s: telemetry.py)."""
+    estimates are not supported by PX4 (-1). Sent when rtl_time_estimate updates (every 2 s: streams.py)."""
     safe = rtl_time_estimate_s(snap)
     return EXTRA.time_estimate_to_target_encode(int(safe) if math.isfinite(safe) else -1, -1, -1, -1, -1)
 

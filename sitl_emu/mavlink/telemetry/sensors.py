@@ -109,7 +109,7 @@ def vibration(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 
 # --- GNSS (sensor_gps_sim: SIH's GPS) ---------------------------------------------------------------------------------
 GPS_DEVICE_ID = 0xAF0004  # DRV_GPS_DEVTYPE_SIM on the simulation bus (device_id: devtype << 16 | bus type 4)
-GPS_EPH_M, GPS_EPV_M, GPS_SPEED_VARIANCE_M_S = 0.5, 0.8, 0.2  # what GPS_RAW_INT reports (telemetry_msgs.gps_raw_int)
+GPS_EPH_M, GPS_EPV_M, GPS_SPEED_VARIANCE_M_S = 0.5, 0.8, 0.2  # what GPS_RAW_INT reports (messages.gps_raw_int)
 
 
 def gnss_integrity(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:

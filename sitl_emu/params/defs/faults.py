@@ -4,7 +4,7 @@ Sources: src/modules/failure_injection_manager/failure_injection_manager_params.
 ROMFS/px4fmu_common/init.d-posix/rcS sets it to 1), src/modules/commander/commander_params.yaml (COM_DLL_EXCEPT),
 src/lib/circuit_breaker/circuit_breaker_params.yaml (CBRK_FLIGHTTERM), src/modules/commander/failure_detector/
 failure_detector_params.yaml (FD_FAIL_*), src/modules/ekf2/params_*.yaml (EKF2_NOAID_TOUT).
-The battery parameters (SIM_BAT_*, BAT_*) are in defs_system.py, COM_LOW_BAT_ACT and NAV_DLL_ACT in defs_commander.py.
+The battery parameters (SIM_BAT_*, BAT_*) are in system.py, COM_LOW_BAT_ACT and NAV_DLL_ACT in commander.py.
 """
 
 from __future__ import annotations

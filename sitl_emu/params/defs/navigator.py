@@ -25,7 +25,7 @@ _NAVIGATOR: list[ParamDef] = [
     integer("GF_SOURCE", 0, 0, 1, ""),
     real("GF_MAX_HOR_DIST", 0.0, 0.0, 10000.0, "m"),
     real("GF_MAX_VER_DIST", 0.0, 0.0, 10000.0, "m"),
-    # AUTO.MISSION (flight/mission.py): a waypoint's heading, the loiter a finished mission leaves (RTL's climb)
+    # AUTO.MISSION (navigator/mission.py): a waypoint's heading, the loiter a finished mission leaves (RTL's climb)
     real("MIS_YAW_ERR", 12.0, 0.0, 90.0, "deg"),
     real("MIS_YAW_TMT", -1.0, -1.0, 20.0, "s"),
     real("NAV_LOITER_RAD", 80.0, -10000.0, 10000.0, "m"),

@@ -1,6 +1,6 @@
 """Faults in the vehicle core: INJECT_FAILURE (gps, motor, battery), the battery drain, the data-link loss, the
-failure detector; each with PX4's ACK, texts and mode sequence (sources cited in sitl_emu/vehicle_faults.py and
-sitl_emu/flight/{failure_injection,battery,fault_failsafes}.py)."""
+failure detector; each with PX4's ACK, texts and mode sequence (sources cited in sitl_emu/vehicle/faults.py and
+sitl_emu/commander/{failure_injection,battery,fault_failsafes}.py)."""
 
 from __future__ import annotations
 

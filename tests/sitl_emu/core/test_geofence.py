@@ -1,4 +1,4 @@
-"""The geofence's geometry and rules (flight/geofence.py), the breach check over time (geofence_monitor.py), the
+"""The geofence's geometry and rules (navigator/geofence.py), the breach check over time (geofence_monitor.py), the
 GF_ACTION failsafe (geofence_failsafe.py) and RTL's rally-point choice (rally.py), without MAVLink."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The auto modes' heading smoothing (sitl_emu/flight/heading.py, after PX4's HeadingSmoothing)."""
+"""The auto modes' heading smoothing (sitl_emu/motion_planning/heading.py, after PX4's HeadingSmoothing)."""
 
 from __future__ import annotations
 

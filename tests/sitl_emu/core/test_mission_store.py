@@ -1,4 +1,4 @@
-"""The vehicle's plan store (flight/mission_store.py): whole plans replaced at once, cleared per type, the current
+"""The vehicle's plan store (navigator/mission_store.py): whole plans replaced at once, cleared per type, the current
 item, the vehicle-wide upload lock, and nothing kept across a reboot (no storage file, unlike PX4's dataman file)."""
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ def _check(v: Vehicle) -> VehicleSnapshot:
     assert s.time_us == v.time_us
     assert s.extras == {"system_status": float(v.commander.system_status())}
     assert s.pre_flight_checks_pass == v.commander.pre_flight_checks_pass()
-    # the battery simulator (flight/battery.py): full while disarmed, draining while armed
+    # the battery simulator (commander/battery.py): full while disarmed, draining while armed
     assert (s.battery_voltage_v, s.battery_remaining) == (v.faults.battery.voltage_v, v.faults.battery.remaining)
     if not s.armed:
         assert s.battery_voltage_v == 16.2 and s.battery_remaining == 1.0

@@ -1,4 +1,4 @@
-"""The messages pymavlink lacks are framed as mavgen's generated code would (sitl_emu/mavlink/extra_messages.py).
+"""The messages pymavlink lacks are framed as mavgen's generated code would (sitl_emu/mavlink/wire/extra_messages.py).
 
 The CRC_EXTRA seed and wire order are computed from the field lists; the algorithm must reproduce every message
 pymavlink has, and the seeds and payload lengths must be the published ones (MAVLINK_MSG_ID_<NAME>_CRC / _LEN of the
