@@ -12,7 +12,7 @@ from collections.abc import Callable
 
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 POS = OffboardControlMode(position=True)

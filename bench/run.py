@@ -39,7 +39,7 @@ if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
 from bench import campaign, core, params, runner, scale, serve  # noqa: E402
-from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
+from sitl_emu.cli.main import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
 DEFAULT = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params", "view")
 NAMES = (*DEFAULT, "campaign")
@@ -57,7 +57,7 @@ def machine() -> None:
     # imported first, so that describe() sees whether the vehicle core runs compiled
     import sitl_emu.control.cascade
     import sitl_emu.physics
-    import sitl_emu.vehicle  # noqa: F401
+    import sitl_emu.vehicle.vehicle  # noqa: F401
     from sitl_emu._speedups import describe
 
     say(f"build: {describe()} (make speedups compiles the vehicle core; make clean-speedups goes back)")

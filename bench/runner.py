@@ -14,13 +14,13 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from sitl_emu.mavlink.telemetry import BUILDERS
+from sitl_emu.mavlink.telemetry.streams import BUILDERS
 from sitl_emu.px4 import MavCmd
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner
 from sitl_emu.runtime.swarm import SwarmRunner
 from sitl_emu.types import VehicleCommand, VehicleEvent, VehicleSnapshot
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 
 class StubVehicle:

@@ -62,7 +62,7 @@ def search(start: int, limit: int, seconds: float, cpu: int | None) -> tuple[int
 
 
 def _worker(count: int, seconds: float, cpu: int | None) -> dict[str, float]:
-    from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
+    from sitl_emu.cli.main import DEFAULT_BATCH_MS, wake_period_s
     from sitl_emu.px4 import MavCmd
     from sitl_emu.runtime.swarm import SwarmRunner
     from sitl_emu.testing.sim import Sim

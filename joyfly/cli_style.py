@@ -1,7 +1,7 @@
 """The one style of joyfly's user errors: one line `joyfly: <what is wrong and what to do>` on stderr, a non-zero
 exit status, no traceback; click's own usage errors too (`OneLineGroup` turns them into `UserError`).
 
-sitl_emu/cli_options.py does the same for `sitl-emu` (joyfly imports sitl_emu only to run the demo's emulator, and
+sitl_emu/cli/options.py does the same for `sitl-emu` (joyfly imports sitl_emu only to run the demo's emulator, and
 sitl_emu never imports joyfly: ARCHITECTURE.md); change both.
 """
 

@@ -37,7 +37,7 @@ CONTROLS = ("velocity", "step", *MANUAL_CONTROLS)
 ON_EXIT = ("land", "hold", "rtl")
 MIN_RATE_HZ = 10.0  # PX4 needs a setpoint younger than COM_OF_LOSS_T = 1 s; 10 Hz leaves room for lost datagrams
 # --speed: the vehicle's simulated seconds per wall second; the same range as `sitl-emu serve --speed`
-# (sitl_emu/cli_options.py; a test keeps them equal).
+# (sitl_emu/cli/options.py; a test keeps them equal).
 SPEED_MIN, SPEED_MAX = 0.1, 100.0
 
 

@@ -102,8 +102,8 @@ class EmbeddedVehicle:
         HOST:PORT where the ground-station link sends its telemetry until a ground station talks to it (None: to a
         socket of the demo's own that drops it, so that a QGroundControl on this machine sees nothing unasked)."""
         try:
-            from sitl_emu.cli import build_params, build_vehicle
-            from sitl_emu.cli_options import UsageProblem, parse_address
+            from sitl_emu.cli.main import build_params, build_vehicle
+            from sitl_emu.cli.options import UsageProblem, parse_address
             from sitl_emu.disturbance.wind import parse_wind
             from sitl_emu.runtime.node import LinkSettings, VehicleNode
             from sitl_emu.runtime.runner import RealTimeRunner

@@ -1,14 +1,14 @@
 """The `sitl-emu` command (and `python -m sitl_emu`): SIGINT and SIGTERM are taken in hand before anything else is
-imported (sitl_emu/shutdown_signals.py), then the CLI (sitl_emu/cli.py) runs."""
+imported (sitl_emu/cli/signals.py), then the CLI (sitl_emu/cli/main.py) runs."""
 
 from __future__ import annotations
 
-from sitl_emu.shutdown_signals import EARLY
+from sitl_emu.cli.signals import EARLY
 
 
 def main() -> None:
     EARLY.install()
-    from sitl_emu.cli import main as cli
+    from sitl_emu.cli.main import main as cli
 
     cli(prog_name="sitl-emu")
 

@@ -11,7 +11,7 @@ import time
 
 from sitl_emu.px4 import LandedState, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, mode_name
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 POS = OffboardControlMode(position=True)

@@ -87,9 +87,9 @@ class MavCmd(IntEnum):
     stores, here and nowhere else.
 
     Answered: the commander's (Commander.cpp handle_command), the navigator's (DO_SET_MISSION_CURRENT) and the
-    mavlink module's (mavlink_receiver.cpp handle_message_command_both); flight/commands.py and
+    mavlink module's (mavlink_receiver.cpp handle_message_command_both); commander/commands.py and
     mavlink/link_commands.py map them to their handlers. Stored: the mission, geofence and rally items PX4 accepts
-    in an upload (mavlink_mission.cpp parse_mavlink_mission_item; mavlink/mission_items.py). PX4 keeps MAVLink's
+    in an upload (mavlink_mission.cpp parse_mavlink_mission_item; protocols/mission_items.py). PX4 keeps MAVLink's
     numbering for vehicle_command and mission_item internally, and so do we.
     """
 

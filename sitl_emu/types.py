@@ -38,7 +38,7 @@ class TrajectorySetpoint:
     """PX4's trajectory_setpoint in the local NED frame; NaN components are not controlled.
 
     Made several times a tick (the flight tasks, the position controller's output), so not frozen and with its
-    __init__ written out, as flight/failsafe.Decision: `make speedups` compiles only a written-out __init__, and a
+    __init__ written out, as commander/failsafe.Decision: `make speedups` compiles only a written-out __init__, and a
     frozen one sets each field through object.__setattr__. Treat it as read-only: one setpoint is held and shared."""
 
     position_ned_m: Vec3 = NAN3

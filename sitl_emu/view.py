@@ -15,7 +15,7 @@ from flightview.scene import Frame
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.px4 import mode_name
 from sitl_emu.types import VehicleSnapshot
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 
 def vehicle_key(sysid: int) -> str:

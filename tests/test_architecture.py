@@ -24,11 +24,11 @@ def sources(*parts: str) -> list[Path]:
     return files
 
 
-CORE = sources("sitl_emu/control", "sitl_emu/flight", "sitl_emu/params", "sitl_emu/physics.py", "sitl_emu/vehicle.py",
-               "sitl_emu/control_chain.py", "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py",
-               "sitl_emu/vehicle_faults.py", "sitl_emu/vehicle_fence.py", "sitl_emu/disturbance")
+CORE = sources("sitl_emu/control", "sitl_emu/vehicle", "sitl_emu/commander", "sitl_emu/navigator",
+               "sitl_emu/flight_tasks", "sitl_emu/motion_planning", "sitl_emu/params", "sitl_emu/physics.py",
+               "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py", "sitl_emu/disturbance")
 CORE_MAY_NOT = ("pymavlink", "sitl_emu.mavlink", "sitl_emu.runtime", "sitl_emu.testing", "sitl_emu.cli",
-                "sitl_emu.console", "sitl_emu.shell", "time", "socket", "threading", "random")
+                "sitl_emu.console", "time", "socket", "threading", "random")
 
 
 @pytest.mark.parametrize("path", CORE, ids=lambda p: str(p.relative_to(REPO_ROOT)))

@@ -22,7 +22,7 @@ from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.testing.harness import ClosedLoop, hover_loop
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 

@@ -1,4 +1,4 @@
-"""`sitl-emu campaign`: the command line of sitl_emu.campaign (sitl_emu/cli.py only lists this command)."""
+"""`sitl-emu campaign`: the command line of sitl_emu.campaign (sitl_emu/cli/main.py only lists this command)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sitl_emu.cli_options import SEED_MAX, FiniteRange, UserError, WholeRange
+from sitl_emu.cli.options import SEED_MAX, FiniteRange, UserError, WholeRange
 
 __all__ = ["campaign"]
 

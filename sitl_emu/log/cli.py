@@ -1,6 +1,6 @@
 """`sitl-emu log FILE.ulg`: a ULog file summarised in the terminal, and with --plot drawn to a PNG (issue 15).
 
-sitl_emu/cli.py only lists this command; summary.py reads the file, plot.py draws it.
+sitl_emu/cli/main.py only lists this command; summary.py reads the file, plot.py draws it.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sitl_emu.cli_options import UserError
+from sitl_emu.cli.options import UserError
 from sitl_emu.log.summary import LogError, LogSummary, format_summary, read_ulog, summarise
 
 __all__ = ["log"]

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from sitl_emu.log.flight_log import FlightLogger
 from sitl_emu.mavlink.endpoint import load_handler_classes
-from sitl_emu.mavlink.log_protocol import DirectoryLogSource, LogProtocol
+from sitl_emu.mavlink.protocols.log import DirectoryLogSource, LogProtocol
 from sitl_emu.runtime.node import VehicleNode
 
 DEFAULT_LOG_DIR = Path("log")  # PX4 SITL: LOG_ROOT = PX4_STORAGEDIR "/log", the working directory's log/

@@ -30,7 +30,7 @@ from typing import Any
 from sitl_emu.control.qmath import yaw_from_q
 from sitl_emu.geo import ned_to_global
 from sitl_emu.log.ulog_writer import MessageFormat
-from sitl_emu.mavlink.telemetry_actuators import servo_outputs
+from sitl_emu.mavlink.telemetry.actuators import servo_outputs
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot

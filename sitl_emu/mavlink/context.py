@@ -21,9 +21,9 @@ if TYPE_CHECKING:
 
     from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
 
-    from sitl_emu.flight.mission_store import MissionStore
-    from sitl_emu.mavlink.encoding import MessageEncoder
-    from sitl_emu.mavlink.fastpack import Packed
+    from sitl_emu.mavlink.wire.encoding import MessageEncoder
+    from sitl_emu.mavlink.wire.fastpack import Packed
+    from sitl_emu.navigator.mission_store import MissionStore
     from sitl_emu.params import ParamRegistry
     from sitl_emu.px4 import Severity
     from sitl_emu.types import (
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
         VehicleEvent,
         VehicleSnapshot,
     )
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
     OutMessage: TypeAlias = MAVLink_message | Packed
@@ -78,7 +78,7 @@ class EndpointStats:
 class LinkVehicle(Protocol):
     """The vehicle as the links see it: all that the endpoint, its parts and the protocol handlers ask of it.
 
-    sitl_emu/vehicle.py's Vehicle is one (checked below); the link's unit tests drive it with a recording stand-in
+    vehicle/vehicle.py's Vehicle is one (checked below); the link's unit tests drive it with a recording stand-in
     (tests/support/fakes.py). Typed as this protocol, the compiled build does not insist on the Vehicle class.
     """
 
@@ -180,8 +180,8 @@ class Handler(Protocol):
 
 
 def vehicle_news(vehicle: LinkVehicle) -> tuple[int, int, bool, int]:
-    """What protocol handlers act on between messages: the parameters' version (params_protocol sends changed
-    values, as PX4's parameter_update subscription) and the navigator's mission progress (mission_protocol reports
+    """What protocol handlers act on between messages: the parameters' version (protocols/params.py sends changed
+    values, as PX4's parameter_update subscription) and the navigator's mission progress (protocols/mission.py reports
     it, as PX4's mission_result subscription)."""
     store = vehicle.mission_store()
     return vehicle.params.version, store.current_seq, store.finished, store.seq_reached

@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, vehicle_news
-from sitl_emu.mavlink.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
-from sitl_emu.mavlink.telemetry import StreamMode, Streams
+from sitl_emu.mavlink.telemetry.streams import StreamMode, Streams
+from sitl_emu.mavlink.wire.fastpack import ENCODER, frame_message
 
 if TYPE_CHECKING:
     from pymavlink.dialects.v20.development import MAVLink_message
@@ -36,11 +36,11 @@ MAVLINK_LOG_QUEUE = 8  # msg/MavlinkLog.msg ORB_QUEUE_LENGTH
 
 # Protocol handlers by other modules, one instance per link (sitl_emu/mavlink/context.py). Missing modules are skipped.
 HANDLER_CLASSES: tuple[tuple[str, str], ...] = (
-    ("sitl_emu.mavlink.params_protocol", "ParamProtocol"),
-    ("sitl_emu.mavlink.mission_protocol", "MissionProtocol"),
-    ("sitl_emu.mavlink.shell_bridge", "ShellBridge"),
-    ("sitl_emu.mavlink.ftp_protocol", "FtpProtocol"),
-    ("sitl_emu.mavlink.log_protocol", "LogProtocol"),
+    ("sitl_emu.mavlink.protocols.params", "ParamProtocol"),
+    ("sitl_emu.mavlink.protocols.mission", "MissionProtocol"),
+    ("sitl_emu.mavlink.protocols.shell", "ShellBridge"),
+    ("sitl_emu.mavlink.protocols.ftp", "FtpProtocol"),
+    ("sitl_emu.mavlink.protocols.log", "LogProtocol"),
 )
 
 
@@ -98,7 +98,7 @@ class Endpoint:
         # pymavlink's encoder: handlers build messages with it; its `seq` is this link's sequence number, which
         # send() continues (one sequence per link, whichever way a message was built)
         self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
-        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/fastpack.py): same calls, cheaper messages
+        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/wire/fastpack.py): same calls, cheaper messages
         self._parser = _new_parser()
         self.stats = EndpointStats()
         self.streams = Streams(mode, stream_delay_us)

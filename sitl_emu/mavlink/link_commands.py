@@ -11,13 +11,13 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from sitl_emu.mavlink.modes_msgs import available_modes
+from sitl_emu.mavlink.telemetry.modes import available_modes
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.types import VehicleCommand
 
 if TYPE_CHECKING:
     from sitl_emu.mavlink.context import EndpointContext, OutMessage
-    from sitl_emu.mavlink.telemetry import Streams
+    from sitl_emu.mavlink.telemetry.streams import Streams
 
 MSG_HOME_POSITION = 242
 MSG_MESSAGE_INTERVAL = 244

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from sitl_emu.mavlink.telemetry_msgs import rotate_body_to_ned
+from sitl_emu.mavlink.telemetry.messages import rotate_body_to_ned
 from sitl_emu.px4 import MavFrame
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, VehicleSnapshot
 

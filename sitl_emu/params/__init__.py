@@ -2,7 +2,7 @@
 
 `default_registry()` gives every PX4 parameter (sitl_emu/params/px4_params.csv, PX4's order and defaults; their
 ranges, units and descriptions in px4_param_meta.csv) plus the emulator's own definitions of the parameters its code
-reads by name (`defs_<domain>.py`, one module per domain, exporting `PARAMS: list[ParamDef]`; add a new module's name
+reads by name (`defs/<domain>.py`, one module per domain, exporting `PARAMS: list[ParamDef]`; add a new module's name
 to catalog.DOMAINS). catalog.py says how they are reconciled.
 """
 

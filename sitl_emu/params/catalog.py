@@ -3,7 +3,7 @@
 - px4_params.csv (package data, written by tools/px4_params_csv.py) is every parameter PX4 SITL (SIH quadrotor)
   lists on a fresh boot: name, MAV_PARAM_TYPE and default, in PX4's order. These are the *used* parameters; their
   order and count are PX4's, so PARAM_REQUEST_LIST returns PX4's indices.
-- The `defs_<domain>.py` modules define the parameters the emulator reads by name, with a range, a unit and a
+- The `defs/<domain>.py` modules define the parameters the emulator reads by name, with a range, a unit and a
   description. A parameter in both keeps PX4's type and PX4's default unless EMULATOR_DEFAULTS lists it (a deliberate
   difference, with its reason); a definition whose default is the same float32 as PX4's keeps its own decimal form, so
   0.95 stays 0.95 (the derived controller settings do not change by a rounding).
@@ -34,7 +34,7 @@ from sitl_emu.params.registry import FLT_MAX, INT32_MAX, INT32_MIN, ParamDef, Pa
 
 DATA_FILE = "px4_params.csv"
 META_FILE = "px4_param_meta.csv"
-DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system", "faults")  # one defs_<domain>.py module each
+DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system", "faults")  # one defs/<domain>.py module each
 
 # PX4's @volatile parameters among the listed ones (the system changes them itself; _HASH_CHECK leaves them out):
 # src/modules/commander/commander_params.c COM_FLIGHT_UUID, src/modules/land_detector/land_detector_params.c
@@ -67,10 +67,10 @@ class Catalog:
 
 
 def emulator_definitions() -> list[ParamDef]:
-    """The `defs_*.py` definitions, in domain order."""
+    """The `defs/*.py` definitions, in domain order."""
     defs: list[ParamDef] = []
     for domain in DOMAINS:
-        module = importlib.import_module(f"sitl_emu.params.defs_{domain}")
+        module = importlib.import_module(f"sitl_emu.params.defs.{domain}")
         defs.extend(module.PARAMS)
     return defs
 
@@ -120,7 +120,7 @@ def _reconcile(own: ParamDef | None, meta: Meta | None, name: str, ptype: ParamT
         lo, hi = _typed(ptype, meta.min, lo), _typed(ptype, meta.max, hi)
         return ParamDef(name, ptype, px4_default, lo, hi, meta.unit, meta.doc, volatile=name in VOLATILE)
     if own.type is not ptype:
-        raise ValueError(f"{name} is {own.type.value} in defs_*.py but {ptype.value} in PX4's list")
+        raise ValueError(f"{name} is {own.type.value} in defs/*.py but {ptype.value} in PX4's list")
     keep_own = same_value(ptype, own.default, px4_default) or name in EMULATOR_DEFAULTS
     return dataclasses.replace(own, default=own.default if keep_own else px4_default, unit=own.unit or meta.unit,
                                doc=meta.doc or own.doc, volatile=name in VOLATILE)

@@ -1,6 +1,6 @@
 """PX4-named parameters: one registry, typed (INT32 or REAL32), range-checked, changeable at run time.
 
-Which parameters exist and their defaults come from sitl_emu/params/catalog.py (PX4's list plus the `defs_*.py`
+Which parameters exist and their defaults come from sitl_emu/params/catalog.py (PX4's list plus the `defs/*.py`
 modules). As in PX4 (src/lib/parameters/parameters.cpp), every known parameter can be read and set by name, but only
 the *used* ones are listed: they alone have an index, count in `len()` and go out after PARAM_REQUEST_LIST. PX4 marks
 a parameter used when a module first looks it up; here the catalog says which are used at boot and `mark_used(name)`

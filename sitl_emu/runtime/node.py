@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING, Any, Protocol
 from sitl_emu.mavlink.context import LinkVehicle
 from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
 from sitl_emu.mavlink.link import Address, UdpLink
-from sitl_emu.mavlink.telemetry import StreamMode
+from sitl_emu.mavlink.telemetry.streams import StreamMode
 from sitl_emu.runtime.timeline import TickVehicle
 from sitl_emu.types import VehicleSnapshot
 
 if TYPE_CHECKING:
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +53,7 @@ class LinkSettings:
 
 
 class NodeVehicle(LinkVehicle, TickVehicle, Protocol):
-    """A node's vehicle: what its links ask of it, and what the tick loop asks (sitl_emu.vehicle.Vehicle; a protocol,
+    """A node's vehicle: what its links ask of it, and what the tick loop asks (vehicle/vehicle.py Vehicle; a protocol,
     so that the compiled build takes the tests' stand-ins too)."""
 
 

@@ -97,7 +97,7 @@ class RealTimeRunner:
         # Sleep at least this long (wall time) between wake-ups and run the ticks due in one batch; 0 wakes for every
         # tick. Each wake-up costs more CPU than most ticks (cold caches), so batches save CPU; telemetry then leaves
         # in bursts (each message still stamped at its own tick) and a datagram still wakes us at once. `serve` sets
-        # it from --batch-ms (sitl_emu/cli.py DEFAULT_BATCH_MS); library users (tests, joyfly demo) wake every tick.
+        # it from --batch-ms (cli/main.py DEFAULT_BATCH_MS); library users (tests, joyfly demo) wake every tick.
         self.min_wake_s = 0.0
         self._watch: SocketWatch | None = None
 

@@ -17,7 +17,7 @@ Ready = dict[int, int]  # node index -> bit set of its links with datagrams wait
 
 
 class TickVehicle(Protocol):
-    """What the tick loop asks of a vehicle (sitl_emu.vehicle.Vehicle)."""
+    """What the tick loop asks of a vehicle (sitl_emu.vehicle.vehicle.Vehicle)."""
 
     @property
     def dt_us(self) -> int: ...

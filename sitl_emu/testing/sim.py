@@ -36,7 +36,7 @@ from sitl_emu.runtime.node import IO_BUDGET_DATAGRAMS, LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import SocketWatch
 from sitl_emu.runtime.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner, build_nodes
 from sitl_emu.runtime.timeline import Timeline
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 __all__ = ["LockstepClock", "ScaledWallClock", "Sim", "VehiclePorts"]
 

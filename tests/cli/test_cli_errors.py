@@ -12,7 +12,7 @@ from click.testing import CliRunner, Result
 from support import REPO_ROOT
 
 import joyfly.cli
-import sitl_emu.cli
+import sitl_emu.cli.main
 
 REPO = REPO_ROOT
 SCRIPT = str(REPO / "examples" / "joystick_script.txt")
@@ -33,8 +33,8 @@ def serve_error(*args: str, monkeypatch: pytest.MonkeyPatch) -> str:
     def never(*_a: object, **_k: object) -> None:
         raise AssertionError("the bad value was not caught before the vehicle was built")
 
-    monkeypatch.setattr(sitl_emu.cli, "build_nodes", never)
-    result = CliRunner().invoke(sitl_emu.cli.main, ["serve", "--no-console", *args], prog_name="sitl-emu")
+    monkeypatch.setattr(sitl_emu.cli.main, "build_nodes", never)
+    result = CliRunner().invoke(sitl_emu.cli.main.main, ["serve", "--no-console", *args], prog_name="sitl-emu")
     return _one_line_error(result, "sitl-emu")
 
 

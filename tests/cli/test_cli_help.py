@@ -13,12 +13,12 @@ from support import REPO_ROOT
 
 import joyfly.cli
 import joyfly.config
-import sitl_emu.cli
-import sitl_emu.cli_options
+import sitl_emu.cli.main
+import sitl_emu.cli.options
 from joyfly.sticks.profiles import read_config
 
 REPO = REPO_ROOT
-TOOLS = {"joyfly": joyfly.cli.main, "sitl-emu": sitl_emu.cli.main}
+TOOLS = {"joyfly": joyfly.cli.main, "sitl-emu": sitl_emu.cli.main.main}
 
 
 def command_paths(group: click.Command, path: tuple[str, ...] = ()) -> Iterator[tuple[str, ...]]:
@@ -73,8 +73,8 @@ def test_fly_help_says_what_the_control_choices_do_and_how_speed_relates() -> No
 
 
 def test_both_tools_take_the_same_speed_range() -> None:
-    assert (joyfly.config.SPEED_MIN, joyfly.config.SPEED_MAX) == (sitl_emu.cli_options.SPEED_MIN,
-                                                                    sitl_emu.cli_options.SPEED_MAX)
+    assert (joyfly.config.SPEED_MIN, joyfly.config.SPEED_MAX) == (sitl_emu.cli.options.SPEED_MIN,
+                                                                    sitl_emu.cli.options.SPEED_MAX)
     for tool, path in (("joyfly", ("demo",)), ("sitl-emu", ("serve",))):
         group = TOOLS[tool]
         assert isinstance(group, click.Group)

@@ -6,7 +6,7 @@ from typing import Any
 
 import pytest
 
-from sitl_emu.cli import build_params, build_vehicle
+from sitl_emu.cli.main import build_params, build_vehicle
 from sitl_emu.geo import GeoRef
 from sitl_emu.runtime.swarm import DEFAULT_HOME, instance_home
 from sitl_emu.view import manual_sticks, snapshot_frame

@@ -18,7 +18,7 @@ from support import REPO_ROOT
 from support.view_process import listening_sockets, require_rerun, view_process, wait_until
 
 from joyfly.cli import main as joyfly_main
-from sitl_emu.cli import main as sitl_main
+from sitl_emu.cli.main import main as sitl_main
 
 SERVE = ["serve", "--port", "0", "--gcs-port", "0", "--no-console", "--params-reset"]
 

@@ -33,7 +33,7 @@ POSCTL = 3
 def emulator_flies_posctl() -> bool:
     """Whether sitl_emu takes off by throttle in Position mode (its manual flight tasks, issue 12)."""
     from sitl_emu.types import ManualControlSetpoint, VehicleCommand
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     vehicle = Vehicle()
 

@@ -10,9 +10,9 @@ import types
 import pytest
 from support.handler_ctx import FakeVehicle
 
-from sitl_emu import console_input
-from sitl_emu.console import PROMPT, Console
-from sitl_emu.console_input import ReadlineInput, StreamInput, make_input
+from sitl_emu.console import terminal as console_input
+from sitl_emu.console.console import PROMPT, Console
+from sitl_emu.console.terminal import ReadlineInput, StreamInput, make_input
 from sitl_emu.px4 import Severity
 
 

@@ -8,9 +8,9 @@ import re
 import pytest
 from support.handler_ctx import FakeVehicle, make_snapshot
 
+from sitl_emu.console.shell import Shell
 from sitl_emu.px4 import NavState
-from sitl_emu.shell import Shell
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 S = 1_000_000
 

@@ -14,7 +14,7 @@ from pymavlink import mavutil
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
-from sitl_emu.cli import stored_params
+from sitl_emu.cli.main import stored_params
 from sitl_emu.params import default_registry
 from sitl_emu.params import store as store_module
 from sitl_emu.params.store import DEFAULT_FILE, ParamFileError, ParamStore, instance_path, read_file

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pymavlink.dialects.v20 import common
 
-from sitl_emu.flight.commands import _HANDLERS
+from sitl_emu.commander.commands import _HANDLERS
 from sitl_emu.mavlink.link_commands import MAVLINK_MODULE_COMMANDS
 from sitl_emu.px4 import ABSOLUTE_FRAMES, GLOBAL_FRAMES, RELATIVE_FRAMES, MavCmd, MavFrame, MavResult, Severity
 

@@ -123,7 +123,7 @@ def test_bad_options_are_one_sentence_and_status_2(args, words):
 
 
 def test_wind_option_reaches_the_vehicle():
-    from sitl_emu.cli import _wind_option, build_vehicle
+    from sitl_emu.cli.main import _wind_option, build_vehicle
     from sitl_emu.params import default_registry
 
     wind = _wind_option("5@270,light")
@@ -133,7 +133,7 @@ def test_wind_option_reaches_the_vehicle():
 
 
 def test_params_file_in_both_formats_sets_parameters(tmp_path):
-    from sitl_emu.cli import build_params
+    from sitl_emu.cli.main import build_params
 
     f = tmp_path / "vehicle.params"
     f.write_text("# QGC style\n1\t1\tMIS_TAKEOFF_ALT\t5.0\t9\nCOM_OF_LOSS_T 2.0  # plain\n")
@@ -176,7 +176,7 @@ def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
 
 
 def test_instance_sets_mav_sys_id_like_rcs():
-    from sitl_emu.cli import build_vehicle
+    from sitl_emu.cli.main import build_vehicle
     from sitl_emu.params import default_registry
 
     vehicle = build_vehicle(default_registry(), None, 0, 4)
@@ -189,7 +189,7 @@ def test_real_time_runner_follows_the_wall_clock_across_a_reboot():
     from support.fakes import Harness
 
     from sitl_emu.runtime.runner import RealTimeRunner
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     h = Harness(Vehicle())
     runner = RealTimeRunner([h.node], speed=4.0)

@@ -7,8 +7,8 @@ import math
 import pytest
 from support.handler_ctx import FakeVehicle, make_snapshot
 
+from sitl_emu.console.shell import Shell
 from sitl_emu.px4 import SHELL_MODE_NAMES, MavResult, NavState, main_sub
-from sitl_emu.shell import Shell
 
 
 @pytest.fixture()
@@ -215,7 +215,7 @@ def test_shutdown_calls_back(vehicle):
 
 
 def test_commander_takeoff_flies_the_real_vehicle():
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     vehicle = Vehicle()
     vehicle.run_until(3_000_000)  # ready to arm
@@ -245,7 +245,7 @@ def test_commander_mode_auto_mission_sends_set_mode(vehicle):
 
 
 def test_mission_summary(vehicle):
-    from sitl_emu.flight.mission_store import PLAN_MISSION, MissionItem
+    from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem
 
     shell = Shell(vehicle)
     assert shell.execute("mission") == ("INFO  [mission] mission: none\n"

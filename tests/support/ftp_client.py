@@ -1,6 +1,6 @@
 """A MAVLink FTP client for the tests: real FILE_TRANSFER_PROTOCOL datagrams to a node stepped in lockstep (Harness).
 
-It speaks the payload layout of sitl_emu/mavlink/ftp_protocol.py (which MAVSDK's and QGC's clients share) and
+It speaks the payload layout of sitl_emu/mavlink/protocols/ftp.py (which MAVSDK's and QGC's clients share) and
 waits, tick by tick of simulated time, for the reply whose seq is the request's + 1.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from sitl_emu.mavlink.ftp_protocol import MAX_DATA, Err, Op, Payload
+from sitl_emu.mavlink.protocols.ftp import MAX_DATA, Err, Op, Payload
 from support.fakes import Harness
 
 MAX_TICKS = 50  # a reply comes in the tick after the request; bursts take more

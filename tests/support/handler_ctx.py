@@ -12,7 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.flight.mission_store import MissionStore
+from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.px4 import LandedState, MavResult, NavState, Severity
 from sitl_emu.types import CommandAck, VehicleCommand, VehicleEvent, VehicleSnapshot
@@ -100,7 +100,7 @@ def make_snapshot(**overrides: Any) -> VehicleSnapshot:
 
 
 class FakeVehicle:
-    """The attributes of sitl_emu.vehicle.Vehicle the handlers and shells use, with scripted command results.
+    """The attributes of sitl_emu.vehicle.vehicle.Vehicle the handlers and shells use, with scripted command results.
 
     `results` maps a MAV_CMD number to the MavResult to answer (default ACCEPTED); `on_command` lets a test react
     (e.g. report an event) when a command arrives.

@@ -107,7 +107,7 @@ class PtyJob:
 
 
 # serve as `sitl-emu serve` runs it, in a Python where `import readline` fails (as where readline does not exist)
-_WITHOUT_READLINE = "import sys; sys.modules['readline'] = None; from sitl_emu.cli import main; main()"
+_WITHOUT_READLINE = "import sys; sys.modules['readline'] = None; from sitl_emu.cli.main import main; main()"
 
 
 def _shell(control_fd: int, pid_fd: int, mode: str, readline: str, serve_args: list[str]) -> int:

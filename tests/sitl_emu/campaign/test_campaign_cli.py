@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner, Result
 from support import campaign_scenarios
 
-import sitl_emu.cli
+import sitl_emu.cli.main
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()
 
@@ -34,7 +34,7 @@ params = {{ SIH_WIND_N = {{ uniform = [0.0, 10.0] }} }}
 
 
 def run(*args: str) -> Result:
-    return CliRunner().invoke(sitl_emu.cli.main, list(args), prog_name="sitl-emu")
+    return CliRunner().invoke(sitl_emu.cli.main.main, list(args), prog_name="sitl-emu")
 
 
 def test_a_campaign_file_through_the_command_line_gives_the_table_the_summary_and_the_reruns(tmp_path: Path) -> None:

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import pytest
 
-from sitl_emu.flight.commander import Commander
-from sitl_emu.flight.commands import handle_command
+from sitl_emu.commander.commander import Commander
+from sitl_emu.commander.commands import handle_command
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavResult, NavState
 from sitl_emu.types import HomePosition, OffboardControlMode, VehicleCommand

@@ -7,9 +7,9 @@ import math
 
 import pytest
 
-from sitl_emu.flight.commander import Commander
-from sitl_emu.flight.commands import handle_command
-from sitl_emu.flight.nav_commands import NavCommandKind
+from sitl_emu.commander.commander import Commander
+from sitl_emu.commander.commands import handle_command
+from sitl_emu.navigator.commands import NavCommandKind
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavResult, MavState, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import HomePosition, OffboardControlMode, VehicleCommand

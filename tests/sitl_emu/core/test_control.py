@@ -313,7 +313,7 @@ def test_attitude_control_gives_finite_limited_rates_for_any_attitude_pair():
 
 
 def test_a_parameter_set_in_flight_reaches_the_controllers_at_the_next_tick():
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     v = Vehicle()
     v.step()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from support.flights import scripted_flight as _script
 
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 
 def test_same_inputs_give_identical_runs() -> None:

@@ -1,6 +1,6 @@
 """Faults in the vehicle core: INJECT_FAILURE (gps, motor, battery), the battery drain, the data-link loss, the
-failure detector; each with PX4's ACK, texts and mode sequence (sources cited in sitl_emu/vehicle_faults.py and
-sitl_emu/flight/{failure_injection,battery,fault_failsafes}.py)."""
+failure detector; each with PX4's ACK, texts and mode sequence (sources cited in sitl_emu/vehicle/faults.py and
+sitl_emu/commander/{failure_injection,battery,fault_failsafes}.py)."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import math
 
 import pytest
 
+from sitl_emu.console.shell import Shell
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, MavResult, NavState, Severity
-from sitl_emu.shell import Shell
 from sitl_emu.types import CommandAck, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 GPS, BATTERY, MOTOR, RC_SIGNAL = 4.0, 100.0, 101.0, 104.0

@@ -22,7 +22,7 @@ import pytest
 
 from sitl_emu.px4 import MavCmd, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 PX4 = json.loads((Path(__file__).parents[2] / "reference" / "px4-manual" / "metrics.json").read_text())
 NAN = math.nan

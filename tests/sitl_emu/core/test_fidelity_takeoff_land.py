@@ -15,7 +15,7 @@ import pytest
 from sitl_emu.px4 import LandedState, MavCmd, NavState
 from sitl_emu.testing.metrics import step_metrics
 from sitl_emu.types import VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN7 = (math.nan,) * 7
 ARM = VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))

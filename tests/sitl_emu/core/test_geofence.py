@@ -1,4 +1,4 @@
-"""The geofence's geometry and rules (flight/geofence.py), the breach check over time (geofence_monitor.py), the
+"""The geofence's geometry and rules (navigator/geofence.py), the breach check over time (geofence_monitor.py), the
 GF_ACTION failsafe (geofence_failsafe.py) and RTL's rally-point choice (rally.py), without MAVLink."""
 
 from __future__ import annotations
@@ -7,7 +7,9 @@ import math
 
 import pytest
 
-from sitl_emu.flight.geofence import (
+from sitl_emu.commander.geofence_failsafe import GeofenceFailsafe
+from sitl_emu.geo import GeoRef, ned_to_global
+from sitl_emu.navigator.geofence import (
     GF_ACTION_HOLD,
     GF_ACTION_LAND,
     GF_ACTION_NONE,
@@ -26,11 +28,9 @@ from sitl_emu.flight.geofence import (
     parse_areas,
     point_allowed,
 )
-from sitl_emu.flight.geofence_failsafe import GeofenceFailsafe
-from sitl_emu.flight.geofence_monitor import GeofenceInputs, GeofenceMonitor
-from sitl_emu.flight.mission_store import MissionItem, Plan, plan_id
-from sitl_emu.flight.rally import choose_destination, safe_points
-from sitl_emu.geo import GeoRef, ned_to_global
+from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor
+from sitl_emu.navigator.mission_store import MissionItem, Plan, plan_id
+from sitl_emu.navigator.rally import choose_destination, safe_points
 from sitl_emu.px4 import MavCmd, NavState
 
 POLY_IN, POLY_EX = MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION, MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION

@@ -1,4 +1,4 @@
-"""The auto modes' heading smoothing (sitl_emu/flight/heading.py, after PX4's HeadingSmoothing)."""
+"""The auto modes' heading smoothing (sitl_emu/motion_planning/heading.py, after PX4's HeadingSmoothing)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from sitl_emu.flight.heading import HeadingSmoother
+from sitl_emu.motion_planning.heading import HeadingSmoother
 
 DT = 0.008
 RATE, ACC = math.radians(60.0), math.radians(20.0)  # MPC_YAWRAUTO_MAX, MPC_YAWRAUTO_ACC defaults

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from sitl_emu.flight.land_detector import LandDetector, LandDetectorInput, LandDetectorState
 from sitl_emu.params import default_registry
+from sitl_emu.vehicle.land_detector import LandDetector, LandDetectorInput, LandDetectorState
 
 STEP_US = 4000
 HOVER = 0.5  # thresholds with MPC_THR_MIN 0.12: ground contact <= 0.348, maybe landed <= 0.158

@@ -9,7 +9,7 @@ import math
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 CENTRED = ManualControlSetpoint(throttle=0.0)

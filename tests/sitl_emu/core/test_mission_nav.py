@@ -8,17 +8,17 @@ from collections.abc import Callable
 
 import pytest
 
-from sitl_emu.flight.mission_store import (
+from sitl_emu.geo import ned_to_global
+from sitl_emu.navigator.mission_store import (
     MISSION_STATE_ACTIVE,
     MISSION_STATE_COMPLETE,
     MISSION_STATE_PAUSED,
     PLAN_MISSION,
     MissionItem,
 )
-from sitl_emu.geo import ned_to_global
 from sitl_emu.px4 import MavCmd, MavResult, NavState
 from sitl_emu.types import VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 WP, LOITER_UNLIM, LOITER_TIME, LAND, TAKEOFF, DELAY = 16, 17, 19, 21, 22, 93

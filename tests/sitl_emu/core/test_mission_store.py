@@ -1,9 +1,9 @@
-"""The vehicle's plan store (flight/mission_store.py): whole plans replaced at once, cleared per type, the current
+"""The vehicle's plan store (navigator/mission_store.py): whole plans replaced at once, cleared per type, the current
 item, the vehicle-wide upload lock, and nothing kept across a reboot (no storage file, unlike PX4's dataman file)."""
 
 from __future__ import annotations
 
-from sitl_emu.flight.mission_store import (
+from sitl_emu.navigator.mission_store import (
     MISSION_STATE_NO_MISSION,
     MISSION_STATE_NOT_STARTED,
     PLAN_ALL,
@@ -13,7 +13,7 @@ from sitl_emu.flight.mission_store import (
     MissionItem,
     MissionStore,
 )
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 
 def _wp(seq: int, x: int = 473977420) -> MissionItem:

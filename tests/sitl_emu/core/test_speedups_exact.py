@@ -16,7 +16,7 @@ from support import REPO_ROOT
 
 import sitl_emu.control.attitude
 import sitl_emu.physics
-import sitl_emu.vehicle  # noqa: F401  (imported so that compiled_modules() can see them)
+import sitl_emu.vehicle.vehicle  # noqa: F401  (imported so that compiled_modules() can see them)
 from sitl_emu._speedups import compiled_modules
 
 REPO = REPO_ROOT
@@ -24,7 +24,7 @@ HASH_SCRIPT = """
 import hashlib, sys
 sys.path.insert(0, {tests!r})
 from support.flights import scripted_flight as _script
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 from sitl_emu._speedups import compiled_modules
 print(len(compiled_modules()), hashlib.sha256(repr(_script(Vehicle(seed=7))).encode()).hexdigest())
 """
@@ -44,7 +44,7 @@ def _child(pure: bool) -> tuple[int, str]:
 
 def test_the_vehicle_core_really_runs_compiled() -> None:
     names = compiled_modules()
-    for module in ("sitl_emu.physics", "sitl_emu.control.attitude", "sitl_emu.vehicle"):
+    for module in ("sitl_emu.physics", "sitl_emu.control.attitude", "sitl_emu.vehicle.vehicle"):
         assert module in names
 
 
@@ -58,7 +58,7 @@ def test_compiled_and_pure_python_fly_identically() -> None:
 def test_in_process_run_matches_a_pure_python_child() -> None:
     from support.flights import scripted_flight as _script
 
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     digest = hashlib.sha256(repr(_script(Vehicle(seed=7))).encode()).hexdigest()
     assert digest == _child(pure=True)[1]

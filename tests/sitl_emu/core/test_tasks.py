@@ -9,8 +9,7 @@ from dataclasses import dataclass, field
 import pytest
 
 from sitl_emu.control.takeoff import TakeoffState
-from sitl_emu.flight.smoothing import AxisSmoother, braking_distance, max_speed_from_distance
-from sitl_emu.flight.tasks import (
+from sitl_emu.flight_tasks.auto import (
     NavInput,
     SetpointType,
     TakeoffTask,
@@ -21,7 +20,8 @@ from sitl_emu.flight.tasks import (
     make_rtl,
     make_takeoff,
 )
-from sitl_emu.flight.tasks_rtl import RtlState, rtl_start_text
+from sitl_emu.flight_tasks.rtl import RtlState, rtl_start_text
+from sitl_emu.motion_planning.smoothing import AxisSmoother, braking_distance, max_speed_from_distance
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import TrajectorySetpoint, Vec3

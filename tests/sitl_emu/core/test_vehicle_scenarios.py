@@ -9,7 +9,7 @@ import pytest
 
 from sitl_emu.px4 import LandedState, MavCmd, MavResult, MavState, NavState, Severity, custom_mode, decode_custom_mode
 from sitl_emu.types import NAN3, OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 S = 1_000_000

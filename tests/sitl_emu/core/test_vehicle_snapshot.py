@@ -8,7 +8,7 @@ import math
 from sitl_emu.geo import GeoRef, ned_to_global
 from sitl_emu.px4 import MavState, NavState, custom_mode, decode_custom_mode
 from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 
@@ -34,7 +34,7 @@ def _check(v: Vehicle) -> VehicleSnapshot:
     assert s.time_us == v.time_us
     assert s.extras == {"system_status": float(v.commander.system_status())}
     assert s.pre_flight_checks_pass == v.commander.pre_flight_checks_pass()
-    # the battery simulator (flight/battery.py): full while disarmed, draining while armed
+    # the battery simulator (commander/battery.py): full while disarmed, draining while armed
     assert (s.battery_voltage_v, s.battery_remaining) == (v.faults.battery.voltage_v, v.faults.battery.remaining)
     if not s.armed:
         assert s.battery_voltage_v == 16.2 and s.battery_remaining == 1.0

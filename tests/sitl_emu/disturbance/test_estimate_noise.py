@@ -11,7 +11,7 @@ from support.states import hover_state
 from sitl_emu.disturbance.estimate import EstimateNoise, EstimateNoiseSettings
 from sitl_emu.px4 import MavCmd
 from sitl_emu.types import VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 

@@ -21,7 +21,7 @@ from sitl_emu.disturbance.wind import (
 from sitl_emu.physics import GRAVITY_M_S2
 from sitl_emu.px4 import MavCmd
 from sitl_emu.types import VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 DT = 0.004
 NAN = math.nan

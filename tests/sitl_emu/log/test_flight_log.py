@@ -17,7 +17,7 @@ import pytest
 from support.log_flight import TAKEOFF_ALT_M, Flight, fly_takeoff_land, log_files
 
 from sitl_emu.log.topics import default_topics
-from sitl_emu.mavlink.log_protocol import LIST_ALL
+from sitl_emu.mavlink.protocols.log import LIST_ALL
 
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")
 ULog = pyulog.ULog

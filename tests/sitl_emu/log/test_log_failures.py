@@ -12,7 +12,7 @@ import pytest
 from support.log_flight import fly_takeoff_land, log_files
 
 from sitl_emu.log.flight_log import BUFFER_BYTES
-from sitl_emu.mavlink.log_protocol import LIST_ALL
+from sitl_emu.mavlink.protocols.log import LIST_ALL
 from sitl_emu.types import ManualControlSetpoint
 
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")

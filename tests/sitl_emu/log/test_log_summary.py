@@ -16,7 +16,7 @@ import pytest
 from click.testing import CliRunner
 from support.log_flight import RecordingClient, log_files
 
-from sitl_emu.cli import main
+from sitl_emu.cli.main import main
 from sitl_emu.log.plot import INSTALL_HINT
 from sitl_emu.log.summary import mode_label, read_ulog, series, summarise
 from sitl_emu.testing.client import fly_square

@@ -16,7 +16,7 @@ from support import REPO_ROOT
 from support.log_flight import RecordingClient
 from support.ports import free_udp_ports
 
-from sitl_emu.mavlink.log_protocol import LIST_ALL
+from sitl_emu.mavlink.protocols.log import LIST_ALL
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.testing.sim import ScaledWallClock
 

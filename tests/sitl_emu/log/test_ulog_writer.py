@@ -11,10 +11,10 @@ from support.ftp_client import FtpClient
 
 from sitl_emu.log import ulog_writer as ulog
 from sitl_emu.log.serving import attach_logger
-from sitl_emu.mavlink.ftp_protocol import FtpProtocol
+from sitl_emu.mavlink.protocols.ftp import FtpProtocol
 from sitl_emu.px4 import MavCmd
 from sitl_emu.types import VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")
 NAN = math.nan

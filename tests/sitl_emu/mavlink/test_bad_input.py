@@ -13,7 +13,7 @@ import pytest
 from support.fakes import Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN, INF = math.nan, math.inf
 

@@ -14,7 +14,7 @@ from support.fakes import Harness
 
 from sitl_emu.mavlink.version import ProtocolVersionMessage
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 dialect.mavlink_map.setdefault(300, ProtocolVersionMessage)  # let the test client parse PROTOCOL_VERSION

@@ -1,4 +1,4 @@
-"""The messages pymavlink lacks are framed as mavgen's generated code would (sitl_emu/mavlink/extra_messages.py).
+"""The messages pymavlink lacks are framed as mavgen's generated code would (sitl_emu/mavlink/wire/extra_messages.py).
 
 The CRC_EXTRA seed and wire order are computed from the field lists; the algorithm must reproduce every message
 pymavlink has, and the seeds and payload lengths must be the published ones (MAVLINK_MSG_ID_<NAME>_CRC / _LEN of the
@@ -13,8 +13,8 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import development as dialect
 
-from sitl_emu.mavlink import extra_messages as xm
-from sitl_emu.mavlink import fastpack
+from sitl_emu.mavlink.wire import extra_messages as xm
+from sitl_emu.mavlink.wire import fastpack
 
 # (CRC_EXTRA, payload length) of the C headers generated from mavlink/mavlink's XML
 PUBLISHED = {"LINK_NODE_STATUS": (117, 36), "ESC_INFO": (251, 46), "ESC_STATUS": (10, 57),

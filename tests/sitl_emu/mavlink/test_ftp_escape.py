@@ -15,7 +15,7 @@ import pytest
 from support.fakes import FakeVehicle, Harness
 from support.ftp_client import FtpClient
 
-from sitl_emu.mavlink.ftp_protocol import MAX_DATA, Err, FtpProtocol, Op
+from sitl_emu.mavlink.protocols.ftp import MAX_DATA, Err, FtpProtocol, Op
 
 SECRET = b"outside the root"
 # Every path here, even one the sandbox let through by mistake, lands inside the test's own tmp_path: a suite that

@@ -16,7 +16,7 @@ from support.ftp_client import FtpClient, request_payload
 
 from sitl_emu.mavlink import version
 from sitl_emu.mavlink.endpoint import load_handler_classes
-from sitl_emu.mavlink.ftp_protocol import (
+from sitl_emu.mavlink.protocols.ftp import (
     BURST_CHUNK_BYTES,
     BURST_PACKETS_PER_TICK,
     MAX_DATA,

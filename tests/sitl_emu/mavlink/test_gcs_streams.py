@@ -19,9 +19,9 @@ from pymavlink.dialects.v20 import development as dialect
 from support.fakes import HOME, Harness
 from support.ports import pending_datagrams
 
-from sitl_emu.mavlink import extra_messages
+from sitl_emu.mavlink.wire import extra_messages
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 # ../shared/reference/px4-gcs-streams.json, copied so the test runs anywhere: message id -> rate (Hz) PX4 SIH streams
 # on its GCS link at rest, counted over 10 s by a client acting as QGC.

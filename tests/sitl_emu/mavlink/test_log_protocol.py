@@ -14,7 +14,7 @@ import pytest
 from support.fakes import FakeVehicle, Harness
 
 from sitl_emu.mavlink.endpoint import load_handler_classes
-from sitl_emu.mavlink.log_protocol import (
+from sitl_emu.mavlink.protocols.log import (
     DATA_PER_TICK,
     LIST_ALL,
     LOG_DATA_LEN,

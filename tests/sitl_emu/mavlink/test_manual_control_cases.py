@@ -16,7 +16,7 @@ import pytest
 from support.fakes import Client, Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 # a copy of ../shared/reference/px4-manual (recorded from real PX4 SITL; see its README)
 CASES: dict[str, Any] = json.loads((Path(__file__).parents[2] / "reference" / "px4-manual" / "cases.json").read_text())

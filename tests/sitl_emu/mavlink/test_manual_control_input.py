@@ -14,7 +14,7 @@ from support.fakes import Client, Harness
 from sitl_emu.mavlink.receiver import manual_setpoint
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, NavState
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 INT16_MIN, INT16_MAX = -32768, 32767
 

@@ -19,12 +19,12 @@ from support.fakes import HOME, Harness
 from support.handler_ctx import make_snapshot
 from support.ports import pending_datagrams
 
-from sitl_emu.mavlink import extra_messages, fastpack
-from sitl_emu.mavlink.telemetry import BUILDERS, ON_REQUEST
+from sitl_emu.mavlink.telemetry.streams import BUILDERS, ON_REQUEST
 from sitl_emu.mavlink.version import ProtocolVersionMessage
+from sitl_emu.mavlink.wire import extra_messages, fastpack
 from sitl_emu.px4 import MavCmd, NavState
 from sitl_emu.types import HomePosition, OffboardControlMode, TrajectorySetpoint, VehicleCommand
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 # (test_commands_wire.py adds PROTOCOL_VERSION to the dialect's map for its client: not a dialect class here)
 DIALECT_CLASSES = [cls for cls in dialect.mavlink_map.values() if cls is not ProtocolVersionMessage]
@@ -266,7 +266,7 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
 
 
 def test_integer_fields_saturate_and_send_zero_for_non_finite_values():
-    from sitl_emu.mavlink import telemetry_msgs as tm
+    from sitl_emu.mavlink.telemetry import messages as tm
 
     def int32_ref(x: float) -> int:
         return max(min(round(x) if math.isfinite(x) else 0, 2**31 - 1), -(2**31))

@@ -18,8 +18,8 @@ from typing import Any
 import pytest
 from support.fakes import Client, Harness
 
-from sitl_emu.mavlink.mission_protocol import MissionProtocol
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.mavlink.protocols.mission import MissionProtocol
+from sitl_emu.vehicle.vehicle import Vehicle
 
 CASES: dict[str, Any] = json.loads((Path(__file__).parents[2] / "reference" / "px4-mission" / "cases.json").read_text())
 PROTOCOL = ("MISSION_COUNT", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ITEM_INT", "MISSION_ITEM",

@@ -22,7 +22,7 @@ import pytest
 from support.fakes import Client, Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 REF = Path(__file__).parents[2] / "reference" / "px4-mission"
 CASES: dict[str, Any] = json.loads((REF / "cases.json").read_text())
@@ -162,7 +162,7 @@ def test_flight1_times_against_the_reference(flight1: Flight) -> None:
     texts = dict((text.rstrip("\t"), t) for t, text in flight1.texts)
     assert texts["Takeoff detected"] == pytest.approx(METRICS["t_takeoff_text_s"], abs=0.6)
     assert texts["Returning to launch"] == pytest.approx(METRICS["_info"]["texts_t_s"][4], abs=0.6)
-    # the return itself is RTL's (flight/tasks_rtl.py): it lands ~2 s sooner than PX4 did, hence the 3 s here
+    # the return itself is RTL's (flight_tasks/rtl.py): it lands ~2 s sooner than PX4 did, hence the 3 s here
     assert texts["RTL: land at destination"] == pytest.approx(METRICS["_info"]["texts_t_s"][6], abs=3.0)
     assert texts["Disarmed by landing"] == pytest.approx(METRICS["t_disarmed_text_s"], abs=4.0)
 

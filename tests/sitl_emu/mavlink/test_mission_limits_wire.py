@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 from support.fakes import Client
 
-from sitl_emu.flight.mission_store import MAX_ITEMS
+from sitl_emu.navigator.mission_store import MAX_ITEMS
 from sitl_emu.testing.sim import Sim
 
 LAT, LON = 473977420, 85455940

@@ -10,8 +10,8 @@ import pytest
 from support import REPO_ROOT
 from support.handler_ctx import CLIENT_COMPID, CLIENT_SYSID, Client, FakeVehicle, MemoryContext
 
-from sitl_emu.flight.mission_store import MAX_ITEMS
-from sitl_emu.mavlink.mission_items import (
+from sitl_emu.mavlink.protocols.mission import MissionProtocol
+from sitl_emu.mavlink.protocols.mission_items import (
     MAV_MISSION_ACCEPTED,
     MAV_MISSION_ERROR,
     MAV_MISSION_INVALID_PARAM5_X,
@@ -21,7 +21,7 @@ from sitl_emu.mavlink.mission_items import (
     UINT16_MAX,
     mission_current_fields,
 )
-from sitl_emu.mavlink.mission_protocol import MissionProtocol
+from sitl_emu.navigator.mission_store import MAX_ITEMS
 from sitl_emu.px4 import NavState, Severity
 
 LAT, LON = 473977420, 85455940

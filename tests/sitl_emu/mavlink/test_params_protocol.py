@@ -8,7 +8,7 @@ import struct
 import pytest
 from support.handler_ctx import Client, FakeVehicle, MemoryContext
 
-from sitl_emu.mavlink.params_protocol import (
+from sitl_emu.mavlink.protocols.params import (
     HASH_CHECK_INDEX,
     MAV_PARAM_TYPE_INT32,
     MAV_PARAM_TYPE_REAL32,

@@ -12,7 +12,7 @@ import struct
 import pytest
 from support.fakes import Harness
 
-from sitl_emu.mavlink.params_protocol import (
+from sitl_emu.mavlink.protocols.params import (
     HASH_CHECK_INDEX,
     MAV_PARAM_TYPE_INT32,
     MAV_PARAM_TYPE_REAL32,
@@ -25,7 +25,7 @@ from sitl_emu.mavlink.params_protocol import (
 )
 from sitl_emu.params.catalog import EMULATOR_DEFAULTS
 from sitl_emu.params.registry import ParamType, float32, same_value
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 from ..test_params_registry import px4_list
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from support.handler_ctx import Client, FakeVehicle, MemoryContext
 
-from sitl_emu.mavlink.shell_bridge import (
+from sitl_emu.mavlink.protocols.shell import (
     CHUNKS_PER_TICK,
     MAX_CHUNK,
     SERIAL_CONTROL_FLAG_REPLY,

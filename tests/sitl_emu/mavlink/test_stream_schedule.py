@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import random
 
-from sitl_emu.mavlink import telemetry
-from sitl_emu.mavlink.telemetry import HEARTBEAT_ID, HEARTBEAT_INTERVAL_US, StreamMode, Streams
+from sitl_emu.mavlink.telemetry import streams as telemetry
+from sitl_emu.mavlink.telemetry.streams import HEARTBEAT_ID, HEARTBEAT_INTERVAL_US, StreamMode, Streams
 
 
 class _Reference:

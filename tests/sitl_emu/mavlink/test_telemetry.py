@@ -10,7 +10,7 @@ from pymavlink import mavutil
 from support.fakes import HOME, Harness
 
 from sitl_emu.px4 import MavCmd
-from sitl_emu.vehicle import Vehicle
+from sitl_emu.vehicle.vehicle import Vehicle
 
 EPOCH_US = 1_700_000_000_000_000
 

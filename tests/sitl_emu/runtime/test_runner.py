@@ -159,7 +159,7 @@ def test_batched_ticks_keep_simulated_time_with_fewer_wake_ups():
 
 
 def test_serve_batches_in_simulated_ms_but_wakes_at_most_1000_times_a_second():
-    from sitl_emu.cli import DEFAULT_BATCH_MS, wake_period_s
+    from sitl_emu.cli.main import DEFAULT_BATCH_MS, wake_period_s
 
     assert wake_period_s(DEFAULT_BATCH_MS, 1.0) == pytest.approx(0.010)  # 100 wake-ups a second at real time
     assert wake_period_s(DEFAULT_BATCH_MS, 5.0) == pytest.approx(0.002)  # still 10 simulated ms at --speed 5

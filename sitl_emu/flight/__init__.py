@@ -1,1 +1,0 @@
-"""sitl_emu.flight"""

@@ -1,0 +1,161 @@
+"""AUTO.RTL for a multicopter returning to home (PX4 navigator rtl.cpp + rtl_direct.cpp, RTL_TYPE 0).
+
+States as RtlDirect: CLIMBING (to the return altitude above the current position) -> MOVE_TO_LOITER (home at the
+return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise LOITER_DOWN (to RTL_DESCEND_ALT) ->
+LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The destination is home or the rally
+point RTL_TYPE selects (navigator/rally.py; "home" below means that destination). The return altitude follows
+RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from enum import Enum
+from typing import Final
+
+from sitl_emu.flight_tasks.core import NavInput, SetpointType, Task, Waypoint
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import Severity
+from sitl_emu.types import NAN, Vec3
+
+_F32: Final = struct.Struct("<f")
+
+
+class RtlState(Enum):
+    """RtlDirect's states (rtl_direct.h RTLState), named for what the vehicle does."""
+
+    CLIMB = "climb"  # CLIMBING
+    RETURN = "return"  # MOVE_TO_LOITER
+    DESCEND = "descend"  # LOITER_DOWN
+    HOLD = "hold"  # LOITER_HOLD
+    HOVER = "hover"  # MOVE_TO_LAND_HOVER
+    LAND = "land"  # LAND
+    IDLE = "idle"  # IDLE (on the ground)
+
+
+def rtl_start_text(return_alt_amsl_m: float, destination_alt_amsl_m: float) -> str:
+    """The text RtlDirect::on_activation logs (navigator/rtl_direct.cpp): both altitudes are floats (32 bit) in PX4,
+    rounded up, the second being the float difference; so 518.0000001 m, which is 518.0 as a float, says 518."""
+    rtl_alt = _f32(return_alt_amsl_m)
+    above = _f32(rtl_alt - _f32(destination_alt_amsl_m))
+    return f"RTL: start return at {math.ceil(rtl_alt):d} m ({math.ceil(above):d} m above destination)"
+
+
+def _f32(x: float) -> float:
+    """x rounded to the nearest 32-bit float, as PX4 holds it."""
+    return float(_F32.unpack(_F32.pack(x))[0]) if math.isfinite(x) else x
+
+
+class RtlTask(Task):
+    def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
+                 loiter_at_ned_m: Vec3 | None = None) -> None:
+        """`destination`: where to return (rtl.cpp findRtlDestination: home, or a rally point chosen by
+        navigator/rally.py), NED position and yaw. `loiter_at_ned_m`: the loiter the vehicle was established on when RTL
+        began (a finished mission's last setpoint): the climb keeps its centre (rtl_direct.cpp CLIMBING,
+        is_established_on_loiter); else the climb is centred where the vehicle is."""
+        super().__init__(nav, params)
+        self._loiter_at = loiter_at_ned_m
+        self._yaw_err_rad = math.radians(float(params.get("MIS_YAW_ERR")) if "MIS_YAW_ERR" in params else 12.0)
+        self._home: Vec3 = nav.home_ned_m if destination is None else destination[0]
+        self._home_yaw = nav.home_yaw_rad if destination is None else destination[1]
+        self._rtl_up_m = self._return_altitude_up(nav)
+        self._state = RtlState.IDLE
+        self._hold_until_us = 0
+        if nav.landed:
+            self._enter(RtlState.IDLE, nav)
+        else:
+            self._enter(RtlState.CLIMB if -nav.pos_ned_m[2] < self._rtl_up_m else RtlState.RETURN, nav)
+        self._say(Severity.INFO, rtl_start_text(nav.ref_alt_amsl_m + self._rtl_up_m,
+                                                nav.ref_alt_amsl_m - self._home[2]))
+
+    @property
+    def state(self) -> RtlState:
+        return self._state
+
+    @property
+    def return_alt_up_m(self) -> float:
+        return self._rtl_up_m
+
+    def _return_altitude_up(self, nav: NavInput) -> float:
+        """Return altitude (up, local frame) after the cone rule, never below the current altitude."""
+        s = self._settings
+        home_up, current_up = -self._home[2], -nav.pos_ned_m[2]
+        dist = self._dist_xy(nav)
+        if s.rtl_cone_ang <= 0:
+            return max(current_up, home_up + s.rtl_return_alt)
+        alt = home_up + s.rtl_return_alt
+        if dist <= s.nav_acc_rad:
+            alt = home_up + 2.0 * dist
+        else:
+            if dist <= s.rtl_min_dist:
+                half_angle = math.radians(min(max(s.rtl_cone_ang, 1.0), 89.0))
+                alt = min(dist / math.tan(half_angle) + home_up, alt)
+            alt = max(alt, home_up + 2.0 * s.nav_acc_rad)
+        return max(alt, current_up)
+
+    def _dist_xy(self, nav: NavInput) -> float:
+        return math.hypot(self._home[0] - nav.pos_ned_m[0], self._home[1] - nav.pos_ned_m[1])
+
+    def _enter(self, state: RtlState, nav: NavInput) -> None:
+        self._state = state
+        s = self._settings
+        if state is RtlState.CLIMB:
+            at = self._loiter_at if self._loiter_at is not None else nav.pos_ned_m
+            self._climb_xy = (at[0], at[1])
+            self._climb_yaw = nav.yaw_rad
+        elif state is RtlState.RETURN:
+            self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN
+        elif state is RtlState.HOLD:
+            self._hold_until_us = nav.time_us + int(s.rtl_land_delay * 1e6)
+            if s.rtl_land_delay < 0.0:
+                self._say(Severity.INFO, "RTL: completed, loitering")
+        elif state is RtlState.LAND:
+            self._say(Severity.INFO, "RTL: land at destination")
+
+    def _heading_reached(self, nav: NavInput) -> bool:
+        """mission_block.cpp: an item with a heading (the return leg near home faces home's heading) is reached only
+        once the heading is within MIS_YAW_ERR (MIS_YAW_TMT -1: no timeout)."""
+        if not math.isfinite(self._return_yaw):
+            return True
+        err = (self._return_yaw - nav.yaw_rad + math.pi) % math.tau - math.pi
+        return abs(err) < self._yaw_err_rad
+
+    def _loiter_up_m(self) -> float:
+        return min(-self._home[2] + self._settings.rtl_descend_alt, self._rtl_up_m)
+
+    def _waypoint(self, nav: NavInput) -> Waypoint:
+        self._advance(nav)
+        return self._current_waypoint()
+
+    def _current_waypoint(self) -> Waypoint:
+        hx, hy = self._home[0], self._home[1]
+        st = self._state
+        if st is RtlState.CLIMB:
+            return Waypoint(SetpointType.POSITION, (self._climb_xy[0], self._climb_xy[1], -self._rtl_up_m),
+                            self._climb_yaw)
+        if st is RtlState.RETURN:
+            return Waypoint(SetpointType.POSITION, (hx, hy, -self._rtl_up_m), self._return_yaw)
+        if st in (RtlState.DESCEND, RtlState.HOLD, RtlState.HOVER):
+            return Waypoint(SetpointType.POSITION, (hx, hy, -self._loiter_up_m()), self._home_yaw)
+        if st is RtlState.LAND:
+            return Waypoint(SetpointType.LAND, (hx, hy, NAN), self._home_yaw)
+        return Waypoint(SetpointType.IDLE, self._home)
+
+    def _advance(self, nav: NavInput) -> None:
+        """RtlDirect::_updateRtlState once the current item is reached (mission_block acceptance rules)."""
+        s = self._settings
+        up = -nav.pos_ned_m[2]
+        near_xy = self._dist_xy(nav) <= s.nav_acc_rad
+        st = self._state
+        if st is RtlState.CLIMB and up >= self._rtl_up_m - s.nav_mc_alt_rad:
+            self._enter(RtlState.RETURN, nav)
+        elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad \
+                and self._heading_reached(nav):
+            self._enter(RtlState.LAND if s.rtl_land_delay == 0.0 else RtlState.DESCEND, nav)
+        elif st is RtlState.DESCEND and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
+            self._enter(RtlState.HOLD, nav)
+        elif st is RtlState.HOLD and s.rtl_land_delay >= 0.0 and nav.time_us >= self._hold_until_us:
+            self._enter(RtlState.HOVER, nav)
+        elif st is RtlState.HOVER and near_xy:
+            self._enter(RtlState.LAND, nav)

@@ -1,0 +1,162 @@
+"""The vehicle's geofence and rally-point glue: the stored plans, the parameters and the estimate turned into the
+navigator's geofence check (navigator/geofence_monitor.py) and RTL's destination (navigator/rally.py).
+
+Vehicle.step calls `FenceChecks.check_commands` on the navigator's new requests (DO_REPOSITION and
+DO_CHANGE_ALTITUDE targets outside the fence are refused, navigator_main.cpp geofence_allows_position) and
+`FenceChecks.step` before each commander cycle (PX4: the navigator's geofence_breach_check
+publishes geofence_result, the commander's health check and failsafe act on it); the mode executor asks
+`rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from sitl_emu.commander.commander import Commander
+from sitl_emu.control.qmath import isfinite
+from sitl_emu.flight_tasks.core import NavInput
+from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
+from sitl_emu.navigator.commands import NavCommand, NavCommandKind
+from sitl_emu.navigator.geofence import (
+    GF_ACTION_NONE,
+    GF_ACTION_WARN,
+    GeofenceSettings,
+    GeoPoint,
+    mission_fence_violation,
+    point_allowed,
+)
+from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
+from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
+from sitl_emu.navigator.rally import choose_destination
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import NavState, Severity
+from sitl_emu.types import Vec3
+
+# emit(severity, module, text, is_event, statustext), as Vehicle._emit
+Emit = Callable[[Severity, str, str, bool, bool], None]
+
+
+def _geo(ref: GeoRef, pos_ned_m: Vec3) -> GeoPoint:
+    return GeoPoint(*ned_to_global(ref, pos_ned_m))
+
+
+def home_point(c: Commander) -> GeoPoint | None:
+    h = c.home
+    return GeoPoint(h.lat_deg, h.lon_deg, h.alt_amsl_m) if h is not None else None
+
+
+class FenceChecks:
+    """The geofence monitor with its settings, read again only when a parameter changes."""
+
+    def __init__(self, params: ParamRegistry) -> None:
+        self.params = params
+        self.monitor = GeofenceMonitor()
+        self._settings: GeofenceSettings = geofence_settings(params)
+        self._version = params.version
+        self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
+        # the very objects that key was made of (plans and home are replaced, never changed in place): while they
+        # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
+        # changes)
+        self._mission_inputs: tuple[object, ...] = (None, None, None, -1)
+
+    @property
+    def settings(self) -> GeofenceSettings:
+        if self.params.version != self._version:
+            self._settings, self._version = geofence_settings(self.params), self.params.version
+        return self._settings
+
+    def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
+             ref: GeoRef, emit: Emit) -> None:
+        """The navigator's geofence work before a commander cycle: the breach check when due, then the mission
+        against the fence when a plan, home or a parameter was replaced."""
+        fence = store.plan(PLAN_FENCE)
+        if self.monitor.due(now_us, fence, position_valid=c.estimator_ready):  # as _breach_check's inputs
+            self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
+        if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
+            self._check_mission(store, c, emit)
+
+    def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
+                      truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:
+        """One geofence check: the result goes to the commander (c.geofence), the texts out, and the Hold position
+        after a breach into the navigator's queue."""
+        plan = store.plan(PLAN_FENCE)
+        ready = c.estimator_ready
+        inputs = GeofenceInputs(estimate=_geo(ref, estimate_ned_m) if ready else None,
+                                gps=_geo(ref, truth_ned_m) if ready else None, home=home_point(c), landed=c.landed,
+                                armed=c.armed, in_hold=c.nav_state is NavState.AUTO_LOITER)
+        out = self.monitor.update(now_us, plan, self.settings, inputs)
+        c.geofence = self.monitor.result
+        for text in out.navigator_texts:
+            emit(Severity.CRITICAL, "navigator", text, True, True)
+        for text in out.health_texts:  # geofenceCheck.cpp's legacy mavlink_log_critical (no event: no tab)
+            emit(Severity.CRITICAL, "commander", text, False, True)
+        if out.reposition is not None:
+            p = out.reposition
+            c.nav_commands.append(NavCommand(NavCommandKind.REPOSITION, p.lat_deg, p.lon_deg, p.alt_amsl_m))
+
+    def _check_mission(self, store: MissionStore, c: Commander, emit: Emit) -> None:
+        """The mission against the fence, again whenever the mission, the fence, home or a parameter changed
+        (mission_base.cpp check_mission_valid): a violation makes the mission invalid and is told once."""
+        mission, fence = store.plan(PLAN_MISSION), store.plan(PLAN_FENCE)
+        key = (mission.opaque_id, mission.count, fence.opaque_id, fence.count, home_point(c), self.params.version)
+        if key == self._mission_key:
+            return
+        self._mission_key = key
+        text = self.mission_violation(store, c) if mission.count else None
+        store.fence_violation = text
+        if text is not None:
+            emit(Severity.CRITICAL, "navigator", text, True, True)
+
+    def _inputs_replaced(self, mission: Plan, fence: Plan, c: Commander) -> bool:
+        """Whether a plan, home or the parameters were replaced since the last call (maybe with equal values)."""
+        inputs = self._mission_inputs
+        if inputs[0] is mission and inputs[1] is fence and inputs[2] is c.home and inputs[3] == self.params.version:
+            return False
+        self._mission_inputs = (mission, fence, c.home, self.params.version)
+        return True
+
+    def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:
+        """Drop a reposition or altitude change whose target the fence forbids (GF_ACTION other than None and
+        Warning), with PX4's text; NaN coordinates mean the current ones. An allowed reposition ends the Hold latch
+        after a breach."""
+        s = self.settings
+        if s.action in (GF_ACTION_NONE, GF_ACTION_WARN) or not c.armed:
+            return
+        here = _geo(ref, here_ned_m)
+        kept = []
+        for cmd in c.nav_commands:
+            if cmd.kind is NavCommandKind.TAKEOFF:
+                kept.append(cmd)
+                continue
+            has_xy = isfinite(cmd.lat_deg) and isfinite(cmd.lon_deg)
+            target = GeoPoint(cmd.lat_deg if has_xy else here.lat_deg, cmd.lon_deg if has_xy else here.lon_deg,
+                              cmd.alt_amsl_m if isfinite(cmd.alt_amsl_m) else here.alt_amsl_m)
+            if point_allowed(self.monitor.fence, s, target, home_point(c)):
+                kept.append(cmd)
+                if cmd.kind is NavCommandKind.REPOSITION:
+                    self.monitor.unlatch()
+            else:
+                what = "Reposition" if cmd.kind is NavCommandKind.REPOSITION else "Altitude change"
+                emit(Severity.CRITICAL, "navigator", f"{what} is outside geofence", True, True)
+        c.nav_commands[:] = kept
+
+    def mission_violation(self, store: MissionStore, c: Commander) -> str | None:
+        """MissionFeasibilityChecker::checkMissionAgainstGeofence for the stored mission against the fence in force:
+        None, or the CRITICAL text the navigator logs (an event: module navigator) and the mission is not valid.
+        PX4 runs it when the mission, the fence (geofence_id) or home changes (mission_base.cpp check_mission_valid)."""
+        return mission_fence_violation(store.plan(PLAN_MISSION).items, self.monitor.fence, self.settings,
+                                       home_point(c))
+
+
+def rtl_destination(nav: NavInput, params: ParamRegistry, store: MissionStore, c: Commander,
+                    ref: GeoRef) -> tuple[Vec3, float] | None:
+    """RTL's destination in NED with its yaw, or None to return home as before (no rally point chosen)."""
+    home = home_point(c)
+    if home is None or c.home is None:
+        return None
+    here = _geo(ref, nav.pos_ned_m)
+    dest = choose_destination(int(params["RTL_TYPE"]), store.plan(PLAN_RALLY).items, home, c.home.yaw_rad, here)
+    if dest.point == home:
+        return None
+    p = dest.point
+    return global_to_ned(ref, p.lat_deg, p.lon_deg, p.alt_amsl_m), dest.yaw_rad
