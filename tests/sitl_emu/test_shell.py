@@ -268,7 +268,7 @@ def test_mission_summary(vehicle):
 def test_a_mode_refused_in_the_air_says_so(word: str, name: str):
     """In the air without setpoints (OFFBOARD) or sticks (Position), PX4 refuses the mode; the console says it in
     PX4's words (printRejectMode) instead of nothing."""
-    from sitl_emu.vehicle import Vehicle
+    from sitl_emu.vehicle.vehicle import Vehicle
 
     vehicle = Vehicle()
     vehicle.run_until(3_000_000)  # ready to arm
