@@ -37,6 +37,7 @@ from sitl_emu.cli.options import (
     parse_address,
     parse_home,
 )
+from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
 from sitl_emu.console.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
@@ -44,7 +45,6 @@ from sitl_emu.mavlink.link_errors import PortInUseError
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner
 from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
-from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
 
 if TYPE_CHECKING:  # imported where used, so that `--help` stays quick
     from flightview.launch import ViewHandle
