@@ -66,7 +66,7 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 
 @main.command(short_help="Fly a vehicle with a joystick.")
 @_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
-                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
+                    "raw:FILE (a capture of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "

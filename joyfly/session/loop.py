@@ -108,11 +108,23 @@ class SessionLoop(SessionWatch):
             if not self._watch_link(now):
                 self._tick_exit_timeout(now)
                 return
+        if self._sticks_gone_before_arming():
+            return
         self._watch_joystick(now)
         if self.phase not in (Phase.EXITING, Phase.CONNECTING):
             self._handle_buttons()
         getattr(self, _PHASE_METHODS[self.phase])(now)
         self._after_tick(now)
+
+    def _sticks_gone_before_arming(self) -> bool:
+        """A joystick gone for good (it sent no js_events, its capture ended) before anything armed ends the session
+        with its sentence; after that it is a lost joystick (hold, then land)."""
+        if self.phase not in (Phase.CONNECTING, Phase.PRESTREAM, Phase.ARMING, Phase.ENTERING) or self._maybe_armed():
+            return False
+        why: str | None = getattr(self.sticks, "gone", lambda: None)()
+        if why is not None:
+            self._fail(why)
+        return why is not None
 
     # --- buttons -----------------------------------------------------------------------------------------------
 
