@@ -71,9 +71,9 @@ class Run:
     armed: bool
 
 
-def start(vehicle: Vehicle, spec: str) -> subprocess.Popen[str]:
+def start(vehicle: Vehicle, spec: str, *extra: str) -> subprocess.Popen[str]:
     return subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", spec, "--url", vehicle.url,
-                             "--speed", str(SPEED), "--connect-timeout", "60"], cwd=ROOT,
+                             "--speed", str(SPEED), "--connect-timeout", "60", *extra], cwd=ROOT,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -240,3 +240,46 @@ def test_the_example_script_flies_and_lands(vehicle: Vehicle) -> None:
     assert not any(f"{button} pressed" in out for button in ("ARM", "TAKEOFF", "OFFBOARD"))
     distance = next(line for line in out.splitlines() if line.startswith("distance flown"))
     assert float(distance.split()[2]) > 25.0  # climb, the square, the fence push and back
+
+
+def _fly_to_the_end(vehicle: Vehicle, spec: str, *extra: str, wall_s: float = 90.0) -> tuple[int | None, str, bool]:
+    """`joyfly fly` until it ends by itself (or wall_s: then Ctrl-C); (exit status, output, whether it ever armed)."""
+    proc = start(vehicle, spec, *extra)
+    armed = False
+    end = time.monotonic() + wall_s
+    while proc.poll() is None and time.monotonic() < end:
+        armed |= vehicle.armed
+        time.sleep(0.05)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    try:
+        stdout, stderr = proc.communicate(timeout=30.0)
+    finally:
+        proc.kill()
+    return proc.returncode, stdout + stderr, armed
+
+
+def test_the_position_mode_example_script_takes_off_flies_and_lands(vehicle: Vehicle) -> None:
+    """Issue 25.8: the README's script has no throttle in time, so in Position mode it never left the ground; the
+    example for Position mode takes off with the throttle, flies its square and lands, without a warning."""
+    status, out, armed = _fly_to_the_end(vehicle, "script:examples/joystick_script_position.txt",
+                                         "--control", "position")
+    assert status == 0 and armed and not vehicle.armed, out
+    assert "Takeoff detected" in out and "LAND pressed: landing" in out and "Landed and disarmed" in out, out
+    assert "not take off" not in out and "cannot take off" not in out  # no warning at the start
+    distance = next(line for line in out.splitlines() if line.startswith("distance flown"))
+    assert float(distance.split()[2]) > 8.0, out  # the climb and the square
+
+
+def test_position_mode_with_a_script_that_never_takes_off_in_time_warns_at_start(vehicle: Vehicle) -> None:
+    proc = start(vehicle, "script:examples/joystick_script.txt", "--control", "position")
+    assert proc.stdout is not None
+    first = [proc.stdout.readline() for _ in range(2)]
+    proc.send_signal(signal.SIGINT)
+    try:
+        stdout, stderr = proc.communicate(timeout=30.0)
+    finally:
+        proc.kill()
+    warning = first[1]
+    assert "examples/joystick_script.txt first pushes the throttle up at 20 s" in warning, [*first, stdout, stderr]
+    assert "will likely not take off" in warning and "examples/joystick_script_position.txt" in warning
