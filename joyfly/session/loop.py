@@ -180,8 +180,9 @@ class SessionLoop(SessionWatch):
             self._on_connected()
         elif now - self._start_s > self.s.connect_timeout_s:
             st = self.link.state
+            taken: bool | None = getattr(self.link.transport, "vehicle_port_taken", lambda: None)()
             self._fail(no_vehicle_message(self.link.transport.description, st.last_heartbeat_s is not None,
-                                          self.s.connect_timeout_s))
+                                          self.s.connect_timeout_s, taken))
 
     def _on_connected(self) -> None:
         st = self.link.state
