@@ -283,3 +283,24 @@ def test_position_mode_with_a_script_that_never_takes_off_in_time_warns_at_start
     warning = first[1]
     assert "examples/joystick_script.txt first pushes the throttle up at 20 s" in warning, [*first, stdout, stderr]
     assert "will likely not take off" in warning and "examples/joystick_script_position.txt" in warning
+
+
+def test_a_second_joyfly_on_another_port_is_told_the_vehicle_is_busy(vehicle: Vehicle) -> None:
+    """Issue 25.9: the vehicle answers its first client only (PX4's API link); a second joyfly used to be told to
+    start a vehicle."""
+    first = start(vehicle, "script:examples/joystick_script.txt")
+    try:
+        end = time.monotonic() + 40.0
+        while not vehicle.armed and time.monotonic() < end:
+            time.sleep(0.05)
+        assert vehicle.armed
+        other = f"udp://127.0.0.1:{free_udp_port()}@{vehicle.url.rsplit('@', 1)[1]}"
+        second = subprocess.run([sys.executable, "-m", "joyfly", "fly", "--joy", "script:examples/joystick_script.txt",
+                                 "--url", other, "--speed", str(SPEED), "--connect-timeout", "4"], cwd=ROOT,
+                                stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=60)
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=60.0)
+    lines = second.stderr.splitlines()
+    assert second.returncode == 1 and len(lines) == 1, second.stdout + second.stderr
+    assert "the vehicle is probably busy with another client" in lines[0] and "sitl-emu serve`" not in lines[0]
