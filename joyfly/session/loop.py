@@ -12,7 +12,7 @@ from dataclasses import replace
 
 from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER
 from joyfly.session.core import MIN_SEND_GAP_S, Level, Phase, SessionView, no_vehicle_message
-from joyfly.session.retry import ExitPlan, Outcome, on_ground_armed
+from joyfly.session.retry import ExitPlan, Outcome, exits_by_disarming
 from joyfly.session.watch import SessionWatch
 from joyfly.sticks.mapping import fired
 from joyfly.types import Action
@@ -248,7 +248,7 @@ class SessionLoop(SessionWatch):
         if self.phase is Phase.CONNECTING or not self._maybe_armed():
             self._set_phase(Phase.DONE)
             return
-        what = "disarming on the ground" if on_ground_armed(self.link.state) else self.s.on_exit
+        what = "disarming on the ground" if exits_by_disarming(self.link.state) else self.s.on_exit
         self._note(Level.INFO, f"Exiting: {what} (press Ctrl-C again to quit at once).")
         self._set_phase(Phase.EXITING)
 

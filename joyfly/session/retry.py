@@ -104,10 +104,11 @@ EXIT_MODES = {"land": "AUTO.LAND", "rtl": "AUTO.RTL", "hold": "AUTO.LOITER"}  # 
 class ExitPlan:
     """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
     until the vehicle is disarmed (land, rtl) or out of joyfly's mode (hold: `in_control`, OFFBOARD by default).
-    A vehicle armed on the ground (before its take-off, or after landing in a manual mode) is disarmed at once, as a
-    pilot would: LAND there would only wait for PX4's auto-disarm (COM_DISARM_PRFLT, 10 s). The disarm is a plain
-    ARM_DISARM, which PX4 refuses in the air ("Disarming denied: not landed", Commander::disarm): if the vehicle lifted
-    off meanwhile, the --on-exit action follows. The caller enforces the overall timeout."""
+    A vehicle armed on the ground (before its take-off, or after landing in a manual mode; or an ARM on its way) is
+    disarmed at once, as a pilot would: LAND there would only wait for PX4's auto-disarm (COM_DISARM_PRFLT, 10 s).
+    The disarm is a plain ARM_DISARM, which PX4 refuses in the air ("Disarming denied: not landed",
+    Commander::disarm): if the vehicle lifted off meanwhile, the --on-exit action follows. The caller enforces the
+    overall timeout."""
 
     def __init__(self, on_exit: str, link: VehicleLink, now_s: float,
                  in_control: Callable[[VehicleState], bool] | None = None) -> None:
@@ -115,7 +116,7 @@ class ExitPlan:
         self.link = link
         self.in_control = in_control or (lambda st: st.offboard)
         self.started_s = now_s
-        self.disarming = on_ground_armed(link.state)
+        self.disarming = exits_by_disarming(link.state)
         what = "Disarming on the ground" if self.disarming else f"Exit action {on_exit}"
         self.retry = Retry(what, 1 if self.disarming else 3, now_s, settle_s=math.inf)
         self._gave_up = False
@@ -160,6 +161,7 @@ class ExitPlan:
         return outcome
 
 
-def on_ground_armed(st: VehicleState) -> bool:
-    """Armed and on the ground by the vehicle's own land detector (EXTENDED_SYS_STATE landed_state ON_GROUND)."""
-    return st.armed and st.landed_state == MAV_LANDED_STATE_ON_GROUND
+def exits_by_disarming(st: VehicleState) -> bool:
+    """On the ground by the vehicle's own land detector (EXTENDED_SYS_STATE landed_state ON_GROUND), or not yet
+    armed by its HEARTBEAT (an ARM on its way): there the exit disarms."""
+    return st.landed_state == MAV_LANDED_STATE_ON_GROUND or (st.landed_state == 0 and not st.armed)
