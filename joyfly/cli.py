@@ -27,10 +27,11 @@ from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
-from joyfly.session.manual_session import MANUAL_CONTROLS
+from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
 
 D = FlyOptions()
@@ -66,7 +67,7 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 
 @main.command(short_help="Fly a vehicle with a joystick.")
 @_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
-                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
+                    "raw:FILE (a capture of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "
@@ -132,6 +133,10 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     view = make_view(out)
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
+    if opts.control in MANUAL_CONTROLS:
+        warning = takeoff_warning(sticks.source, sticks.profile, MANUAL_MODES[opts.control][2])
+        if warning is not None:
+            view.note(Note(clock.now(), Level.WARN, warning))
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), Level.WARN, text)))
     session.link.on_message.append(watch.observe)

@@ -126,7 +126,8 @@ def test_profiles_lists_every_builtin_layout():
 
 def test_test_reads_a_raw_file_and_refuses_a_plain_one(tmp_path):
     events = tmp_path / "events.bin"
-    events.write_bytes(pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, 0, 0) + pack_event(JS_EVENT_AXIS, 1, -32767))
+    init = pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, 0, 0) + pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, 1, 0)
+    events.write_bytes(init + pack_event(JS_EVENT_AXIS, 1, -32767, 100) + pack_event(JS_EVENT_AXIS, 1, 0, 400))
     result = run("test", "--joy", f"raw:{events}", "--duration", "0.2")
     assert result.exit_code == 0, result.output
     assert "axes=[0, -32767]" in result.output
