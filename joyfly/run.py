@@ -2,6 +2,8 @@
 (what happened, the summary, or in what state the vehicle was left).
 
 The first Ctrl-C or SIGTERM asks the session to perform --on-exit; a second one quits at once (exit status 130).
+Exit status: 0 a flight (or none) that ended well, 1 a failure joyfly reports, 3 the vehicle breached the fence,
+130 quit at once.
 """
 
 from __future__ import annotations
@@ -14,14 +16,16 @@ from typing import Any
 
 import click
 
-from joyfly.dashboard import summary_lines
+from joyfly.dashboard import breach_words, summary_lines
 from joyfly.session.core import Phase
 from joyfly.session.loop import SessionLoop
+
+EXIT_FENCE_BREACHED = 3  # the flight went outside the fence (joyfly/session/fence_watch.py)
 
 
 def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     """Run the session with Ctrl-C/SIGTERM handling, close everything, then say how it ended; returns the exit
-    status (0 done, 1 failed, 130 quit at once by a second Ctrl-C)."""
+    status (0 done, 1 failed, 3 the fence was breached, 130 quit at once by a second Ctrl-C)."""
     interrupted = False
     try:
         with exit_signals(session):
@@ -43,6 +47,10 @@ def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     if session.phase is Phase.FAILED:
         click.echo(f"joyfly: {session.error}", err=True)
         return 1
+    if session.stats.fence_breaches:
+        click.echo(f"joyfly: the vehicle went outside the {session.fence.half_width_m:g} m fence "
+                   f"({breach_words(session.stats)}).", err=True)
+        return EXIT_FENCE_BREACHED
     return 0
 
 
