@@ -207,6 +207,8 @@ class SessionCore:
         self._home_from_vehicle = False  # True when joyfly took over a flying vehicle: its HOME_POSITION is home
         self.home_known = False  # the fence's home is this flight's (set where joyfly arms, or the vehicle's own)
         self.fence_watch = FenceWatch()
+        self.airborne_mode: str | None = None  # the vehicle's mode while last known armed in the air, else None
+        self.unlanded: str | None = None  # why a flight of this session ended in the air (the vehicle restarted)
 
     def in_control(self, st: VehicleState) -> bool:
         """Whether the vehicle is in the mode joyfly flies it in (OFFBOARD here; ManualSession: POSCTL/ALTCTL)."""
@@ -222,6 +224,16 @@ class SessionCore:
     def summary_extra(self) -> list[str]:
         """Lines the flight's summary adds for this way of flying."""
         return []
+
+    def landing_missing(self) -> str | None:
+        """Why a flight of this session ended without a landing, or None: the vehicle restarted in the air, or
+        joyfly ends with the vehicle last known armed in the air (unless the user asked --on-exit hold)."""
+        if self.unlanded is not None:
+            return self.unlanded
+        if self.airborne_mode is None or (self.exit_requested and self.s.on_exit == "hold"):
+            return None
+        heard = "" if self.link.state.link_ok(self.clock.now()) else " (the link is lost: as last heard)"
+        return f"joyfly ends with the vehicle armed in the air in {self.airborne_mode}{heard}"
 
     @property
     def finished(self) -> bool:

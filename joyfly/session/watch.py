@@ -28,14 +28,20 @@ class SessionWatch(SessionCore):
             self._on_restart(now)
             return
         self.armed_seen |= st.armed
+        self.airborne_mode = st.mode if st.armed and not st.on_ground else None
         if self._home_from_vehicle and st.home_ned_m is not None and st.home_ned_m != self.fence.home_ned_m:
             self.fence = replace(self.fence, home_ned_m=st.home_ned_m)
 
     def _on_restart(self, now: float) -> None:
+        """The flight is over: say so, and forget what belonged to it (the setpoint, and the home, which the new
+        vehicle's frame knows nothing of: the fence margin is unknown until joyfly arms it again)."""
         quitting = self.exit_requested or self.s.exit_when_landed
         self._note(Level.WARN, restarted_message(self.link.state, quitting))
-        self._restart_s = now
-        self.sp, self._last_pos, self._home_from_vehicle = None, None, False
+        if self.airborne_mode is not None:  # last heard flying: the flight ended without a landing
+            self.unlanded = f"the vehicle restarted while it flew in {self.airborne_mode} (last heard armed in the air)"
+        self._restart_s, self.airborne_mode = now, None
+        self.sp, self._last_pos, self._home_from_vehicle, self.home_known = None, None, False, False
+        self.fence_watch.reset()
         self._set_phase(Phase.DONE if quitting else Phase.GROUNDED)
 
     def _watch_fence(self, now: float) -> None:
