@@ -47,8 +47,10 @@ class SessionWatch(SessionCore):
     def _watch_fence(self, now: float) -> None:
         """Warn at once when the flying vehicle is outside joyfly's fence, say when it is back, and carry out
         --fence-action once it has stayed outside for the grace time (joyfly/session/fence_watch.py)."""
-        watch = self.fence_watch
-        change = watch.update(self._fence_margin(now), now)
+        st, watch = self.link.state, self.fence_watch
+        if st.stamped_s is None or now - st.stamped_s > STALE_S:
+            return  # no news of the vehicle's position: nothing to judge, and a breach under way goes on
+        change = watch.update(self._fence_margin(), now)
         self.stats = replace(self.stats, fence_breaches=watch.count, deepest_breach_m=watch.deepest_m)
         if change is FenceChange.OUT and watch.breach is not None:
             self._note(Level.WARN, breach_message(watch.breach.depth_m, self.fence.half_width_m, self.s.fence_action))
@@ -57,13 +59,12 @@ class SessionWatch(SessionCore):
         if watch.due(now):
             self._fence_act(now)
 
-    def _fence_margin(self, now: float) -> float | None:
+    def _fence_margin(self) -> float | None:
         """The flying vehicle's fence margin (negative outside); None when there is nothing to judge: no fence or
-        no home yet, on the ground or disarmed, or no fresh position."""
+        no home yet, no position, on the ground or disarmed."""
         st = self.link.state
         pos = st.pos_ned_m
-        if (not self.fence.enabled or not self.home_known or pos is None or not st.armed or st.on_ground
-                or st.stamped_s is None or now - st.stamped_s > STALE_S):
+        if not self.fence.enabled or not self.home_known or pos is None or not st.armed or st.on_ground:
             return None
         return self.fence.margin_m(pos)
 

@@ -461,3 +461,15 @@ def test_a_vehicle_on_its_way_back_is_let_come_back_and_one_the_wind_holds_outsi
     else:
         assert "BREACH: coming back" in alert and "back inside the fence" in world.notes()
         assert not land and world.session.phase is Phase.FLYING
+
+
+def test_a_breach_is_said_once_even_when_the_vehicles_position_pauses_during_it() -> None:
+    world = airborne(fence_action="warn")
+    world.vehicle.wind_m_s = (0.0, 8.0)
+    world.run_until(10.0)
+    world.vehicle.speak = False  # a second without telemetry: its position is stale, the link not yet lost
+    world.run_until(11.0)
+    world.vehicle.speak = True
+    world.run_until(14.0)
+    assert len([text for _, text in _breach_notes(world) if "m outside the fence (5 m" in text]) == 1, world.notes()
+    assert world.session.stats.fence_breaches == 1
