@@ -1,7 +1,8 @@
 """`joyfly fly`, `joyfly demo` and `joyfly joystick ...`: parse options, build the pieces, run, report.
 
 Errors a user can hit (no joystick, port in use, no vehicle, arming refused) end in one sentence and a non-zero exit
-status; Ctrl-C / SIGTERM perform --on-exit and exit 0; a second Ctrl-C quits at once.
+status; Ctrl-C / SIGTERM perform --on-exit and exit 0 (3 if the vehicle went outside the fence, 4 if a flight ended
+in the air: joyfly/run.py); a second Ctrl-C quits at once.
 """
 
 from __future__ import annotations
