@@ -94,6 +94,10 @@ def test_cases_from_options_without_a_file_and_a_zero_exit_when_all_pass(tmp_pat
      "--fault must look like NAME@SECONDS"),
     (["campaign", "--scenario", f"{SCENARIOS}:hover", "--fault", "gps_offf@3", "--out", "-"],
      "unknown fault 'gps_offf'"),
+    (["campaign", "--scenario", f"{SCENARIOS}:hover", "--option", "side_m=nan", "--out", "-"],
+     "options.side_m must be finite, not nan."),
+    (["campaign", "--scenario", f"{SCENARIOS}:hover", "--option", "legs={n = [1.0, -inf]}", "--out", "-"],
+     "options.legs must be finite, not -inf (in {'n': [1.0, -inf]})."),
     (["campaign", "no_such.toml"], "cannot read the campaign file no_such.toml: No such file or directory."),
     (["campaign", "--engine", "spark"], "Invalid value for '--engine'"),
 ])
