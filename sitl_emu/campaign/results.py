@@ -3,8 +3,9 @@
 Columns, in this order: `case` (c0000...), `key` (a hash of the inputs: a rerun skips a case only if it matches),
 `seed`, `faults` (`name@time_s` joined by `;`), `param.NAME` and `option.NAME` (the inputs), `passed` (true/false),
 `status` (passed, failed: the scenario's verdict; error: it raised; sim_limit, timeout: the simulated or wall-time
-limit; crashed: the worker died), `error` (one line), then `metric.NAME` (the scenario's numbers), `sim_s` and
-`wall_s`. Only `wall_s` differs between two runs of the same cases.
+limit; crashed: the worker died), `error` (one line), then `metric.NAME` (the scenario's numbers; empty where a case
+measured none: it failed early, returned None or nan, or never named it), `sim_s` and `wall_s`. Only `wall_s`
+differs between two runs of the same cases.
 
 A row goes to disk (flushed) when its case finishes, so a campaign that dies loses no finished case; a metric column
 first seen late rewrites the file once with the wider header.

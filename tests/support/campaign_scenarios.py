@@ -37,6 +37,8 @@ def misbehave(sim: Any, case: Case) -> Outcome:
             os._exit(3)
         if behave == "fail":
             return Outcome(False, {"error_m": 9.0}, note="too far")
+        if behave == "unmeasured":  # cut short: nothing measured, as nan or as None
+            return Outcome(False, {"error_m": math.nan, "cruise": None}, note="lost")
     return hover(sim, case)
 
 
