@@ -24,7 +24,7 @@ LIMIT = FiniteRange(0.001, 1e7)
                    "an Outcome; overrides the campaign file's `scenario`.")
 @click.option("--out", default="campaign-results.csv", show_default=True, metavar="FILE.csv",
               help="Results: one CSV row per case, written as each finishes (and FILE.parquet when pyarrow is "
-                   "installed); cases already in it are skipped; '-' writes no file.")
+                   "installed), in a folder that exists; cases already in it are skipped; '-' writes no file.")
 @click.option("--engine", type=click.Choice(["local", "ray", "serial"]), default="local", show_default=True,
               help="local: worker processes on this machine; ray: a Ray cluster (pip install ray); serial: this "
                    "process, one case after another (for a debugger).")

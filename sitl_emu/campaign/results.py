@@ -77,6 +77,9 @@ class ResultsFile:
 
     def __init__(self, path: Path | None, columns: Sequence[str]) -> None:
         self.path = path
+        if path is not None and not path.parent.exists():
+            raise CampaignError(f"cannot write the results file {path}: the folder {path.parent} does not exist; "
+                                "create it or choose another --out.")
         header, self.rows = read_rows(path) if path is not None else ([], [])
         self.columns = list(columns) + [c for c in header if c not in columns and c not in TAIL] + list(TAIL)
         if path is not None and header != self.columns:
@@ -117,7 +120,6 @@ class ResultsFile:
             return
         tmp = self.path.with_name(self.path.name + ".tmp")
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
             with tmp.open("w", newline="") as f:
                 writer = csv.DictWriter(f, self.columns, restval="")
                 writer.writeheader()

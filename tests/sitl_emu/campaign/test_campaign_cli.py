@@ -133,6 +133,15 @@ def test_a_results_file_that_cannot_be_written_is_one_line(tmp_path: Path) -> No
     assert lines[0].startswith(f"sitl-emu: cannot write the results file {out}: "), lines[0]
 
 
+def test_a_results_file_in_a_missing_folder_is_refused_not_created(tmp_path: Path) -> None:
+    out = tmp_path / "no" / "such" / "x.csv"
+    result = run("campaign", "--scenario", f"{SCENARIOS}:hover", "--seed", "1", "--out", str(out))
+    assert result.exit_code == 2, result.output
+    assert result.stderr.strip() == (f"sitl-emu: cannot write the results file {out}: the folder {out.parent} does "
+                                     "not exist; create it or choose another --out.")
+    assert not (tmp_path / "no").exists()
+
+
 def test_the_ray_engine_without_ray_or_with_no_cluster_at_the_address_is_one_line(tmp_path: Path) -> None:
     result = run("campaign", "--scenario", f"{SCENARIOS}:hover", "--engine", "ray", "--address", "127.0.0.1:1",
                  "--out", str(tmp_path / "x.csv"))
