@@ -45,8 +45,9 @@ class Summary:
             lines += ["", f"{'metric':<{width}}  {head}"]
             lines += [f"{m:<{width}}  " + "  ".join(f"{v:>10.4g}" for v in vals) for m, vals in self.quantiles.items()]
         if self.left_out:
-            lines += ["", "left out of the quantiles, without a value (a failed or missing metric): "
-                      + ", ".join(f"{m} in {n} of {self.total} cases" for m, n in self.left_out.items())]
+            width = max(len(m) for m in self.left_out)
+            lines += ["", "left out of the quantiles, without a value (a failed or missing metric):"]
+            lines += [f"  {m:<{width}}  in {n} of {self.total} cases" for m, n in self.left_out.items()]
         if self.worst:
             lines += ["", "worst cases:"]
             lines += [f"  {_worst_line(row)}" for row in self.worst]
@@ -64,7 +65,7 @@ def _worst_line(row: Mapping[str, Any]) -> str:
     metrics = ", ".join(f"{k.removeprefix('metric.')}={v:.4g}" for k, v in row.items()
                         if k.startswith("metric.") and isinstance(v, float))
     error = f": {row['error']}" if row.get("error") else ""
-    return f"{row['case']} {row['status']} (seed {row['seed']}) {metrics}{error}"
+    return f"{row['case']} {row['status']} (seed {row['seed']}){' ' + metrics if metrics else ''}{error}"
 
 
 def summarize(rows: Sequence[Mapping[str, Any]], worst_by: str | None = None, worst_count: int = 5) -> Summary:

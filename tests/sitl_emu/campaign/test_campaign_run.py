@@ -120,8 +120,9 @@ def test_a_metric_a_failed_case_did_not_measure_is_empty_and_left_out_of_the_qua
     errors = sorted(float(r["metric.error_m"]) for r in rows[1:])
     assert summary.quantiles["error_m"][0] == errors[0] and summary.quantiles["error_m"][-1] == errors[1]
     assert summary.left_out == {"error_m": 1, "cruise": 1, "faults": 1, "sim_s": 1}
-    assert ("left out of the quantiles, without a value (a failed or missing metric): error_m in 1 of 3 cases, "
-            "cruise in 1 of 3 cases") in summary.text()
+    assert ("left out of the quantiles, without a value (a failed or missing metric):\n"
+            "  error_m  in 1 of 3 cases\n  cruise   in 1 of 3 cases\n") in summary.text()
+    assert "  c0000 failed (seed 0): lost\n" in summary.text()
     assert summary.worst[0]["case"] == "c0000"
 
 
