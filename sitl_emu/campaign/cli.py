@@ -42,7 +42,7 @@ LIMIT = FiniteRange(0.001, 1e7)
 @click.option("--wall-limit", type=LIMIT, default=None, help="Wall seconds a case may take [default: 300].")
 @click.option("--worst-by", metavar="METRIC", default=None, help="Rank the worst cases by this metric (largest "
                                                                  "first) [default: the first metric].")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
+@click.option("--no-progress", is_flag=True, help="No progress bar (without a terminal: no progress lines).")
 def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: str, workers: int | None,
              address: str | None, seeds: tuple[int, ...], assignments: tuple[str, ...], faults: tuple[str, ...],
              options: tuple[str, ...], sim_limit: float | None, wall_limit: float | None, worst_by: str | None,
