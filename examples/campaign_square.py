@@ -23,6 +23,7 @@ from pymavlink import mavutil
 from sitl_emu.campaign import Case, FaultSchedule, Outcome
 
 DEFAULTS = {"side_m": 5.0, "alt_m": 3.0, "hold_s": 3.0, "max_error_m": 1.0}
+METRICS = ("max_hold_error_m", "landing_offset_m", "flight_s")
 MASK_POSITION = 0b0000_1111_1111_1000  # SET_POSITION_TARGET_LOCAL_NED: use x, y, z only
 OFFBOARD = 6  # PX4's main mode (px4_custom_mode.h)
 STEP_S = 0.05  # 20 Hz: setpoints, and how often the script looks at what came in
@@ -105,8 +106,8 @@ def fly(sim: Any, case: Case) -> Outcome:
         pilot.command(MAV.MAV_CMD_NAV_LAND)
         pilot.setpoint = None
         pilot.wait(lambda: not pilot.armed, 60.0, "landing and disarm")
-    except NotInTime as err:
-        return Outcome(False, {"max_hold_error_m": worst[0]}, note=str(err))
+    except NotInTime as err:  # a flight cut short measured nothing whole: no values (empty cells), not zeros
+        return Outcome(False, dict.fromkeys(METRICS), note=str(err))
     finally:
         pilot.mav.close()
     metrics = {"max_hold_error_m": worst[0], "landing_offset_m": pilot.error_to((0.0, 0.0, 0.0)),

@@ -1,7 +1,8 @@
 """The live view: frames of vehicles logged to Rerun (the loopback viewer, a .rrd file, or both) at most RATE_HZ.
 
 Layout: the 3D world on the left (Rerun's ground grid, the fence box, each vehicle's body, trail, setpoint and home),
-plots on the right (north, east and altitude against the setpoint, the sticks, armed), and the mode changes. One
+plots on the right (north, east and altitude against the setpoint, the sticks once there are any, armed), and the
+mode changes. One
 frame costs about 1 ms of CPU in the Rerun SDK, so callers log from their own loop, never from a physics tick, and
 `due()` keeps them at RATE_HZ of wall time whatever the simulation's speed.
 """
@@ -45,6 +46,7 @@ class LiveView:
         sinks = [rr.GrpcSink(server.grpc_url)] if server is not None else []
         if record_path is not None:
             sinks.append(rr.FileSink(str(record_path)))
+        self._sticks_shown = False  # the sticks panel appears with the first sticks (none in OFFBOARD on serve's side)
         self.rec.set_sinks(*sinks, default_blueprint=self._blueprint())
         self._next_wall_s = 0.0
         self._trails: dict[str, deque[tuple[float, float, float]]] = {k: deque(maxlen=TRAIL_POINTS) for k in keys}
@@ -80,6 +82,7 @@ class LiveView:
             self._log_world(key, frame, frame.pos_ned_m)
             self._log_position_plots(key, frame, frame.pos_ned_m)
         if frame.sticks is not None:
+            self._show_sticks_panel()
             rec.log(f"plots/sticks/{key}", rr.Scalars(frame.sticks))
 
     def end_frame(self) -> None:
@@ -150,18 +153,26 @@ class LiveView:
             rec.log(f"plots/armed/{key}", rr.SeriesLines(colors=[colour], names=[f"{key} armed"]), static=True)
             rec.log(f"plots/sticks/{key}", rr.SeriesLines(names=[f"{key} {name}" for name in STICKS]), static=True)
 
+    def _show_sticks_panel(self) -> None:
+        """The first sticks (a joystick, or a MANUAL_CONTROL client of the emulator): the layout again, now with
+        the sticks panel, made active. Until then there is none: OFFBOARD setpoints come without sticks."""
+        if not self._sticks_shown:
+            self._sticks_shown = True
+            self.rec.send_blueprint(self._blueprint(), make_active=True, make_default=True)
+
     def _blueprint(self) -> Any:
         import rerun.blueprint as rrb
 
-        plots = [rrb.TimeSeriesView(origin=f"plots/{axis}", name=title) for axis, title in (
-            ("north", "north (m)"), ("east", "east (m)"), ("altitude", "altitude above home (m)"),
-            ("sticks", "sticks (-1..1)"), ("armed", "armed"))]
+        panels = [("north", "north (m)", 2.0), ("east", "east (m)", 2.0), ("altitude", "altitude above home (m)", 2.0),
+                  ("sticks", "sticks (-1..1)", 2.0), ("armed", "armed", 1.5)]
+        shown = [p for p in panels if p[0] != "sticks" or self._sticks_shown]
+        plots = [rrb.TimeSeriesView(origin=f"plots/{axis}", name=title) for axis, title, _ in shown]
         return rrb.Blueprint(
             rrb.Horizontal(rrb.Spatial3DView(origin="world", name="3D", line_grid=rrb.archetypes.LineGrid3D(
                                visible=True, spacing=1.0), eye_controls=rrb.archetypes.EyeControls3D(
                                position=EYE_POSITION, look_target=EYE_TARGET)),
                            rrb.Vertical(*plots, rrb.TextLogView(origin="modes", name="modes"),
-                                        row_shares=[2, 2, 2, 2, 1.5, 2]),
+                                        row_shares=[share for _, _, share in shown] + [2.0]),
                            column_shares=[3, 2]),
             rrb.TimePanel(timeline="flight_time", play_state="following"),  # the live end, however slow the page
             collapse_panels=True)

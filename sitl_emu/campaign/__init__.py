@@ -14,12 +14,13 @@ columns in results.py, the engines in engines/.
 """
 
 from sitl_emu.campaign.cases import Case, FaultDraw, make_cases
-from sitl_emu.campaign.errors import CampaignError, CaseError
+from sitl_emu.campaign.errors import CampaignError, CampaignInterrupted, CaseError
 from sitl_emu.campaign.faults import Fault, FaultSchedule, parse_fault
 from sitl_emu.campaign.run import run_campaign
 from sitl_emu.campaign.scenario import Limits, Outcome, run_case
 from sitl_emu.campaign.spec import CampaignSpec, read_spec
 from sitl_emu.campaign.summary import Summary
 
-__all__ = ["CampaignError", "CampaignSpec", "Case", "CaseError", "Fault", "FaultDraw", "FaultSchedule", "Limits",
-           "Outcome", "Summary", "make_cases", "parse_fault", "read_spec", "run_campaign", "run_case"]
+__all__ = ["CampaignError", "CampaignInterrupted", "CampaignSpec", "Case", "CaseError", "Fault", "FaultDraw",
+           "FaultSchedule", "Limits", "Outcome", "Summary", "make_cases", "parse_fault", "read_spec", "run_campaign",
+           "run_case"]

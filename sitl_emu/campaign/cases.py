@@ -120,7 +120,7 @@ def _draw_fault(rng: np.random.Generator, draw: FaultDraw) -> Fault | None:
 
 def _case(index: int, values: Mapping[str, Any], drawn_faults: Iterable[Fault]) -> Case:
     params = {k.split(".", 1)[1]: _number(k, v) for k, v in values.items() if k.startswith("params.")}
-    options = {k.split(".", 1)[1]: v for k, v in values.items() if k.startswith("options.")}
+    options = {k.split(".", 1)[1]: _finite(k, v, v) for k, v in values.items() if k.startswith("options.")}
     seed = values.get("seed", index)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise CaseError(f"seed must be a whole number >= 0, not {seed!r}.")
@@ -131,6 +131,21 @@ def _case(index: int, values: Mapping[str, Any], drawn_faults: Iterable[Fault]) 
 def _number(key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise CaseError(f"{key} must be a finite number, not {value!r}.")
+    return value
+
+
+def _finite(key: str, value: Any, whole: Any) -> Any:
+    """`value` (an option, or a number inside one) unless it holds nan or inf: no case flies on a number that is
+    none (as params.NAME and --param refuse it)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        shown = "" if value is whole else f" (in {whole!r})"
+        raise CaseError(f"{key} must be finite, not {value!r}{shown}.")
+    if isinstance(value, Mapping):
+        for item in value.values():
+            _finite(key, item, whole)
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            _finite(key, item, whole)
     return value
 
 

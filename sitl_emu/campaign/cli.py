@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import click
 
@@ -24,7 +23,7 @@ LIMIT = FiniteRange(0.001, 1e7)
                    "an Outcome; overrides the campaign file's `scenario`.")
 @click.option("--out", default="campaign-results.csv", show_default=True, metavar="FILE.csv",
               help="Results: one CSV row per case, written as each finishes (and FILE.parquet when pyarrow is "
-                   "installed); cases already in it are skipped; '-' writes no file.")
+                   "installed), in a folder that exists; cases already in it are skipped; '-' writes no file.")
 @click.option("--engine", type=click.Choice(["local", "ray", "serial"]), default="local", show_default=True,
               help="local: worker processes on this machine; ray: a Ray cluster (pip install ray); serial: this "
                    "process, one case after another (for a debugger).")
@@ -43,7 +42,7 @@ LIMIT = FiniteRange(0.001, 1e7)
 @click.option("--wall-limit", type=LIMIT, default=None, help="Wall seconds a case may take [default: 300].")
 @click.option("--worst-by", metavar="METRIC", default=None, help="Rank the worst cases by this metric (largest "
                                                                  "first) [default: the first metric].")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
+@click.option("--no-progress", is_flag=True, help="No progress bar (without a terminal: no progress lines).")
 def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: str, workers: int | None,
              address: str | None, seeds: tuple[int, ...], assignments: tuple[str, ...], faults: tuple[str, ...],
              options: tuple[str, ...], sim_limit: float | None, wall_limit: float | None, worst_by: str | None,
@@ -52,16 +51,20 @@ def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: st
     the options give, on a pool of processes or Ray; write one row per case and print a summary with the command
     that reruns each failed case alone. Exit status 1 when a case failed. The file format: sitl_emu/campaign/spec.py.
     """
-    from sitl_emu.campaign.errors import CampaignError
+    from sitl_emu.campaign.errors import CampaignError, CampaignInterrupted
+    from sitl_emu.campaign.progress import CampaignProgress
     from sitl_emu.campaign.run import run_campaign
 
+    progress = None if no_progress else CampaignProgress()
     try:
         ref, cases, limits = _inputs(cases_file, scenario, seeds, assignments, faults, options, sim_limit, wall_limit)
-        progress = None if no_progress else _progress
         summary = run_campaign(ref, cases, None if out == "-" else out, engine=engine, workers=workers,
-                               address=address, limits=limits, progress=progress, worst_by=worst_by)
+                               address=address, limits=limits, progress=progress.start if progress else None,
+                               worst_by=worst_by, on_row=progress.row if progress else None)
     except CampaignError as err:
         raise UserError(str(err)) from None
+    except CampaignInterrupted as stop:
+        _interrupted(stop, out)
     click.echo(summary.text())
     if out != "-":
         click.echo(f"\nresults: {out}")
@@ -137,7 +140,31 @@ def _fault_pair(text: str) -> tuple[float, str]:
         raise CampaignError(f"--fault must look like NAME@SECONDS (for example gps_off@12), not '{text}'.") from None
 
 
-@contextmanager
-def _progress(length: int) -> Iterator[Any]:
-    with click.progressbar(length=length, label="cases", file=sys.stderr, show_pos=True, show_eta=True) as bar:
-        yield bar
+def _interrupted(stop: Any, out: str) -> NoReturn:
+    """Ctrl-C: the summary of the cases finished so far and the command that flies the others (exit status 130)."""
+    click.echo(f"interrupted (Ctrl-C) after {stop.flown} of the {stop.to_fly} cases this run was to fly.\n")
+    click.echo(stop.summary.text())
+    if out == "-":
+        click.echo("\nno results file was written (--out -): a run with --out FILE.csv can be resumed.")
+    else:
+        click.echo(f"\nresults so far: {out}\nresume (the cases in {out} are not flown again):\n  "
+                   f"{command_line(click.get_current_context())}")
+    sys.exit(130)
+
+
+def command_line(ctx: click.Context) -> str:
+    """The command as given (defaults left out), with --out always: what resumes an interrupted campaign."""
+    args = ctx.command_path.split()
+    for param in ctx.command.params:
+        value: Any = ctx.params.get(param.name or "")
+        if isinstance(param, click.Argument):
+            args += [str(value)] if value is not None else []
+        elif isinstance(param, click.Option) and (param.name == "out" or value not in (None, False, (), param.default)):
+            flag = param.opts[0]
+            if param.is_flag:
+                args.append(flag)
+            else:
+                items: tuple[Any, ...] = tuple(value) if param.multiple else (value,)
+                for item in items:
+                    args += [flag, str(item)]
+    return shlex.join(args)

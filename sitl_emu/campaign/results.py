@@ -3,8 +3,9 @@
 Columns, in this order: `case` (c0000...), `key` (a hash of the inputs: a rerun skips a case only if it matches),
 `seed`, `faults` (`name@time_s` joined by `;`), `param.NAME` and `option.NAME` (the inputs), `passed` (true/false),
 `status` (passed, failed: the scenario's verdict; error: it raised; sim_limit, timeout: the simulated or wall-time
-limit; crashed: the worker died), `error` (one line), then `metric.NAME` (the scenario's numbers), `sim_s` and
-`wall_s`. Only `wall_s` differs between two runs of the same cases.
+limit; crashed: the worker died), `error` (one line), then `metric.NAME` (the scenario's numbers; empty where a case
+measured none: it failed early, returned None or nan, or never named it), `sim_s` and `wall_s`. Only `wall_s`
+differs between two runs of the same cases.
 
 A row goes to disk (flushed) when its case finishes, so a campaign that dies loses no finished case; a metric column
 first seen late rewrites the file once with the wider header.
@@ -76,6 +77,9 @@ class ResultsFile:
 
     def __init__(self, path: Path | None, columns: Sequence[str]) -> None:
         self.path = path
+        if path is not None and not path.parent.exists():
+            raise CampaignError(f"cannot write the results file {path}: the folder {path.parent} does not exist; "
+                                "create it or choose another --out.")
         header, self.rows = read_rows(path) if path is not None else ([], [])
         self.columns = list(columns) + [c for c in header if c not in columns and c not in TAIL] + list(TAIL)
         if path is not None and header != self.columns:
@@ -116,7 +120,6 @@ class ResultsFile:
             return
         tmp = self.path.with_name(self.path.name + ".tmp")
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
             with tmp.open("w", newline="") as f:
                 writer = csv.DictWriter(f, self.columns, restval="")
                 writer.writeheader()

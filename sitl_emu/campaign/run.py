@@ -15,7 +15,7 @@ from typing import Any
 
 from sitl_emu.campaign.cases import Case, check_params
 from sitl_emu.campaign.engines import Engine, make_engine
-from sitl_emu.campaign.errors import CampaignError
+from sitl_emu.campaign.errors import CampaignError, CampaignInterrupted
 from sitl_emu.campaign.results import ResultsFile, case_columns, input_columns, typed, write_parquet
 from sitl_emu.campaign.scenario import Limits, Row, load_scenario, scenario_ref
 from sitl_emu.campaign.summary import Summary, rerun_command, summarize
@@ -30,7 +30,8 @@ def run_campaign(scenario: str | Callable[..., Any], cases: Sequence[Case], out:
                  limits: Limits | None = None, progress: Progress | None = None, worst_by: str | None = None,
                  on_row: Callable[[Row], None] | None = None) -> Summary:
     """Fly every case of `cases` not yet in `out` (a CSV path; None keeps the rows in memory only) and summarize
-    every case's row. Raises CampaignError, before any case flies, for a scenario or a case that cannot work."""
+    every case's row. Raises CampaignError, before any case flies, for a scenario or a case that cannot work, and
+    CampaignInterrupted (a KeyboardInterrupt holding the summary so far) on Ctrl-C."""
     ref = scenario_ref(scenario)
     load_scenario(ref)
     _check_ids(cases)
@@ -40,16 +41,22 @@ def run_campaign(scenario: str | Callable[..., Any], cases: Sequence[Case], out:
     results = ResultsFile(Path(out) if out is not None else None, input_columns(cases))
     done = results.finished(cases)
     todo = [c for c in cases if c.id not in done]
-    with (progress(len(todo)) if progress else nullcontext()) as bar:
-        for case, row in _guarded(runner.run(ref, todo, limits)):
-            full = {**case_columns(case), "passed": row.get("status") == "passed", **row}
-            results.add(full)
-            if bar is not None:
-                bar.update(1)
-            if on_row is not None:
-                on_row(full)
-    if results.path is not None and todo:
-        write_parquet(results.path)
+    flown = 0
+    try:
+        with (progress(len(todo)) if progress else nullcontext()) as bar:
+            for case, row in _guarded(runner.run(ref, todo, limits)):
+                full = {**case_columns(case), "passed": row.get("status") == "passed", **row}
+                results.add(full)
+                flown += 1
+                if bar is not None:
+                    bar.update(1)
+                if on_row is not None:
+                    on_row(full)
+    except KeyboardInterrupt:  # Ctrl-C: every finished row is on disk; say what they show
+        raise CampaignInterrupted(_summary(results, cases, ref, limits, worst_by), flown, len(todo)) from None
+    finally:
+        if results.path is not None and flown:
+            write_parquet(results.path)
     return _summary(results, cases, ref, limits, worst_by)
 
 

@@ -33,10 +33,12 @@ SIM_KEYWORDS_TAKEN = ("params", "seed")  # the case sets these itself
 
 @dataclass(frozen=True)
 class Outcome:
-    """What a scenario returns: pass/fail and named numbers (`metrics`), with an optional one-line `note`."""
+    """What a scenario returns: pass/fail and named numbers (`metrics`), with an optional one-line `note`. A metric
+    the flight could not measure is None (or nan): an empty cell, left out of the quantiles, never a 0 that would
+    look like the best case."""
 
     passed: bool
-    metrics: Mapping[str, float] = field(default_factory=dict)
+    metrics: Mapping[str, float | None] = field(default_factory=dict)
     note: str = ""
 
 
@@ -182,11 +184,17 @@ def outcome_row(outcome: Any) -> Row:
     if not isinstance(outcome, Outcome):
         return failure_row("error", f"the scenario returned {type(outcome).__name__}, not an Outcome or a mapping "
                                     "with 'passed'.")
-    bad = [k for k, v in outcome.metrics.items() if isinstance(v, bool) or not isinstance(v, (int, float))]
+    bad = [k for k, v in outcome.metrics.items()
+           if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float)))]
     if bad:
         return failure_row("error", f"metric {bad[0]} is not a number: {outcome.metrics[bad[0]]!r}.")
-    metrics = {f"metric.{k}": (float(v) if math.isfinite(v) else math.nan) for k, v in outcome.metrics.items()}
+    metrics = {f"metric.{k}": _measured(v) for k, v in outcome.metrics.items()}
     return {"status": "passed" if outcome.passed else "failed", "error": outcome.note, **metrics}
+
+
+def _measured(value: float | None) -> float | None:
+    """A metric's value, or None (an empty cell, left out of the quantiles) for one not measured: None, nan, inf."""
+    return float(value) if value is not None and math.isfinite(value) else None
 
 
 def failure_row(status: str, error: str) -> Row:

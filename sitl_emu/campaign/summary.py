@@ -27,9 +27,10 @@ class Summary:
     total: int
     passed: int
     statuses: dict[str, int]
-    quantiles: dict[str, list[float]]  # metric -> values at QUANTILES (nan-free cases only)
+    quantiles: dict[str, list[float]]  # metric -> values at QUANTILES (the cases with a value only)
     worst: list[dict[str, Any]]  # the failed cases first, then by the `worst_by` metric, largest first
     reruns: dict[str, str] = field(default_factory=dict)  # failed case id -> command
+    left_out: dict[str, int] = field(default_factory=dict)  # metric -> cases without a value (failed or missing)
 
     @property
     def pass_rate(self) -> float:
@@ -43,6 +44,10 @@ class Summary:
             head = "  ".join(f"{_q_name(q):>10}" for q in QUANTILES)
             lines += ["", f"{'metric':<{width}}  {head}"]
             lines += [f"{m:<{width}}  " + "  ".join(f"{v:>10.4g}" for v in vals) for m, vals in self.quantiles.items()]
+        if self.left_out:
+            width = max(len(m) for m in self.left_out)
+            lines += ["", "left out of the quantiles, without a value (a failed or missing metric):"]
+            lines += [f"  {m:<{width}}  in {n} of {self.total} cases" for m, n in self.left_out.items()]
         if self.worst:
             lines += ["", "worst cases:"]
             lines += [f"  {_worst_line(row)}" for row in self.worst]
@@ -60,7 +65,7 @@ def _worst_line(row: Mapping[str, Any]) -> str:
     metrics = ", ".join(f"{k.removeprefix('metric.')}={v:.4g}" for k, v in row.items()
                         if k.startswith("metric.") and isinstance(v, float))
     error = f": {row['error']}" if row.get("error") else ""
-    return f"{row['case']} {row['status']} (seed {row['seed']}) {metrics}{error}"
+    return f"{row['case']} {row['status']} (seed {row['seed']}){' ' + metrics if metrics else ''}{error}"
 
 
 def summarize(rows: Sequence[Mapping[str, Any]], worst_by: str | None = None, worst_count: int = 5) -> Summary:
@@ -72,15 +77,18 @@ def summarize(rows: Sequence[Mapping[str, Any]], worst_by: str | None = None, wo
     for row in rows:
         if row["status"] != "passed":
             statuses[row["status"]] = statuses.get(row["status"], 0) + 1
-    quantiles = {}
+    quantiles, left_out = {}, {}
     for metric in metrics:
         values = [v for row in rows if isinstance(v := row.get(metric), float) and math.isfinite(v)]
+        name = metric.removeprefix("metric.")
         if values:
-            quantiles[metric.removeprefix("metric.")] = [float(x) for x in np.quantile(values, QUANTILES)]
+            quantiles[name] = [float(x) for x in np.quantile(values, QUANTILES)]
+        if len(values) < len(rows):
+            left_out[name] = len(rows) - len(values)
     key = f"metric.{worst_by}" if worst_by else (metrics[0] if metrics else None)
     ranked = sorted(rows, key=lambda r: (r["status"] == "passed", -_value(r, key), r["case"]))
     worst = [dict(r) for r in ranked[:worst_count]]
-    return Summary(len(rows), len(rows) - sum(statuses.values()), statuses, quantiles, worst)
+    return Summary(len(rows), len(rows) - sum(statuses.values()), statuses, quantiles, worst, left_out=left_out)
 
 
 def _value(row: Mapping[str, Any], key: str | None) -> float:

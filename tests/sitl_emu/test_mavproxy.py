@@ -5,8 +5,9 @@ downloads every parameter, `param set MPC_XY_CRUISE 7` changes one, and `wp list
 The test reads MAVProxy's console lines and the files both programs write: MAVProxy's mav.parm (every parameter it
 received) and serve's parameters.params (the value the vehicle keeps). Every wait has a timeout; nothing sleeps.
 
-MAVProxy loads only its `param` and `wp` modules here (its default list also starts fence, rally, terrain and ADS-B
-work that has nothing to do with this test). The test skips only when MAVProxy is not installed.
+MAVProxy loads only the modules a test uses (its default list also starts fence, rally, terrain and ADS-B work that
+has nothing to do with these tests). A second test tries the README's MAVProxy recipes and warnings (issue 25). The
+tests skip only when MAVProxy is not installed.
 """
 
 from __future__ import annotations
@@ -42,10 +43,10 @@ def gcs_port(tmp_path: Path) -> Iterator[int]:
 class MavProxy:
     """MAVProxy with its console on pipes: `send` a command line, `expect` a console line matching a pattern."""
 
-    def __init__(self, port: int, workdir: Path) -> None:
+    def __init__(self, port: int, workdir: Path, modules: str = "param,wp") -> None:
         workdir.mkdir()
         args = [sys.executable, "-m", "MAVProxy.mavproxy", "--master", f"udpin:127.0.0.1:{port}",
-                "--target-system", "1", "--default-modules", "param,wp"]
+                "--target-system", "1", "--default-modules", modules]
         # HOME in the test's directory: no user's .mavinit.scr or MAVProxy settings are read
         self.proc = subprocess.Popen(args, cwd=workdir, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=subprocess.STDOUT, text=True, bufsize=1,
@@ -132,6 +133,61 @@ def test_mavproxy_downloads_every_parameter_sets_one_and_lists_the_mission(gcs_p
         assert int(gcs.expect(r"Requesting (\d+) waypoints").group(1)) == 0
         gcs.send("wp status")
         gcs.expect(r"Have 0 of 0 waypoints")
+    except AssertionError:
+        print("MAVProxy console:\n" + "\n".join(gcs.seen))
+        raise
+    finally:
+        gcs.close()
+
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+HOME_ROW_PLAN = """QGC WPL 110
+0\t1\t0\t16\t0\t0\t0\t0\t47.397742\t8.545594\t488.0\t1
+1\t0\t3\t22\t0\t0\t0\t0\t47.397742\t8.545594\t6.0\t1
+2\t0\t3\t16\t0\t0\t0\t0\t47.397850\t8.545594\t6.0\t1
+"""  # as MAVProxy saves a plan: row 0 is ArduPilot's home (frame 0, sea-level altitude), here the vehicle's own
+
+
+def _readme_mode_recipes() -> list[tuple[str, str]]:
+    """(MAVProxy command, mode name) from the README's DO_SET_MODE table."""
+    return re.findall(r"^\s*\| `(long DO_SET_MODE [\d ]+)` \| (\w+) \|$", README.read_text(), re.MULTILINE)
+
+
+@pytest.mark.timeout(180)
+def test_the_readmes_mavproxy_recipes_work_and_its_warnings_hold(gcs_port: int, tmp_path: Path) -> None:
+    """Issue 25: MAVProxy's `mode X` fails before anything is sent (pymavlink's PX4 mode table holds tuples);
+    every DO_SET_MODE line of the README switches the mode; `wp list` ends in PX4's "Mission sync timeout" (MAVProxy
+    sends no closing MISSION_ACK); a WPL file's home row is skipped with `wp set 1` and the mission takes off."""
+    if importlib.util.find_spec("MAVProxy") is None:
+        pytest.skip("MAVProxy is not installed (pip install -e '.[test]' installs it).")
+    recipes = _readme_mode_recipes()
+    assert [mode for _, mode in recipes] == ["MANUAL", "ALTCTL", "POSCTL", "MISSION", "LOITER", "RTL", "LAND",
+                                             "TAKEOFF", "FOLLOWME", "ACRO", "OFFBOARD", "STABILIZED"]
+    (tmp_path / "plan.txt").write_text(HOME_ROW_PLAN)
+    gcs = MavProxy(gcs_port, tmp_path / "mavproxy", modules="wp,mode,cmdlong,arm")
+    try:
+        gcs.expect(r"Detected vehicle 1:1")
+        gcs.send("mode POSCTL")
+        gcs.expect(r"ERROR in command .*required argument is not a float")
+        for command, mode in recipes:
+            gcs.send(command)
+            gcs.expect(rf"Mode {mode}$")
+        gcs.send("long DO_SET_MODE 1 4 3")  # Hold, from which the vehicle arms
+        gcs.expect(r"Mode LOITER$")
+
+        gcs.send("wp list")
+        gcs.expect(r"Requesting 0 waypoints")
+        gcs.expect(r"Mission sync timeout", timeout_s=WAIT_S)
+
+        gcs.send(f"wp load {tmp_path / 'plan.txt'}")
+        gcs.expect(r"Got MISSION_ACK: TYPE_MISSION: ACCEPTED")
+        gcs.send("wp set 1")
+        gcs.expect(r"waypoint 1$")
+        gcs.send("arm throttle")
+        gcs.expect(r"ARMED")
+        gcs.send("long DO_SET_MODE 1 4 4")
+        gcs.expect(r"Climb to 6\.0 meters above home")  # not held at the home row's ground level
+        gcs.expect(r"waypoint 2$")
     except AssertionError:
         print("MAVProxy console:\n" + "\n".join(gcs.seen))
         raise

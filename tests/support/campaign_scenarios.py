@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from pathlib import Path
 from typing import Any
 
 from sitl_emu.campaign import Case, Outcome
@@ -37,6 +38,11 @@ def misbehave(sim: Any, case: Case) -> Outcome:
             os._exit(3)
         if behave == "fail":
             return Outcome(False, {"error_m": 9.0}, note="too far")
+        if behave == "wait_for_file":  # wall time passes while the file `wait_file` is there (a test's Ctrl-C)
+            while Path(case.options["wait_file"]).exists():
+                time.sleep(0.02)
+        if behave == "unmeasured":  # cut short: nothing measured, as nan or as None
+            return Outcome(False, {"error_m": math.nan, "cruise": None}, note="lost")
     return hover(sim, case)
 
 

@@ -91,6 +91,8 @@ def test_the_example_campaign_file_is_200_square_flights_under_wind_with_gps_dro
     ("[random]\ncount = -2\n", "random.count must be a whole number >= 0"),
     ("[[random.faults]]\nname = 'gps_off'\n", "each [[random.faults]] needs name and at"),
     ("[fixed]\nparams = { A = true }\n", "params.A must be a finite number"),
+    ("[fixed]\noptions = { side_m = nan }\n", "options.side_m must be finite, not nan."),
+    ("[grid]\noptions = { wind = [[1.0, inf]] }\n", "options.wind must be finite, not inf (in [1.0, inf])."),
 ])
 def test_a_mistake_in_the_campaign_file_is_one_sentence_naming_the_file(tmp_path: Path, text: str,
                                                                          message: str) -> None:

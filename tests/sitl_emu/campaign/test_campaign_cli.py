@@ -94,6 +94,10 @@ def test_cases_from_options_without_a_file_and_a_zero_exit_when_all_pass(tmp_pat
      "--fault must look like NAME@SECONDS"),
     (["campaign", "--scenario", f"{SCENARIOS}:hover", "--fault", "gps_offf@3", "--out", "-"],
      "unknown fault 'gps_offf'"),
+    (["campaign", "--scenario", f"{SCENARIOS}:hover", "--option", "side_m=nan", "--out", "-"],
+     "options.side_m must be finite, not nan."),
+    (["campaign", "--scenario", f"{SCENARIOS}:hover", "--option", "legs={n = [1.0, -inf]}", "--out", "-"],
+     "options.legs must be finite, not -inf (in {'n': [1.0, -inf]})."),
     (["campaign", "no_such.toml"], "cannot read the campaign file no_such.toml: No such file or directory."),
     (["campaign", "--engine", "spark"], "Invalid value for '--engine'"),
 ])
@@ -127,6 +131,15 @@ def test_a_results_file_that_cannot_be_written_is_one_line(tmp_path: Path) -> No
     lines = result.stderr.strip().splitlines()
     assert result.exit_code == 2 and len(lines) == 1, result.output
     assert lines[0].startswith(f"sitl-emu: cannot write the results file {out}: "), lines[0]
+
+
+def test_a_results_file_in_a_missing_folder_is_refused_not_created(tmp_path: Path) -> None:
+    out = tmp_path / "no" / "such" / "x.csv"
+    result = run("campaign", "--scenario", f"{SCENARIOS}:hover", "--seed", "1", "--out", str(out))
+    assert result.exit_code == 2, result.output
+    assert result.stderr.strip() == (f"sitl-emu: cannot write the results file {out}: the folder {out.parent} does "
+                                     "not exist; create it or choose another --out.")
+    assert not (tmp_path / "no").exists()
 
 
 def test_the_ray_engine_without_ray_or_with_no_cluster_at_the_address_is_one_line(tmp_path: Path) -> None:

@@ -110,6 +110,33 @@ def test_a_metric_first_seen_late_widens_the_file_and_keeps_every_row(tmp_path: 
     assert rows[0]["metric.error_m"] == "" and float(rows[1]["metric.error_m"]) >= 0
 
 
+def test_a_metric_a_failed_case_did_not_measure_is_empty_and_left_out_of_the_quantiles(tmp_path: Path) -> None:
+    out = tmp_path / "out.csv"
+    cases = make_cases({"options.bad_seeds": [0], "options.behave": "unmeasured"}, {"seed": [0, 1, 2]})
+    summary = run_campaign(campaign_scenarios.misbehave, cases, out, engine="serial")
+    rows = rows_of(out)
+    assert [r["status"] for r in rows] == ["failed", "passed", "passed"]
+    assert (rows[0]["metric.error_m"], rows[0]["metric.cruise"]) == ("", "")  # not nan, not 0
+    errors = sorted(float(r["metric.error_m"]) for r in rows[1:])
+    assert summary.quantiles["error_m"][0] == errors[0] and summary.quantiles["error_m"][-1] == errors[1]
+    assert summary.left_out == {"error_m": 1, "cruise": 1, "faults": 1, "sim_s": 1}
+    assert ("left out of the quantiles, without a value (a failed or missing metric):\n"
+            "  error_m  in 1 of 3 cases\n  cruise   in 1 of 3 cases\n") in summary.text()
+    assert "  c0000 failed (seed 0): lost\n" in summary.text()
+    assert summary.worst[0]["case"] == "c0000"
+
+
+def test_the_example_scenario_cut_short_leaves_its_metrics_empty_not_zero(tmp_path: Path) -> None:
+    example = f"{REPO_ROOT / 'examples' / 'campaign_square.py'}:fly"
+    cases = make_cases({"options.side_m": 1000.0, "options.hold_s": 0.5}, {"seed": [1]})  # too far for 30 s
+    summary = run_campaign(example, cases, tmp_path / "out.csv", engine="serial")
+    [row] = rows_of(tmp_path / "out.csv")
+    assert row["status"] == "failed" and row["error"].startswith("no arrival at (1000, 0)")
+    assert (row["metric.max_hold_error_m"], row["metric.landing_offset_m"], row["metric.flight_s"]) == ("", "", "")
+    assert summary.quantiles == {} and summary.left_out == {"max_hold_error_m": 1, "landing_offset_m": 1,
+                                                            "flight_s": 1}
+
+
 @pytest.mark.skipif(importlib.util.find_spec("pyarrow") is None, reason="pyarrow is not installed")
 def test_the_parquet_copy_holds_the_same_typed_table(tmp_path: Path) -> None:
     import pyarrow.parquet as pq
