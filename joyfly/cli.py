@@ -31,6 +31,7 @@ from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.view import add_browser_view, check_view_options
 
 D = FlyOptions()
@@ -65,8 +66,13 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 
 
 @main.command(short_help="Fly a vehicle with a joystick.")
-@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
-                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
+@_opt("--joy", str, "Joystick: auto (the first SDL game controller, else SDL joystick, else /dev/input/js0), sdl "
+                    "(the first SDL game controller), sdl:N (SDL device N), sdl:NAME (part of its name), a "
+                    "/dev/input/js* device, a FIFO of js_event records, a --record recording, raw:FILE (a file of "
+                    "js_event records), script:FILE or replay:FILE; other files are refused.")
+@_opt("--sdl-mapping", str, "Extra SDL game-controller mappings: a gamecontrollerdb.txt file or one mapping line.")
+@click.option("--rumble/--no-rumble", default=None, help="Rumble pulses on a fence push, a failsafe, link loss and "
+              "low battery, on a pad that has rumble. [default: rumble]")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "
@@ -117,7 +123,8 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     out = out or sys.stdout
     clock: WallClock | ScaledClock = WallClock() if opts.speed == 1.0 else ScaledClock(opts.speed)
     try:
-        sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
+        sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record,
+                             mappings=SdlMappings(opts.sdl_mapping, opts.mappings))
     except JoystickError as err:
         raise UserError(str(err)) from None
     problem = throttle_problem(opts.control, sticks.profile)
@@ -130,6 +137,8 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
         sticks.close()
         raise UserError(str(err)) from None
     view = make_view(out)
+    if sticks.why:
+        out.write(f"joyfly: --joy {opts.joy} chose {sticks.why}.\n")
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
