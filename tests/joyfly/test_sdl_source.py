@@ -238,3 +238,35 @@ def test_a_recorded_game_controller_replays_through_the_same_profile(pads: list[
     replay = open_sticks(f"replay:{rec}", Clock())
     assert replay.profile.name == "sdl-gamecontroller" and replay.name == "Recorded Pad (SDL game controller)"
     replay.close()
+
+
+def test_the_config_files_mappings_and_rumble_reach_the_options(pads: list[VirtualPad], tmp_path: Path) -> None:
+    from joyfly.config import ConfigError, build_options, load_file
+
+    pads.append(VirtualPad.joystick("Config Mapped Stick", naxes=4, nbuttons=8, nhats=0, product=0x78))
+    guid = sdl_api().device(pads[0].index).guid
+    path = tmp_path / "joyfly.toml"
+    path.write_text(f'mappings = ["{guid},Config Mapped Stick,a:b0,start:b5,leftx:a0,lefty:a1,rightx:a2,righty:a3,"]'
+                    '\n[fly]\njoy = "sdl:config"\nrumble = false\n')
+    o = build_options(load_file(str(path))[0], {})
+    assert o.joy == "sdl:config" and o.rumble is False and len(o.mappings) == 1
+    sticks = open_sticks(o.joy, Clock(), mappings=SdlMappings(o.sdl_mapping, o.mappings))
+    assert sticks.profile.name == "sdl-gamecontroller"  # a game controller now, through the config's mapping
+    sticks.close()
+    path.write_text('mappings = "not a list"\n[fly]\n')
+    with pytest.raises(ConfigError, match="is not a list of SDL mapping lines"):
+        build_options(load_file(str(path))[0], {})
+
+
+def test_a_broken_sdl_mapping_on_the_command_line_is_one_sentence_and_exit_2(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from joyfly.cli import main
+
+    db = tmp_path / "db.txt"
+    db.write_text("\n\nbroken\n")
+    result = CliRunner().invoke(main, ["fly", "--joy", "sdl", "--sdl-mapping", str(db)])
+    assert result.exit_code == 2
+    assert result.output.strip() == (f"joyfly: {db} line 3 is not an SDL game-controller mapping (Couldn't parse GUID "
+                                     "from broken): fix or remove that line (the format is GUID,name,a:b0,...,"
+                                     "leftx:a0,... as in gamecontrollerdb.txt).")
