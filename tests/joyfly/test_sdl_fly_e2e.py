@@ -209,3 +209,28 @@ def test_a_plain_joystick_with_a_profile_flies(vehicle: Vehicle) -> None:
         f.until(lambda: f.pos()[0] - n0 > 1.5, 15.0, "1.5 m north")
     finally:
         stop(f)
+
+
+FENCE_PULSE = f"pilot: rumble {round(0.3 * 65535)} {round(0.7 * 65535)}"  # joyfly.rumble.PULSES["fence"]
+
+
+def push_into_the_fence(f: Flight) -> None:
+    f.send(f"axis {RIGHT_Y} -1.0")  # full forward, towards the 5 m fence north of home
+    f.until(lambda: f.pos()[0] > 4.5, 20.0, "the fence")
+    f.wait(1.0)
+    f.send("rumbles")
+
+
+def test_a_fence_push_rumbles_the_pad(flight: Flight) -> None:
+    push_into_the_fence(flight)
+    assert flight.said(FENCE_PULSE)
+
+
+def test_no_rumble_keeps_the_pad_still(vehicle: Vehicle) -> None:
+    f = start(vehicle, [], "sdl", "--no-rumble")
+    try:
+        take_off(f)
+        push_into_the_fence(f)
+        assert not f.said("pilot: rumble ")
+    finally:
+        stop(f)
