@@ -115,7 +115,6 @@ class SdlApi:
             raise SdlUnavailable(f"SDL2 could not start its joystick subsystem ({self.error()}): use a "
                                  "/dev/input/js* device.")
         self._event = sdl.SDL_Event()
-        self.owner = threading.get_ident()
 
     def error(self) -> str:
         return (self.sdl.SDL_GetError() or b"no reason given").decode("utf-8", "replace").strip().rstrip(".")

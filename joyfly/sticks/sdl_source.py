@@ -125,12 +125,12 @@ class SdlSource:
         if self._opened is not None and not self.api.attached(self._opened):
             self._lost()
         if self._opened is None:
-            return was
-        if not (moved or not was):
+            return was  # it just went away: a change
+        if was and not moved:
             return False
         before = (self._axes, self._buttons)
         self._axes, self._buttons = self.api.read(self._opened)
-        return (self._axes, self._buttons) != before or not was
+        return (self._axes, self._buttons) != before or not was  # moved, or just came back
 
     def _lost(self) -> None:
         if self._opened is not None:
