@@ -14,6 +14,7 @@ from typing import Any, TextIO
 
 import click
 
+from joyfly.cli_calibrate import calibrate
 from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
 from joyfly.clock import WallClock
 from joyfly.sticks.joystick import DeviceInfo, JoystickError, JsDevice, list_devices
@@ -65,6 +66,9 @@ def _device_line(item: DeviceInfo | JoystickError) -> str:
     profile = load_profile("auto", item.name, {})
     counts = f"{item.axes} axes, {item.buttons} buttons" if item.kind == "device" else f"({item.kind})"
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
+
+
+joystick.add_command(calibrate)
 
 
 @joystick.command("profiles", short_help="The built-in controller profiles.")

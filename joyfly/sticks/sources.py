@@ -6,9 +6,10 @@ a source flies with.
 Linux, and says which it took and why. When SDL cannot be loaded, `auto` says so in one sentence and reads js
 devices; `--joy sdl...` then fails with that sentence.
 
-A plain SDL joystick (not a game controller) flies only with a profile that is its own: matched by GUID or name,
-named with --profile, or described in the config's [profile] table. Anything else is refused before arming with
-what to do (a joystick's raw axes mean nothing without one: the generic profile would fly it by guesswork).
+A plain SDL joystick (not a game controller) flies only with a profile that is its own: the user's (calibrate),
+a built-in one matched by GUID or name, one named with --profile, or one described in the config's [profile] table.
+Anything else is refused before arming with what to do (a joystick's raw axes mean nothing without one: the generic
+profile would fly it by guesswork).
 """
 
 from __future__ import annotations
@@ -19,10 +20,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from joyfly.sticks.joystick import JoystickError, default_device, open_joystick
-from joyfly.sticks.profiles import BUILTIN, ROLES, Profile, load_profile
+from joyfly.sticks.profiles import BUILTIN, ROLES, Profile, apply_overrides, load_profile
 from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings
 from joyfly.sticks.sdl_source import LIST_HINT, SDL_PREFIX, SdlSource, choose_device
+from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.types import Clock, JoystickSource
 
 AUTO = "auto"
@@ -112,16 +114,23 @@ def _described(table: Mapping[str, Any]) -> bool:
 
 
 def pick_profile(source: JoystickSource, name_or_auto: str | None, overrides: Mapping[str, Any] | None) -> Profile:
-    """The profile `source` flies with (profiles.load_profile), refusing a plain SDL joystick nothing describes."""
+    """The profile `source` flies with: with --profile auto, the user's own profile for this device (written by
+    `joyfly joystick calibrate`, joyfly/sticks/user_profiles.py) first, then profiles.load_profile; a plain SDL
+    joystick nothing describes is refused."""
     table = dict(overrides or {})
     name = (name_or_auto or AUTO).strip()
+    if name.lower() == AUTO and "base" not in table.get("profile", table):
+        mine = find_user_profile(source.name, str(getattr(source, "guid", "")))
+        if mine is not None:
+            inner = table.get("profile", table)
+            return apply_overrides(mine.profile, inner) if inner else mine.profile
     if isinstance(source, SdlSource) and not source.is_controller and name.lower() == AUTO and not _described(table):
         own = own_profile(source.device.name, source.guid)
         if own is None:
             raise JoystickError(
                 f"{source.path} \"{source.device.name}\" (GUID {source.guid}) is a joystick SDL does not know as a "
-                "game controller and no profile matches it, so joyfly will not guess its axes: give it an SDL "
-                "mapping with --sdl-mapping, pick a profile with --profile, or map its axes in the [profile] table "
-                "of a --config file.")
+                "game controller and no profile matches it, so joyfly will not guess its axes: calibrate it with "
+                f"`joyfly joystick calibrate --joy {source.path}`, give it an SDL mapping with --sdl-mapping, or pick "
+                "a profile with --profile.")
         name = own.name
     return load_profile(name, source.name, table)

@@ -9,6 +9,7 @@ which moves the virtual sticks as this test tells it on its stdin.
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -16,13 +17,22 @@ import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import pytest
 from support import REPO_ROOT
+from support.calibration_user import CalibrationUser
 from support.ports import free_udp_port
-from support.sdl_virtual import RIGHT_X, RIGHT_Y, A
+from support.sdl_virtual import RIGHT_X, RIGHT_Y, A, VirtualPad
 
+from joyfly.clock import WallClock
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
+from joyfly.sticks.calibrate import Wizard
+from joyfly.sticks.sources import open_source
+from joyfly.sticks.user_profiles import profile_toml, write_user_profile
+
+# the wizard's user: throttle on axis 3, yaw 0, pitch 2 (forward negative), roll 1 (right negative)
+GAMEPADISH = {"up": (3, -1.0, 0.0), "yaw": (0, 1.0, 0.0), "forward": (2, -1.0, 0.0), "right": (1, -1.0, 0.0)}
 
 SPEED = 4.0
 PILOT = REPO_ROOT / "tests" / "support" / "sdl_pilot.py"
@@ -92,7 +102,8 @@ def vehicle() -> Iterator[Vehicle]:
         emulator.stop()
 
 
-def start(vehicle: Vehicle, pilot_args: list[str], joy: str, *fly_args: str) -> Flight:
+def start(vehicle: Vehicle, pilot_args: list[str], joy: str, *fly_args: str,
+          env: dict[str, str] | None = None) -> Flight:
     """tests/support/sdl_pilot.py running `joyfly fly --joy joy` against the vehicle."""
     emulator = vehicle.emulator
     host, port = emulator.api_address
@@ -100,7 +111,8 @@ def start(vehicle: Vehicle, pilot_args: list[str], joy: str, *fly_args: str) -> 
     proc = subprocess.Popen(
         [sys.executable, str(PILOT), *pilot_args, "--", "fly", "--joy", joy, "--url", url, "--speed", str(SPEED),
          "--joy-timeout", "3", "--connect-timeout", "60", *fly_args],
-        cwd=REPO_ROOT, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        cwd=REPO_ROOT, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, **(env or {})})
     f = Flight(emulator, emulator.clock(), proc)
     for stream, into in ((proc.stdout, f.out), (proc.stderr, f.err)):
         threading.Thread(target=_reader, args=(stream, into), daemon=True).start()
@@ -232,5 +244,28 @@ def test_no_rumble_keeps_the_pad_still(vehicle: Vehicle) -> None:
         take_off(f)
         push_into_the_fence(f)
         assert not f.said("pilot: rumble ")
+    finally:
+        stop(f)
+
+
+def test_a_joystick_calibrated_by_the_wizard_then_flies(vehicle: Vehicle, tmp_path: Path) -> None:
+    """The wizard, driven by a virtual joystick here, writes the profile; joyfly (in the pilot's process, where a
+    virtual joystick with the same name and GUID is plugged in) flies it with that profile."""
+    pad = VirtualPad.joystick("Calibrated Stick")  # what the pilot plugs in: the same GUID
+    try:
+        source = open_source(f"sdl:{pad.index}", WallClock()).source
+        profile = Wizard(source, CalibrationUser(pad, GAMEPADISH, {"land": 0})).run()
+        guid = str(getattr(source, "guid", ""))
+        write_user_profile(profile_toml(source.name, guid, profile), source.name, tmp_path)
+        source.close()
+    finally:
+        pad.detach()
+    f = start(vehicle, ["--joystick", "Calibrated Stick"], "auto", env={"JOYFLY_PROFILES": str(tmp_path)})
+    try:
+        take_off(f)
+        assert f.said("profile calibrated:calibrated-stick")
+        n0 = f.pos()[0]
+        f.send("axis 2 -0.5")  # the axis calibrated as pitch, pushed forward
+        f.until(lambda: f.pos()[0] - n0 > 1.5, 15.0, "1.5 m north")
     finally:
         stop(f)

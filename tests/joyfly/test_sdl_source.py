@@ -136,7 +136,8 @@ def test_an_unknown_plain_joystick_is_refused_until_described(pads: list[Virtual
     with pytest.raises(JoystickError) as refused:
         open_sticks("sdl:mystery", Clock())
     text = str(refused.value)
-    assert "not know as a game controller" in text and "--sdl-mapping" in text and "[profile]" in text
+    assert "not know as a game controller" in text and "--sdl-mapping" in text
+    assert "`joyfly joystick calibrate --joy sdl:" in text
     described = open_sticks("sdl:mystery", Clock(), overrides={"forward": {"index": 1, "invert": True}})
     assert described.profile.axis("forward") is not None
     described.close()
