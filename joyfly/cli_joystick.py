@@ -25,6 +25,7 @@ from joyfly.sticks.sdl_list import sdl_lines
 from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.sticks.sdl_source import SdlSource
 from joyfly.sticks.sources import open_source, pick_profile
+from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
@@ -63,7 +64,8 @@ def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
 def _device_line(item: DeviceInfo | JoystickError) -> str:
     if isinstance(item, JoystickError):
         return f"?  {item}"
-    profile = load_profile("auto", item.name, {})
+    mine = find_user_profile(item.name)
+    profile = mine.profile if mine is not None else load_profile("auto", item.name, {})
     counts = f"{item.axes} axes, {item.buttons} buttons" if item.kind == "device" else f"({item.kind})"
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
 

@@ -27,6 +27,7 @@ MOVED = 0.5  # fraction of full travel away from rest that counts as "moved"
 RELEASED = 0.2
 STEP_TIMEOUT_S = 60.0
 POLL_S = 0.02
+FULL_REACH = 0.9  # a held stick short of this fraction of full travel is reported
 RADIO_REST = 0.8  # a throttle resting beyond this fraction of travel is a radio's, non-centring
 MIN_DEADZONE, MAX_DEADZONE = 0.05, 0.3
 # (role, what to do), QGroundControl's order
@@ -105,8 +106,11 @@ class Wizard:
             elif held is None or held[0] != index:
                 held = (index, state.time_s)
             elif state.time_s - held[1] >= HOLD_S:
-                self.console.say(f"Axis {index}: got it; let the stick go back.")
                 pushed = state.axes[index]
+                reach = abs(pushed) / AXIS_MAX
+                short = "" if reach >= FULL_REACH else (f" (it reached only {100 * reach:.0f}% of its travel: full "
+                                                         "stick will not give full speed)")
+                self.console.say(f"Axis {index}: got it{short}; let the stick go back.")
                 self._until(lambda: self._all_released(rest), "release of the sticks")
                 return index, pushed
             self._check_time(start, "stick moved")

@@ -11,15 +11,20 @@ from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings
 from joyfly.sticks.sdl_source import GAME_CONTROLLER_TAG
 from joyfly.sticks.sources import own_profile
+from joyfly.sticks.user_profiles import find_user_profile
 
 
 def _profile_text(device: SdlDevice) -> str:
+    name = device.name + (GAME_CONTROLLER_TAG if device.is_controller else "")
+    mine = find_user_profile(name, device.guid)
+    if mine is not None:
+        return f"profile: {mine.profile.name}"
     if device.is_controller:
         return f"profile: {load_profile('auto', device.name + GAME_CONTROLLER_TAG).name}"
     own = own_profile(device.name, device.guid)
     if own is not None:
         return f"profile: {own.name}"
-    return "profile: none (joyfly fly refuses it: give it --sdl-mapping, --profile or a [profile] table)"
+    return f"profile: none (joyfly fly refuses it: `joyfly joystick calibrate --joy sdl:{device.index}`)"
 
 
 def device_line(device: SdlDevice) -> str:

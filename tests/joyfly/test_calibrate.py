@@ -7,9 +7,11 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 from support.calibration_user import CalibrationUser
 from support.sdl_virtual import VirtualPad
 
+from joyfly.cli_joystick import joystick
 from joyfly.clock import WallClock
 from joyfly.sticks.calibrate import Wizard
 from joyfly.sticks.joystick import JoystickError
@@ -69,6 +71,9 @@ def test_the_written_profile_is_the_one_joyfly_then_flies_with(pads: list[Virtua
     profile, name, guid = calibrate(pads[0], "sdl:two", GAMEPADISH, BUTTONS)
     path = write_user_profile(profile_toml(name, guid, profile), name)
     assert path.parent == tmp_path and [p.device_name for p in load_user_profiles()] == ["Wizard Stick Two"]
+    listed = CliRunner().invoke(joystick, ["list", "--dev-dir", str(tmp_path)])
+    assert any("\"Wizard Stick Two\"" in ln and ln.endswith("profile: calibrated:wizard-stick-two")
+               for ln in listed.output.splitlines()), listed.output
     sticks = open_sticks("sdl:two", WallClock())
     try:
         assert sticks.profile.name == "calibrated:wizard-stick-two"

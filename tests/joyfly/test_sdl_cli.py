@@ -38,7 +38,8 @@ def test_list_shows_sdl_devices_and_js_devices(pads: list[VirtualPad], tmp_path:
                    "rumble  profile: sdl-gamecontroller")
     stick = next(ln for ln in lines if "\"List Stick\"" in ln)
     assert "  joystick  " in stick and "3 axes, 5 buttons, 1 hats, no rumble" in stick
-    assert "profile: none (joyfly fly refuses it" in stick
+    calibrate = f"`joyfly joystick calibrate --joy sdl:{pads[1].index}`"
+    assert stick.endswith(f"profile: none (joyfly fly refuses it: {calibrate})")
     assert "no rumble" in next(ln for ln in lines if "\"Quiet Pad\"" in ln)
     assert lines[-1].startswith(f"{tmp_path / 'js0'}  ")
 
