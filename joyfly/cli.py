@@ -24,7 +24,7 @@ from joyfly.dashboard import make_view
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
-from joyfly.rumble import Haptics, HapticView, rumbler_of
+from joyfly.rumble import Haptics, HapticView, device_of, rumbler_of
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
@@ -147,10 +147,9 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     session.link.on_message.append(watch.observe)
     shown = add_browser_view(view, session, view_options, out)
     rumbler = rumbler_of(sticks) if opts.rumble else None
-    if rumbler is not None:
-        yaw_of = (lambda: session.link.state.yaw_rad) if opts.control in MANUAL_CONTROLS else None
-        shown = HapticView(shown, Haptics(rumbler, yaw_of))
-    return fly_session(session, shown, out)
+    yaw_of = (lambda: session.link.state.yaw_rad) if opts.control in MANUAL_CONTROLS else None
+    haptics = Haptics(rumbler, yaw_of) if rumbler is not None else None
+    return fly_session(session, HapticView(shown, haptics, device_of(sticks)), out)
 
 
 def throttle_problem(control: str, profile: Any) -> str | None:

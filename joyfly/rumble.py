@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from joyfly.session.core import Note, SessionView
+from joyfly.session.core import Level, Note, SessionView
 
 FENCE_PUSH_M = 0.5  # closer to a fence side than this, pushing outwards, is a push
 PUSH_STICK = 0.2  # stick deflection towards the side that counts as pushing
@@ -111,25 +111,36 @@ class Haptics:
 
 
 class HapticView:
-    """A session view (the terminal's, the browser's) that also pulses the pad."""
+    """A session view (the terminal's, the browser's) that also pulses the pad (`haptics`), and passes on what the
+    device itself has to say (an SDL source's `news`: another controller plugged in and ignored) as warnings."""
 
-    def __init__(self, inner: Any, haptics: Haptics) -> None:
+    def __init__(self, inner: Any, haptics: Haptics | None, device: Any = None) -> None:
         self.inner = inner
         self.haptics = haptics
+        self.device = device
 
     def note(self, note: Note) -> None:
         self.inner.note(note)
 
     def show(self, view: SessionView) -> None:
+        news = getattr(self.device, "news", None)
+        while news:
+            self.inner.note(Note(view.time_s, Level.WARN, news.pop(0)))
         self.inner.show(view)
-        self.haptics.show(view)
+        if self.haptics is not None:
+            self.haptics.show(view)
 
     def close(self, keep: bool = True) -> None:
         self.inner.close(keep=keep)
 
 
-def rumbler_of(sticks: Any) -> Rumbler | None:
-    """The rumbling device behind a stick source (through --record's wrapper), or None when it has no rumble."""
+def device_of(sticks: Any) -> Any:
+    """The device behind a stick source (through the mapping's and --record's wrappers)."""
     source = getattr(sticks, "source", sticks)
-    source = getattr(source, "source", source)
+    return getattr(source, "source", source)
+
+
+def rumbler_of(sticks: Any) -> Rumbler | None:
+    """The rumbling device behind a stick source, or None when it has no rumble."""
+    source = device_of(sticks)
     return source if getattr(source, "has_rumble", False) else None

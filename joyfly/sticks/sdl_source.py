@@ -76,6 +76,7 @@ class SdlSource:
         self.last_error: JoystickError | None = None
         self._sleep, self._monotonic = sleep, monotonic
         self._ignored: set[str] = set()
+        self.news: list[str] = []  # what the pilot should hear about the device (taken by the face: joyfly/rumble.py)
         opened = api.open(device.index, device.is_controller)
         if opened is None:
             raise NoDeviceError(f"SDL could not open {self.path} \"{device.name}\" ({api.error()}): {LIST_HINT}.")
@@ -145,8 +146,10 @@ class SdlSource:
         if device.guid != self.guid:
             if device.guid not in self._ignored:
                 self._ignored.add(device.guid)
-                log.warning("ignoring \"%s\" (GUID %s), plugged in while joyfly waits for \"%s\" (GUID %s)",
-                            device.name, device.guid, self.device.name, self.guid)
+                self.news.append(f"Ignoring \"{device.name}\" (GUID {device.guid}), plugged in while joyfly waits "
+                                 f"for \"{self.device.name}\" (GUID {self.guid}): joyfly never flies another "
+                                 "controller on its own; plug that one back in, or restart joyfly to fly this one.")
+                log.warning("%s", self.news[-1])
             return
         opened = self.api.open(index, self.is_controller)
         if opened is None:

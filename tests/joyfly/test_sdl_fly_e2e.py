@@ -184,6 +184,7 @@ def test_unplugged_holds_plugged_back_flies_on_another_pad_is_never_taken(flight
     flight.send("other")  # another controller: joyfly must not fly with it
     flight.until(lambda: flight.said("Joystick still lost after 3 s: landing"), 8.0, "the landing after --joy-timeout")
     assert flight.text().count("Joystick back") == backs
+    assert flight.said("Ignoring \"Somebody Else's Pad\"")  # said, not silent
     flight.until(lambda: not flight.armed, 40.0, "the vehicle to land and disarm")
 
 

@@ -194,7 +194,7 @@ def test_unplugged_reports_disconnected_same_guid_resumes_another_is_ignored(pad
         pads.append(VirtualPad.controller("Somebody Else", product=0x22))
         pads[1].axis(RIGHT_Y, -1.0)
         state = source.poll(0.05)
-        assert not state.connected  # never taken over
+        assert not state.connected and "Ignoring \"Somebody Else\"" in source.news[0]  # never taken over
         pads[0].reattach()
         pads[0].axis(RIGHT_Y, -0.5)
         state = source.poll(0.2)
