@@ -122,7 +122,12 @@ class SdlApi:
     # -- enumeration ------------------------------------------------------------------------------------------------
 
     def devices(self) -> list[SdlDevice]:
+        """Every device now (pumps SDL's events first, so that devices plugged in since show up)."""
         self.pump()
+        return self.devices_now()
+
+    def devices_now(self) -> list[SdlDevice]:
+        """Every device SDL knows now, without pumping (the events stay for the source that pumps)."""
         return [self.device(i) for i in range(self.sdl.SDL_NumJoysticks())]
 
     def device(self, index: int) -> SdlDevice:

@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 SDL_PREFIX = "sdl"
 GAME_CONTROLLER_TAG = " (SDL game controller)"
 POLL_STEP_S = 0.001
+RESCAN_S = 0.5  # while the device is away, look for it among the devices present this often
 LIST_HINT = "see what is connected with `joyfly joystick list`"
 
 
@@ -76,6 +77,7 @@ class SdlSource:
         self.last_error: JoystickError | None = None
         self._sleep, self._monotonic = sleep, monotonic
         self._ignored: set[str] = set()
+        self._next_scan_s = 0.0
         self.news: list[str] = []  # what the pilot should hear about the device (taken by the face: joyfly/rumble.py)
         opened = api.open(device.index, device.is_controller)
         if opened is None:
@@ -125,6 +127,8 @@ class SdlSource:
                 self._maybe_back(which)
         if self._opened is not None and not self.api.attached(self._opened):
             self._lost()
+        if self._opened is None and self._monotonic() >= self._next_scan_s:
+            self._scan()
         if self._opened is None:
             return was  # it just went away: a change
         if was and not moved:
@@ -134,12 +138,21 @@ class SdlSource:
         return (self._axes, self._buttons) != before or not was  # moved, or just came back
 
     def _lost(self) -> None:
+        self._next_scan_s = self._monotonic() + RESCAN_S
         if self._opened is not None:
             self.api.close(self._opened)
             self._opened = None
         self.last_error = DeviceVanishedError(f"The joystick \"{self.device.name}\" vanished (unplugged?): plug it "
                                               "back in and joyfly takes it again.")
         log.warning("%s", self.last_error)
+
+    def _scan(self) -> None:
+        """Look for our GUID among the devices present (an ADDED event someone else pumped away is not missed)."""
+        self._next_scan_s = self._monotonic() + RESCAN_S
+        for device in self.api.devices_now():
+            if device.guid == self.guid:
+                self._maybe_back(device.index)
+                return
 
     def _maybe_back(self, index: int) -> None:
         device = self.api.device(index)

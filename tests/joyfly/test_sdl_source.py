@@ -271,3 +271,17 @@ def test_a_broken_sdl_mapping_on_the_command_line_is_one_sentence_and_exit_2(tmp
     assert result.output.strip() == (f"joyfly: {db} line 3 is not an SDL game-controller mapping (Couldn't parse GUID "
                                      "from broken): fix or remove that line (the format is GUID,name,a:b0,...,"
                                      "leftx:a0,... as in gamecontrollerdb.txt).")
+
+
+def test_the_device_is_found_again_even_when_its_plug_event_was_pumped_away(pads: list[VirtualPad]) -> None:
+    pads.append(VirtualPad.controller("Stolen Events", product=0x61))
+    source = open_source("sdl:stolen", Clock()).source
+    assert isinstance(source, SdlSource)
+    try:
+        pads[0].detach()
+        assert not source.poll(0.0).connected
+        pads[0].reattach()
+        sdl_api().pump()  # someone else took the ADDED event
+        assert source.poll(1.0).connected  # found by the rescan
+    finally:
+        source.close()
