@@ -3,10 +3,11 @@ goes through `SdlApi`, so the SDL source (joyfly/sticks/sdl_source.py) can be dr
 in tests, and a machine without a loadable SDL gets one sentence (`SdlUnavailable`) instead of a traceback.
 
 SDL runs headless here: only the joystick and game-controller subsystems are started (no video, no window), with
-background joystick events allowed (no window focus exists) and SDL's own SIGINT/SIGTERM handlers off (joyfly's
-Ctrl-C and SIGTERM handling must keep working). SDL is not thread-safe for the event pump: the thread that polls
-the source pumps SDL's events; SDL's virtual-joystick setters lock SDL's joystick mutex, so a test may move a
-virtual stick from another thread.
+background joystick events allowed (no window focus exists), SDL's own SIGINT/SIGTERM handlers off (joyfly's
+Ctrl-C and SIGTERM handling must keep working) and, on Windows, SDL_HINT_JOYSTICK_THREAD (SDL reads raw input on a
+thread of its own, as no window's message loop does it). SDL is not thread-safe for the event pump: the thread
+that polls the source pumps SDL's events; SDL's virtual-joystick setters lock SDL's joystick mutex, so a test may
+move a virtual stick from another thread.
 
 What a device reads as (`read`), in the js API's units so profiles and mappings stay one code path:
   - a game controller (SDL's database, or a user mapping, knows it): SDL's standard layout, axes 0 left X, 1 left
@@ -108,8 +109,9 @@ class SdlApi:
     def __init__(self) -> None:
         sdl = _load_sdl2()
         self.sdl = sdl
-        for hint, value in ((sdl.SDL_HINT_NO_SIGNAL_HANDLERS, b"1"),
-                            (sdl.SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, b"1")):
+        for hint, value in ((sdl.SDL_HINT_NO_SIGNAL_HANDLERS, b"1"),  # joyfly's Ctrl-C/SIGTERM stay joyfly's
+                            (sdl.SDL_HINT_JOYSTICK_ALLOW_BACKGROUND_EVENTS, b"1"),  # no window has the focus
+                            (sdl.SDL_HINT_JOYSTICK_THREAD, b"1")):  # Windows: raw input without a window's loop
             sdl.SDL_SetHint(hint, value)
         if sdl.SDL_InitSubSystem(sdl.SDL_INIT_JOYSTICK | sdl.SDL_INIT_GAMECONTROLLER) != 0:
             raise SdlUnavailable(f"SDL2 could not start its joystick subsystem ({self.error()}): use a "
