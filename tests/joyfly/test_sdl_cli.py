@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import os
+import signal
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Iterator
@@ -10,6 +13,7 @@ from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
+from support import REPO_ROOT
 from support.sdl_virtual import RIGHT_Y, VirtualPad
 
 from joyfly.cli_joystick import joystick
@@ -61,3 +65,18 @@ def test_test_shows_a_game_controllers_live_values(pads: list[VirtualPad]) -> No
     assert lines[1].startswith("Test Pad (SDL game controller) (sdl:")
     assert lines[1].endswith("), profile sdl-gamecontroller")
     assert any("forward=+1.00" in ln and "axes=[0, 0, 0, -32767, 0, 0]" in ln for ln in lines[2:]), result.output
+
+
+def test_sigterm_still_ends_joystick_test_with_sdl_loaded() -> None:
+    """SDL would turn SIGTERM into an SDL_QUIT event nobody reads (SDL_HINT_NO_SIGNAL_HANDLERS keeps it away)."""
+    proc = subprocess.Popen([sys.executable, str(REPO_ROOT / "tests" / "support" / "sdl_pilot.py"), "--", "joystick",
+                             "test", "--joy", "sdl"], cwd=REPO_ROOT, stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        assert "Pilot Pad" in proc.stdout.readline()  # running, SDL loaded
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(10.0) == -signal.SIGTERM
+    finally:
+        proc.kill()
+        proc.communicate()
