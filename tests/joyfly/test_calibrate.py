@@ -3,6 +3,9 @@ a radio's resting throttle, deadzones, buttons), the file it writes, and that jo
 
 from __future__ import annotations
 
+import io
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -11,6 +14,7 @@ from click.testing import CliRunner
 from support.calibration_user import CalibrationUser
 from support.sdl_virtual import VirtualPad
 
+from joyfly.cli_calibrate import TerminalConsole
 from joyfly.cli_joystick import joystick
 from joyfly.clock import WallClock
 from joyfly.sticks.calibrate import Wizard
@@ -92,3 +96,32 @@ def test_a_bad_profile_file_is_one_sentence(tmp_path: Path, monkeypatch: pytest.
     (tmp_path / "broken.toml").write_text("[profile]\nforward = 3\n")
     with pytest.raises(JoystickError, match="is not a joyfly profile"):
         load_user_profiles()
+
+
+def test_the_terminal_console_takes_enter_per_prompt_and_everything_once_stdin_closes(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    lines = threading.Semaphore(0)
+
+    class Keyboard(io.StringIO):
+        def __iter__(self):  # type: ignore[override]
+            lines.acquire()
+            yield "\n"  # one Enter
+            lines.acquire()  # then the user closes stdin
+
+    monkeypatch.setattr("sys.stdin", Keyboard())
+    console = TerminalConsole()
+    console.say("first prompt")
+    assert not console.entered()
+    lines.release()
+    deadline = time.monotonic() + 5.0
+    while not console.entered() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert console.entered()
+    console.say("second prompt")  # a new prompt forgets the earlier Enter
+    assert not console.entered()
+    lines.release()
+    while not console.entered() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    console.say("third prompt")
+    assert console.entered()  # stdin closed: every prompt counts as answered
+    assert capsys.readouterr().out.splitlines() == ["first prompt", "second prompt", "third prompt"]
