@@ -30,7 +30,7 @@ from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
 from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
-from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.view import add_browser_view, check_view_options

@@ -17,7 +17,8 @@ import click
 from joyfly.cli_calibrate import calibrate
 from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
 from joyfly.clock import WallClock
-from joyfly.sticks.joystick import DeviceInfo, JoystickError, JsDevice, list_devices
+from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js_seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
 from joyfly.sticks.mapping import StickMapper
 from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
@@ -49,7 +50,8 @@ def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
         lines = sdl_lines(SdlMappings(sdl_mapping))
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None
-    found = list_devices(dev_dir)
+    js = js_reader_or_none()
+    found = js.list_devices(dev_dir) if js is not None else []
     if not found and not [ln for ln in lines if not ln.startswith("?")]:
         raise click.ClickException(
             f"No joystick found (SDL sees none, and no {dev_dir}/js*): plug one in, or fly a virtual one with "
@@ -61,7 +63,8 @@ def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
         click.echo(_device_line(item))
 
 
-def _device_line(item: DeviceInfo | JoystickError) -> str:
+def _device_line(item: Any) -> str:
+    """A js device (joystick.DeviceInfo) with its profile, or the JoystickError that stopped its probe."""
     if isinstance(item, JoystickError):
         return f"?  {item}"
     mine = find_user_profile(item.name)
@@ -158,7 +161,8 @@ def _error_of(source: JoystickSource) -> str:
         return "(the virtual joystick reached its end)"
     if isinstance(inner, SdlSource):
         return str(inner.last_error or "")
-    if not isinstance(inner, JsDevice):
+    js = js_reader_or_none()
+    if js is None or not isinstance(inner, js.JsDevice):
         return ""
     if inner.last_error is None and inner.kind == "fifo":
         return "(waiting for a writer on the FIFO)"

@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from joyfly.clock import WallClock
-from joyfly.sticks.joystick import AXIS_MAX, JoystickError
+from joyfly.sticks.js_events import AXIS_MAX, JoystickError
 from joyfly.sticks.profiles import AxisMap, Profile, rest_problems
 from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.sticks.sources import open_source, pick_profile

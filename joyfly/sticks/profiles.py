@@ -35,7 +35,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from joyfly.sticks.joystick import AXIS_MAX, JoystickError
+from joyfly.sticks.js_events import AXIS_MAX, JoystickError
 from joyfly.types import Action, JoyState
 
 if sys.version_info >= (3, 11):

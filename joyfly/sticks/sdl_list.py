@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.profiles import load_profile
 from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings

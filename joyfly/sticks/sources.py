@@ -19,7 +19,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from joyfly.sticks.joystick import JoystickError, default_device, open_joystick
+from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js_seam import js_reader, open_js
 from joyfly.sticks.profiles import BUILTIN, ROLES, Profile, apply_overrides, load_profile
 from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings
@@ -59,7 +60,7 @@ def open_source(spec: str, clock: Clock, dev_dir: str = "/dev/input", mappings: 
         return _sdl_opened(api, device, clock, reason)
     if not mappings.empty and mappings.file is not None:
         _start_sdl(mappings, loader)  # a broken --sdl-mapping is reported whatever --joy says
-    return Opened(open_joystick(spec, clock, dev_dir=dev_dir), "")
+    return Opened(open_js(spec, clock, dev_dir), "")
 
 
 def _open_auto(clock: Clock, dev_dir: str, mappings: SdlMappings, loader: Callable[[], SdlApi]) -> Opened:
@@ -68,9 +69,9 @@ def _open_auto(clock: Clock, dev_dir: str, mappings: SdlMappings, loader: Callab
     except SdlUnavailable as exc:
         if not sys.platform.startswith("linux"):
             raise
-        path = default_device(dev_dir)
+        path = js_reader().default_device(dev_dir)
         why = f"{path}: the first js device ({str(exc).rstrip('.')}; so js devices are read instead)"
-        return Opened(open_joystick(path, clock, dev_dir=dev_dir), why)
+        return Opened(open_js(path, clock, dev_dir), why)
     devices = api.devices()
     pads = [d for d in devices if d.is_controller]
     if pads or devices:
@@ -78,13 +79,12 @@ def _open_auto(clock: Clock, dev_dir: str, mappings: SdlMappings, loader: Callab
         return _sdl_opened(api, (pads or devices)[0], clock, reason)
     if sys.platform.startswith("linux"):
         try:
-            path = default_device(dev_dir)
+            path = js_reader().default_device(dev_dir)
         except JoystickError:
             raise JoystickError(f"No joystick found: SDL sees no controller and there is no {dev_dir}/js*; plug one "
                                 f"in and {LIST_HINT}, or fly a virtual one with "
                                 "--joy script:examples/joystick_script.txt.") from None
-        return Opened(open_joystick(path, clock, dev_dir=dev_dir),
-                      f"{path}: the first js device (SDL sees no controller)")
+        return Opened(open_js(path, clock, dev_dir), f"{path}: the first js device (SDL sees no controller)")
     raise JoystickError(f"No joystick found (SDL sees no controller): plug one in and {LIST_HINT}.")
 
 
