@@ -78,6 +78,7 @@ class SdlSource:
         self._sleep, self._monotonic = sleep, monotonic
         self._ignored: set[str] = set()
         self._next_scan_s = 0.0
+        self._closed = False
         self.news: list[str] = []  # what the pilot should hear about the device (taken by the face: joyfly/rumble.py)
         opened = api.open(device.index, device.is_controller)
         if opened is None:
@@ -110,6 +111,7 @@ class SdlSource:
         return self.api.rumble(self._opened, low, high, duration_ms)
 
     def close(self) -> None:
+        self._closed = True  # never reopened by a later poll
         if self._opened is not None:
             self.api.close(self._opened)
             self._opened = None
@@ -118,6 +120,8 @@ class SdlSource:
 
     def _update(self) -> bool:
         """One pump: act on hot-plug, re-read on input; True when the state changed."""
+        if self._closed:
+            return False
         plugs, moved = self.api.pump()
         was = self.connected
         for kind, which in plugs:

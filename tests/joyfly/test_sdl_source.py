@@ -285,3 +285,10 @@ def test_the_device_is_found_again_even_when_its_plug_event_was_pumped_away(pads
         assert source.poll(1.0).connected  # found by the rescan
     finally:
         source.close()
+
+
+def test_a_closed_source_stays_closed(pads: list[VirtualPad]) -> None:
+    pads.append(VirtualPad.controller("Closed Pad", product=0x62))
+    source = open_source("sdl:closed", Clock()).source
+    source.close()
+    assert not source.poll(0.6).connected  # not reopened by the rescan
