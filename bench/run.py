@@ -10,7 +10,8 @@ Figures (targets from issue 4 in brackets):
   startup     wall time from process start to the first HEARTBEAT [< 0.5 s] and to health all good
   flight      reference loopback flight (arm, takeoff, OFFBOARD square, land) by a scripted pymavlink client:
               in-process lockstep wall time, and the highest `serve --speed` that still passes, with its wall time
-  latency     joyfly joystick event -> setpoint datagram, median and p99 [p99 < 5 ms] (bench/joyfly_latency.py)
+  latency     joyfly joystick event -> setpoint datagram, median and p99 [p99 < 5 ms], the js reader's and the SDL
+              path's side by side (bench/joyfly_latency.py)
   scale       largest --count N kept on time at real time on one core, hovering, default streams [100]
   view        `serve --view` at real time, hovering: % of one core of serve and of the Rerun viewer it starts (no
               browser connected), against serve without the view
@@ -146,13 +147,19 @@ def bench_flight(quick: bool) -> None:
 def bench_latency(quick: bool) -> None:
     script = REPO / "bench" / "joyfly_latency.py"
     out = subprocess.run([sys.executable, str(script), "--events", "100" if quick else "300"], cwd=REPO,
-                         capture_output=True, text=True, timeout=600)
-    m = re.search(r"median ([\d.]+) ms, p99 ([\d.]+) ms", out.stdout)
-    if out.returncode != 0 or m is None:
+                         capture_output=True, text=True, timeout=900)
+    found = {m.group(1): (m.group(2), m.group(3))
+             for m in re.finditer(r"^(js|sdl) .*median ([\d.]+) ms, p99 ([\d.]+) ms", out.stdout, re.M)}
+    if out.returncode != 0 or not found:
         say(f"joyfly latency: not measured ({(out.stderr or out.stdout).strip()[-200:]})")
         return
-    say(f"joyfly latency median: {m.group(1)} ms (joystick event -> setpoint datagram)")
-    say(f"joyfly latency p99: {m.group(2)} ms (target < 5)")
+    for path, label in (("js", "js reader (a FIFO of js_event records)"), ("sdl", "SDL (a virtual game controller)")):
+        if path in found:
+            median, p99 = found[path]
+            say(f"joyfly latency {path}: median {median} ms, p99 {p99} ms (target < 5; joystick event -> setpoint "
+                f"datagram, {label})")
+        else:
+            say(f"joyfly latency {path}: not measured")
 
 
 def bench_scale(quick: bool) -> None:

@@ -25,14 +25,16 @@ from joyfly.dashboard import make_view
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
+from joyfly.rumble import Haptics, HapticView, device_of, rumbler_of
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
 from joyfly.session.fence_watch import FENCE_ACTIONS, FENCE_GRACE_S
 from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
-from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
 
@@ -68,8 +70,13 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 
 
 @main.command(short_help="Fly a vehicle with a joystick.")
-@_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
-                    "raw:FILE (a capture of js_event records), script:FILE or replay:FILE; other files are refused.")
+@_opt("--joy", str, "Joystick: auto (the first SDL game controller, else SDL joystick, else /dev/input/js0), sdl "
+                    "(the first SDL game controller), sdl:N (SDL device N), sdl:NAME (part of its name), a "
+                    "/dev/input/js* device, a FIFO of js_event records, a --record recording, raw:FILE (a capture of "
+                    "js_event records), script:FILE or replay:FILE; other files are refused.")
+@_opt("--sdl-mapping", str, "Extra SDL game-controller mappings: a gamecontrollerdb.txt file or one mapping line.")
+@click.option("--rumble/--no-rumble", default=None, help="Rumble pulses on a fence push, a failsafe, link loss and "
+              "low battery, on a pad that has rumble. [default: rumble]")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "
@@ -123,7 +130,8 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     out = out or sys.stdout
     clock: WallClock | ScaledClock = WallClock() if opts.speed == 1.0 else ScaledClock(opts.speed)
     try:
-        sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record)
+        sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record,
+                             mappings=SdlMappings(opts.sdl_mapping, opts.mappings))
     except JoystickError as err:
         raise UserError(str(err)) from None
     problem = throttle_problem(opts.control, sticks.profile)
@@ -136,6 +144,8 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
         sticks.close()
         raise UserError(str(err)) from None
     view = make_view(out)
+    if sticks.why:
+        out.write(f"joyfly: --joy {opts.joy} chose {sticks.why}.\n")
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
     if opts.control in MANUAL_CONTROLS:
@@ -145,7 +155,11 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), Level.WARN, text)))
     session.link.on_message.append(watch.observe)
-    return fly_session(session, add_browser_view(view, session, view_options, out), out)
+    shown = add_browser_view(view, session, view_options, out)
+    rumbler = rumbler_of(sticks) if opts.rumble else None
+    yaw_of = (lambda: session.link.state.yaw_rad) if opts.control in MANUAL_CONTROLS else None
+    haptics = Haptics(rumbler, yaw_of) if rumbler is not None else None
+    return fly_session(session, HapticView(shown, haptics, device_of(sticks)), out)
 
 
 def throttle_problem(control: str, profile: Any) -> str | None:

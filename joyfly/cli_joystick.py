@@ -14,19 +14,19 @@ from typing import Any, TextIO
 
 import click
 
+from joyfly.cli_calibrate import calibrate
 from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
 from joyfly.clock import WallClock
-from joyfly.sticks.joystick import (
-    DeviceInfo,
-    JoystickError,
-    JsDevice,
-    default_device,
-    list_devices,
-    open_joystick,
-)
+from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js_seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
 from joyfly.sticks.mapping import StickMapper
 from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.sdl_list import sdl_lines
+from joyfly.sticks.sdl_mappings import SdlMappings
+from joyfly.sticks.sdl_source import SdlSource
+from joyfly.sticks.sources import open_source, pick_profile
+from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
@@ -42,24 +42,39 @@ def joystick() -> None:
 
 @joystick.command("list", short_help="List the joysticks and their profiles.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True, help="Where the js* nodes live.")
-def list_cmd(dev_dir: str) -> None:
-    """Every /dev/input/js* with its name, axes, buttons and the profile that matches it (none is an answer too:
-    exit status 0)."""
-    found = list_devices(dev_dir)
-    if not found:
-        click.echo(f"No joystick found (no {dev_dir}/js*): plug one in, or fly a virtual one with "
-                   "--joy script:examples/joystick_script.txt.")
+@click.option("--sdl-mapping", default=None, help="Extra SDL game-controller mappings (a file or one line).")
+def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
+    """Every SDL device (index for --joy sdl:N, name, GUID, game controller or joystick, axes/buttons/hats, rumble)
+    and every /dev/input/js*, with the profile that matches it."""
+    try:
+        lines = sdl_lines(SdlMappings(sdl_mapping))
+    except JoystickError as exc:
+        raise click.ClickException(str(exc)) from None
+    js = js_reader_or_none()
+    found = js.list_devices(dev_dir) if js is not None else []
+    if not found and not [ln for ln in lines if not ln.startswith("?")]:
+        for line in lines:  # why SDL could not look
+            click.echo(line)
+        click.echo(f"No joystick found (SDL sees none, and no {dev_dir}/js*): plug one in, or fly a virtual one "
+                   "with --joy script:examples/joystick_script.txt.")
         return
+    for line in lines:
+        click.echo(line)
     for item in found:
         click.echo(_device_line(item))
 
 
-def _device_line(item: DeviceInfo | JoystickError) -> str:
+def _device_line(item: Any) -> str:
+    """A js device (joystick.DeviceInfo) with its profile, or the JoystickError that stopped its probe."""
     if isinstance(item, JoystickError):
         return f"?  {item}"
-    profile = load_profile("auto", item.name, {})
+    mine = find_user_profile(item.name)
+    profile = mine.profile if mine is not None else load_profile("auto", item.name, {})
     counts = f"{item.axes} axes, {item.buttons} buttons" if item.kind == "device" else f"({item.kind})"
     return f"{item.path}  \"{item.name}\"  {counts}  profile: {profile.name}"
+
+
+joystick.add_command(calibrate)
 
 
 @joystick.command("profiles", short_help="The built-in controller profiles.")
@@ -74,9 +89,10 @@ def profiles_cmd() -> None:
 
 
 @joystick.command("test", short_help="Watch a joystick's axes and buttons live.")
-@click.option("--joy", "joy", default=None, help="A /dev/input/js* device, a FIFO of js_event records, a --record "
-              "recording, raw:FILE (a capture of js_event records), script:FILE or replay:FILE (default: the first "
-              "/dev/input/js*).")
+@click.option("--joy", "joy", default="auto", show_default=True, help="As `joyfly fly --joy`: auto, sdl, sdl:N, "
+              "sdl:NAME, a /dev/input/js* device, a FIFO of js_event records, a --record recording, raw:FILE, "
+              "script:FILE or replay:FILE.")
+@click.option("--sdl-mapping", default=None, help="Extra SDL game-controller mappings (a file or one line).")
 @click.option("--profile", "profile_name", default="auto", show_default=True,
               help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
 @click.option("--config", "config_path", default=None, help="TOML file whose [profile] table overrides the profile.")
@@ -84,17 +100,20 @@ def profiles_cmd() -> None:
 @click.option("--record", "record_path", default=None, help="Also record the session to this file (JSON lines), to "
               "replay with --joy FILE.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True)
-def test_cmd(joy: str | None, profile_name: str, config_path: str | None, duration: float | None,
+def test_cmd(joy: str, sdl_mapping: str | None, profile_name: str, config_path: str | None, duration: float | None,
              record_path: str | None, dev_dir: str) -> None:
     """Show the axes and buttons live, and the flying commands the profile makes of them."""
     clock = WallClock()
     try:
         overrides: dict[str, Any] = read_config(config_path) if config_path else {}
-        source = open_joystick(joy or default_device(dev_dir), clock, dev_dir=dev_dir)
+        opened = open_source(joy, clock, dev_dir=dev_dir, mappings=SdlMappings(sdl_mapping))
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None
+    source = opened.source
+    if opened.why:
+        click.echo(f"--joy {joy} chose {opened.why}.")
     try:
-        profile = load_profile(profile_name, source.name, overrides)
+        profile = pick_profile(source, profile_name, overrides)
         source = record_to(source, record_path) if record_path else source
     except JoystickError as exc:
         source.close()
@@ -144,7 +163,10 @@ def _error_of(source: JoystickSource) -> str:
         return f"({gone})"
     if isinstance(inner, TimedSource) and inner.ended:
         return "(the virtual joystick reached its end)"
-    if not isinstance(inner, JsDevice):
+    if isinstance(inner, SdlSource):
+        return str(inner.last_error or "")
+    js = js_reader_or_none()
+    if js is None or not isinstance(inner, js.JsDevice):
         return ""
     if inner.last_error is None and inner.kind == "fifo":
         return "(waiting for a writer on the FIFO)"

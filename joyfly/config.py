@@ -6,12 +6,16 @@ Command-line options win over the file, the file over the defaults::
 
     [fly]
     url = "udp://:14540@127.0.0.1:14557"
-    joy = "/dev/input/js0"
+    joy = "sdl"               # or "auto" (the default), "sdl:1", "sdl:xbox", "/dev/input/js0", "script:FILE"
+    sdl-mapping = "gamecontrollerdb.txt"   # extra SDL game-controller mappings (or one mapping line)
+    rumble = false            # like --no-rumble
     control = "velocity"      # or "step" (OFFBOARD), "position" or "altitude" (PX4's manual modes)
     max-speed = 3.0
     fence = 8.0
     fence-action = "land"     # or "warn", "hold", "rtl"
     on-exit = "rtl"
+
+    mappings = ["030000005e0400008e02000010010000,My pad,a:b0,b:b1,...,leftx:a0,lefty:a1,..."]
 
     [profile]
     base = "xbox"
@@ -49,7 +53,7 @@ class ConfigError(Exception):
 
 @dataclass(frozen=True, slots=True)
 class FlyOptions:
-    joy: str = "/dev/input/js0"
+    joy: str = "auto"  # the first SDL game controller, else SDL joystick, else /dev/input/js0 (sticks/sources.py)
     url: str = DEFAULT_URL
     profile: str = "auto"
     control: str = "velocity"
@@ -68,6 +72,9 @@ class FlyOptions:
     joy_timeout: float = 5.0  # s
     connect_timeout: float = 15.0  # s
     speed: float = 1.0  # the emulator's speed factor (sitl-emu serve --speed): joyfly's timing follows it
+    sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl_mappings.py)
+    mappings: tuple[str, ...] = ()  # SDL mapping lines from the config file's `mappings` list
+    rumble: bool = True  # rumble pulses on a pad that has them (sticks/rumble.py); --no-rumble
 
     def session_settings(self, **extra: Any) -> SessionSettings:
         limits = Limits(control=self.control, step_m=self.step, max_speed_m_s=self.max_speed,
@@ -112,6 +119,8 @@ def load_file(path: str) -> tuple[dict[str, Any], dict[str, Any]]:
     data = read_config(path)
     profile = data.get("profile", {})
     table = data.get("fly", {k: v for k, v in data.items() if k != "profile"})
+    if "fly" in data and "mappings" in data and isinstance(table, Mapping):
+        table = {**table, "mappings": data["mappings"]}  # `mappings = [...]` may sit beside [fly] too
     if not isinstance(table, Mapping) or not isinstance(profile, Mapping):
         raise ConfigError(f"{path}: [fly] and [profile] must be tables.")
     options: dict[str, Any] = {}
@@ -172,6 +181,15 @@ def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any
 def _coerce(name: str, value: Any, origins: _Origins) -> Any:
     defaults = FlyOptions()
     default = getattr(defaults, name)
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(f"{origins.says(name, value)} is not true or false: write {name} = true or false.")
+        return value
+    if isinstance(default, tuple):
+        if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+            raise ConfigError(f"{origins.says(name, value)} is not a list of SDL mapping lines: write "
+                              f"{name} = [\"GUID,name,a:b0,...\"].")
+        return tuple(value)
     if isinstance(default, float):
         number = _number(value)
         if number is None:

@@ -18,8 +18,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from joyfly.sticks.joystick import AXIS_MAX, JoystickError, open_joystick
-from joyfly.sticks.profiles import AxisMap, Profile, load_profile, rest_problems
+from joyfly.clock import WallClock
+from joyfly.sticks.js_events import AXIS_MAX, JoystickError
+from joyfly.sticks.profiles import AxisMap, Profile, rest_problems
+from joyfly.sticks.sdl_mappings import SdlMappings
+from joyfly.sticks.sources import open_source, pick_profile
 from joyfly.sticks.virtual import record_to
 from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
 
@@ -185,6 +188,7 @@ class MappedSource:
         self._mapper = StickMapper(profile)
         self.last_state: JoyState | None = None
         self.last_actions: frozenset[Action] = frozenset()
+        self.why = ""  # which device --joy auto / sdl chose, and why
 
     def poll(self, timeout_s: float) -> StickCommand:
         state = self.source.poll(timeout_s)
@@ -212,14 +216,18 @@ class MappedSource:
 
 def open_sticks(spec: str, clock: Clock | None = None, profile: str = "auto",
                 overrides: Mapping[str, Any] | None = None, record: str | None = None,
-                dev_dir: str = "/dev/input") -> MappedSource:
-    """One call for `joyfly fly`: open `--joy` (path, raw:, script:, replay:), pick the profile (`--profile`, the
-    config's `[profile]` table), optionally `--record`, and map. Raises JoystickError (one sentence) on any problem."""
-    source = open_joystick(spec, clock, dev_dir=dev_dir)
+                dev_dir: str = "/dev/input", mappings: SdlMappings | None = None) -> MappedSource:
+    """One call for `joyfly fly`: open `--joy` (auto, sdl[:N|:NAME], path, raw:, script:, replay:; see
+    joyfly/sticks/sources.py), pick the profile (`--profile`, the config's `[profile]` table), optionally `--record`,
+    and map. `why` on the result says which device `auto`/`sdl` chose. Raises JoystickError (one sentence)."""
+    opened = open_source(spec, clock or WallClock(), dev_dir=dev_dir, mappings=mappings)
+    source = opened.source
     try:
-        chosen = load_profile(profile, source.name, overrides)
+        chosen = pick_profile(source, profile, overrides)
         source = record_to(source, record) if record else source
     except JoystickError:
         source.close()
         raise
-    return MappedSource(source, chosen)
+    mapped = MappedSource(source, chosen)
+    mapped.why = opened.why
+    return mapped

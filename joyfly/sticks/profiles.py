@@ -35,7 +35,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from joyfly.sticks.joystick import AXIS_MAX, JoystickError
+from joyfly.sticks.js_events import AXIS_MAX, JoystickError
 from joyfly.types import Action, JoyState
 
 if sys.version_info >= (3, 11):
@@ -74,6 +74,7 @@ class Profile:
     arm_hold_s: float = 1.0
     kernel_before: tuple[int, int] | None = None  # only auto-matched on kernels older than this (old hid-sony)
     notes: str = ""
+    guids: tuple[str, ...] = ()  # SDL joystick GUIDs it is for (a plain SDL joystick is matched by GUID, then name)
 
     def axis(self, role: str) -> AxisMap | None:
         return self.axes.get(role)
@@ -112,6 +113,12 @@ BUILTIN: tuple[Profile, ...] = (
     Profile("script", "joyfly virtual script joystick (values already in the flying convention)", ("joyfly script",),
             {role: AxisMap(i, deadzone=0.0) for i, role in enumerate(STICK_ROLES)},
             {**_buttons(arm=0, takeoff=1, land=2, ret=3, hold=4, offboard=5)}),
+    # SDL's standard game-controller layout (joyfly/sticks/sdl_api.py): axes 0 LX, 1 LY, 2 RX, 3 RY, 4 LT, 5 RT;
+    # buttons 0 A, 1 B, 2 X, 3 Y, 4 Back, 5 Guide, 6 Start. Any pad SDL's database (or a mapping) knows flies with it.
+    Profile("sdl-gamecontroller", "any game controller read through SDL, in SDL's standard layout",
+            ("*(sdl game controller)",), _mode2(lx=0, ly=1, rx=2, ry=3),
+            _buttons(arm=6, takeoff=3, land=0, ret=1, hold=2, offboard=4),
+            notes="triggers (axes 4, 5) rest at 0 and are not mapped"),
     Profile("xbox", "Xbox 360 / Xbox One / Series pads on the xpad driver",
             ("*x-box*", "*xbox*", "*xinput*"), _XPAD_AXES, _XPAD_BUTTONS,
             notes="triggers (axes 2, 5) rest at -32767 and are not mapped"),
@@ -147,7 +154,8 @@ BUILTIN: tuple[Profile, ...] = (
 _BY_NAME = {p.name: p for p in BUILTIN}
 ALIASES = {"xbox360": "xbox", "xboxone": "xbox", "xpad": "xbox", "f310": "logitech-x", "f710": "logitech-x",
            "ds4": "dualshock", "ps4": "dualshock", "ps5": "dualshock", "dualsense": "dualshock",
-           "hid-sony": "dualshock-old", "edgetx": "radio", "opentx": "radio", "taranis": "radio"}
+           "hid-sony": "dualshock-old", "sdl": "sdl-gamecontroller", "edgetx": "radio", "opentx": "radio",
+           "taranis": "radio"}
 
 
 def profile_names() -> list[str]:

@@ -12,7 +12,7 @@ from joyfly.config import ConfigError, FlyOptions, build_options, load_file
 
 def test_defaults_are_the_documented_ones() -> None:
     o = build_options({}, {})
-    assert (o.joy, o.url, o.profile, o.control) == ("/dev/input/js0", "udp://:14540@127.0.0.1:14557", "auto",
+    assert (o.joy, o.url, o.profile, o.control) == ("auto", "udp://:14540@127.0.0.1:14557", "auto",
                                                    "velocity")
     assert (o.step, o.alt, o.max_climb, o.max_speed, o.fence, o.rate, o.on_exit, o.joy_timeout) == (
         2.0, 3.0, 1.0, 5.0, 5.0, 20.0, "land", 5.0)

@@ -34,6 +34,8 @@ from joyfly.types import Action, JoyState
         ("EdgeTX RadioMaster TX16S Joystick", "radio"),
         ("OpenTX FrSky Taranis Joystick", "radio"),
         ("joyfly script", "script"),
+        ("Xbox 360 Controller (SDL game controller)", "sdl-gamecontroller"),
+        ("PS4 Controller (SDL game controller)", "sdl-gamecontroller"),
         ("Thrustmaster T.16000M", "generic"),
         ("/tmp/some-fifo", "generic"),
     ],
@@ -59,7 +61,8 @@ def test_name_beats_auto_and_aliases_work():
 def test_unknown_profile_name_lists_the_choices():
     with pytest.raises(ProfileError) as info:
         load_profile("nintendo", "", {})
-    assert str(info.value).startswith("Unknown profile 'nintendo': choose auto or one of script, xbox,")
+    assert str(info.value).startswith("Unknown profile 'nintendo': choose auto or one of script, sdl-gamecontroller, "
+                                      "xbox,")
 
 
 def test_config_table_merges_over_the_builtin(tmp_path):
