@@ -30,6 +30,7 @@ if TYPE_CHECKING:
         AttitudeSetpoint,
         CommandAck,
         FollowTargetSample,
+        GroundTruth,
         ManualControlSetpoint,
         OffboardControlMode,
         TrajectorySetpoint,
@@ -89,6 +90,10 @@ class LinkVehicle(Protocol):
     def time_us(self) -> int: ...
 
     def snapshot(self) -> VehicleSnapshot: ...
+
+    def ground_truth(self) -> GroundTruth | None:
+        """The simulator's true state (HIL_STATE_QUATERNION); None where no simulator stands behind the vehicle."""
+        ...
 
     def events_after(self, seq: int) -> list[VehicleEvent]: ...
 
