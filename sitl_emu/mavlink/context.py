@@ -57,6 +57,7 @@ class EndpointStats:
     tx_bytes: int = 0
     tx_pack_errors: int = 0
     tx_forwarded: int = 0
+    rx_signing_rejected: int = 0  # unsigned, wrongly signed, replayed or stale, while signing is on
     # the byte counts at the last rate sample (link_rates)
     _rate_time_us: int = -1
     _rate_tx_bytes: int = 0
