@@ -65,6 +65,8 @@ class FlyOptions:
     joy_timeout: float = 5.0  # s
     connect_timeout: float = 15.0  # s
     speed: float = 1.0  # the emulator's speed factor (sitl-emu serve --speed): joyfly's timing follows it
+    signing_key: str | None = None  # MAVLink 2 signing key file (joyfly/link/signing_key.py)
+    setup_signing: bool = False  # give the vehicle the key with SETUP_SIGNING
 
     def session_settings(self, **extra: Any) -> SessionSettings:
         limits = Limits(control=self.control, step_m=self.step, max_speed_m_s=self.max_speed,
@@ -170,6 +172,11 @@ def build_options(file_options: Mapping[str, Any], cli_options: Mapping[str, Any
 def _coerce(name: str, value: Any, origins: _Origins) -> Any:
     defaults = FlyOptions()
     default = getattr(defaults, name)
+    if isinstance(default, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(f"{origins.says(name, value)} is not true or false: write {name.replace('_', '-')} = "
+                              "true or false.")
+        return value
     if isinstance(default, float):
         number = _number(value)
         if number is None:
