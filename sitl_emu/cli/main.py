@@ -280,8 +280,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
                             epoch_unix_us=int(time.time() * 1e6),
                             handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
-        for warning in _signed(nodes, instance, key):
-            click.echo(f"{TOOL}: {warning}", err=True)
+        _sign(nodes, instance, key)
     except (UsageProblem, PortInUseError) as err:
         raise UserError(str(err)) from None
     loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
@@ -301,9 +300,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             live.close()
         for logger in loggers:
             logger.close()  # a flight cut short keeps its log up to here
-    for node in nodes:
-        node.close()
-    _save_all(stores)
+    _close_all(nodes, stores)
 
 
 def _check_view(view: dict[str, Any]) -> None:
@@ -342,14 +339,22 @@ def _start_view(vehicles: list[Vehicle], nodes: list[VehicleNode], view: dict[st
     return handle
 
 
-def _signed(nodes: list[VehicleNode], instance: int, key: bytes | None) -> list[str]:
+def _sign(nodes: list[VehicleNode], instance: int, key: bytes | None) -> None:
     """Each vehicle's signing key (cli/signing_key.py); the nodes are closed if it cannot be stored."""
     try:
-        return attach_signing(nodes, instance, key)
+        warnings = attach_signing(nodes, instance, key)
     except UsageProblem:
         for node in nodes:
             node.close()
         raise
+    for warning in warnings:
+        click.echo(f"{TOOL}: {warning}", err=True)
+
+
+def _close_all(nodes: list[VehicleNode], stores: list[ParamStore]) -> None:
+    for node in nodes:
+        node.close()
+    _save_all(stores)
 
 
 def _save_or_fail(store: ParamStore) -> None:
