@@ -22,6 +22,7 @@ from joyfly.cli_style import CONTEXT, TOOL, VERSION_MESSAGE, FiniteRange, OneLin
 from joyfly.clock import ScaledClock, WallClock
 from joyfly.config import BOUNDS, CONTROLS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
+from joyfly.link.signing_key import SigningKeyError, read_signing_key
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
@@ -108,6 +109,11 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 @_opt("--speed", float, "How many times faster than real time the vehicle runs: the N of its sitl-emu serve "
       "--speed N (1 for PX4 SITL or a real vehicle). joyfly's rates and timeouts run as fast; it warns when the "
       "vehicle's clock says otherwise.")
+@_opt("--signing-key", str, "MAVLink 2 signing: sign everything with the 32-byte key in this file (64 hex digits or "
+      "raw bytes, as `sitl-emu serve --signing-key`) and take only what the vehicle signs with it.")
+@click.option("--setup-signing", is_flag=True, default=None,
+              help="Give the vehicle the --signing-key key first (SETUP_SIGNING, as QGroundControl does; PX4 accepts "
+                   "it while it has no key, or signed with its current key, and never while armed).")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 @view_options
 def fly(config_path: str | None, view: bool, view_port: int | None, view_grpc_port: int | None,
@@ -129,6 +135,7 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     """Open the joystick and the link, fly until done; returns the exit status."""
     out = out or sys.stdout
     clock: WallClock | ScaledClock = WallClock() if opts.speed == 1.0 else ScaledClock(opts.speed)
+    key = _signing_key(opts)
     try:
         sticks = open_sticks(opts.joy, clock, opts.profile, profile_table, record=opts.record,
                              mappings=SdlMappings(opts.sdl_mapping, opts.mappings))
@@ -152,7 +159,10 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
         warning = takeoff_warning(sticks.source, sticks.profile, MANUAL_MODES[opts.control][2])
         if warning is not None:
             view.note(Note(clock.now(), Level.WARN, warning))
-    session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
+    link = VehicleLink(transport, clock)
+    if key is not None:
+        link.use_signing(key, setup=opts.setup_signing)
+    session = make_session(link, sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), Level.WARN, text)))
     session.link.on_message.append(watch.observe)
     shown = add_browser_view(view, session, view_options, out)
@@ -160,6 +170,15 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     yaw_of = (lambda: session.link.state.yaw_rad) if opts.control in MANUAL_CONTROLS else None
     haptics = Haptics(rumbler, yaw_of) if rumbler is not None else None
     return fly_session(session, HapticView(shown, haptics, device_of(sticks)), out)
+
+
+def _signing_key(opts: FlyOptions) -> bytes | None:
+    if opts.setup_signing and opts.signing_key is None:
+        raise UserError("--setup-signing gives the vehicle the --signing-key key: name its file with --signing-key.")
+    try:
+        return read_signing_key(opts.signing_key) if opts.signing_key is not None else None
+    except SigningKeyError as err:
+        raise UserError(str(err)) from None
 
 
 def throttle_problem(control: str, profile: Any) -> str | None:

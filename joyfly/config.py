@@ -75,6 +75,8 @@ class FlyOptions:
     sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl_mappings.py)
     mappings: tuple[str, ...] = ()  # SDL mapping lines from the config file's `mappings` list
     rumble: bool = True  # rumble pulses on a pad that has them (sticks/rumble.py); --no-rumble
+    signing_key: str | None = None  # MAVLink 2 signing key file (joyfly/link/signing_key.py)
+    setup_signing: bool = False  # give the vehicle the key with SETUP_SIGNING
 
     def session_settings(self, **extra: Any) -> SessionSettings:
         limits = Limits(control=self.control, step_m=self.step, max_speed_m_s=self.max_speed,
@@ -183,7 +185,8 @@ def _coerce(name: str, value: Any, origins: _Origins) -> Any:
     default = getattr(defaults, name)
     if isinstance(default, bool):
         if not isinstance(value, bool):
-            raise ConfigError(f"{origins.says(name, value)} is not true or false: write {name} = true or false.")
+            raise ConfigError(f"{origins.says(name, value)} is not true or false: write {name.replace('_', '-')} = "
+                              "true or false.")
         return value
     if isinstance(default, tuple):
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):

@@ -136,6 +136,21 @@ class HomePosition:
 
 
 @dataclass(frozen=True, slots=True)
+class GroundTruth:
+    """The physics' true state, not the estimate: what PX4's SIH publishes as its vehicle_*_groundtruth topics
+    (simulator_sih/sih.cpp publish_ground_truth) and HIL_STATE_QUATERNION streams."""
+
+    pos_ned_m: Vec3
+    vel_ned_m_s: Vec3
+    acc_ned_m_s2: Vec3
+    q_wxyz: Vec4
+    rates_frd_rad_s: Vec3
+    lat_deg: float
+    lon_deg: float
+    alt_amsl_m: float
+
+
+@dataclass(frozen=True, slots=True)
 class OrbitStatus:
     """PX4's orbit_status while the orbit flight task runs (ORBIT_EXECUTION_STATUS): the signed radius (positive
     clockwise), the centre and the altitude (AMSL) of the altitude setpoint."""

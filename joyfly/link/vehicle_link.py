@@ -15,6 +15,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import common as mavlink2
 
+from joyfly.link.signing_key import keep_up, sign_with, wall_timestamp
 from joyfly.link.transport import Transport
 from joyfly.sticks.setpoints import FRAME_LOCAL_NED, Setpoint
 from joyfly.types import Clock
@@ -169,6 +170,15 @@ class VehicleLink:
         self._t0_s = clock.now()
         self._chunks: dict[int, str] = {}
         self.on_message: list[Any] = []  # callables(msg) for observers (benchmarks, tests)
+        self._signing = False
+        self._key_to_give: bytes | None = None  # SETUP_SIGNING until the vehicle's heartbeat comes signed
+
+    def use_signing(self, key: bytes, setup: bool = False) -> None:
+        """Sign everything sent with `key` and take from the vehicle only what it signs with it, but its heartbeat
+        (joyfly/link/signing_key.py); `setup`: give the vehicle the key with SETUP_SIGNING, once it is found."""
+        sign_with(self._mav, key)
+        self._signing = True
+        self._key_to_give = key if setup else None
 
     # --- receiving -------------------------------------------------------------------------------------------
     def poll(self, timeout_s: float = 0.0) -> int:
@@ -208,6 +218,17 @@ class VehicleLink:
             return
         self.state = replace(self.state, last_heartbeat_s=self._clock.now(), armed=bool(msg.base_mode & 128),
                              custom_mode=msg.custom_mode, system_status=msg.system_status)
+        if self._key_to_give is not None:
+            self._give_key(self._key_to_give, signed_heartbeat=bool(getattr(msg, "_signed", False)))
+
+    def _give_key(self, key: bytes, signed_heartbeat: bool) -> None:
+        """SETUP_SIGNING (signed with the key: a vehicle without one accepts anything) until the vehicle signs."""
+        if signed_heartbeat:
+            log.info("the vehicle signs with our key")
+            self._key_to_give = None
+            return
+        sysid, compid = self._target()
+        self._mav.setup_signing_send(sysid, compid, list(key), wall_timestamp())
 
     def _on_boot_time(self, boot_s: float) -> None:
         """Track the vehicle's time since boot; when it goes back, the vehicle restarted: forget what we knew of the
@@ -262,6 +283,8 @@ class VehicleLink:
     def tick(self) -> None:
         """Send the 1 Hz heartbeat and retransmit unanswered commands."""
         now = self._clock.now()
+        if self._signing:
+            keep_up(self._mav)
         if now >= self._next_heartbeat_s:
             self._mav.heartbeat_send(MAV_TYPE_GCS, MAV_AUTOPILOT_INVALID, 0, 0, 4)  # system_status ACTIVE
             self._next_heartbeat_s = now + HEARTBEAT_PERIOD_S

@@ -38,6 +38,7 @@ from sitl_emu.cli.options import (
     parse_home,
 )
 from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
+from sitl_emu.cli.signing_key import attach_signing, read_signing_key
 from sitl_emu.console.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
@@ -235,12 +236,16 @@ def main(ctx: click.Context, verbose: int) -> None:
                    "HH_MM_SS.ulg, the vehicle's UTC time; DIR-N for instance N of a --count), and serve them to "
                    "ground stations' log download.")
 @click.option("--no-log", is_flag=True, help="Write no flight logs.")
+@click.option("--signing-key", "signing_key", type=click.Path(path_type=Path), default=None, metavar="FILE",
+              help="Start with MAVLink 2 signing on, with the 32-byte key in FILE (64 hex digits or raw bytes), "
+                   "stored as PX4 stores a SETUP_SIGNING key (mavlink/mavlink-signing-key.bin here); without it a "
+                   "key stored there earlier is used.")
 @view_options
 @owning_signals  # SIGINT and SIGTERM end serve from its first line, whatever its phase (sitl_emu/cli/signals.py)
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
           params_reset: bool, seed: int, no_console: bool, wind_text: str | None, log_dir: Path, no_log: bool,
-          signals: ShutdownSignals, **view: Any) -> None:
+          signing_key: Path | None, signals: ShutdownSignals, **view: Any) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         _check_view(view)
@@ -252,6 +257,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
         check_own_ports([settings.for_instance(i) for i in range(instance, instance + count)])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
+        key = read_signing_key(signing_key) if signing_key is not None else None
         if signals.received:  # SIGINT or SIGTERM during the imports or the checks: no port is opened
             _say_exiting()
             return
@@ -274,6 +280,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
                             epoch_unix_us=int(time.time() * 1e6),
                             handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
+        _sign(nodes, instance, key)
     except (UsageProblem, PortInUseError) as err:
         raise UserError(str(err)) from None
     loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
@@ -293,9 +300,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
             live.close()
         for logger in loggers:
             logger.close()  # a flight cut short keeps its log up to here
-    for node in nodes:
-        node.close()
-    _save_all(stores)
+    _close_all(nodes, stores)
 
 
 def _check_view(view: dict[str, Any]) -> None:
@@ -332,6 +337,24 @@ def _start_view(vehicles: list[Vehicle], nodes: list[VehicleNode], view: dict[st
     assert handle is not None
     runner.hooks.append(ServeView(handle, vehicles))
     return handle
+
+
+def _sign(nodes: list[VehicleNode], instance: int, key: bytes | None) -> None:
+    """Each vehicle's signing key (cli/signing_key.py); the nodes are closed if it cannot be stored."""
+    try:
+        warnings = attach_signing(nodes, instance, key)
+    except UsageProblem:
+        for node in nodes:
+            node.close()
+        raise
+    for warning in warnings:
+        click.echo(f"{TOOL}: {warning}", err=True)
+
+
+def _close_all(nodes: list[VehicleNode], stores: list[ParamStore]) -> None:
+    for node in nodes:
+        node.close()
+    _save_all(stores)
 
 
 def _save_or_fail(store: ParamStore) -> None:

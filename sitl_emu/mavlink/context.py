@@ -30,6 +30,7 @@ if TYPE_CHECKING:
         AttitudeSetpoint,
         CommandAck,
         FollowTargetSample,
+        GroundTruth,
         ManualControlSetpoint,
         OffboardControlMode,
         TrajectorySetpoint,
@@ -56,6 +57,7 @@ class EndpointStats:
     tx_bytes: int = 0
     tx_pack_errors: int = 0
     tx_forwarded: int = 0
+    rx_signing_rejected: int = 0  # unsigned, wrongly signed, replayed or stale, while signing is on
     # the byte counts at the last rate sample (link_rates)
     _rate_time_us: int = -1
     _rate_tx_bytes: int = 0
@@ -89,6 +91,10 @@ class LinkVehicle(Protocol):
     def time_us(self) -> int: ...
 
     def snapshot(self) -> VehicleSnapshot: ...
+
+    def ground_truth(self) -> GroundTruth | None:
+        """The simulator's true state (HIL_STATE_QUATERNION); None where no simulator stands behind the vehicle."""
+        ...
 
     def events_after(self, seq: int) -> list[VehicleEvent]: ...
 

@@ -20,8 +20,11 @@ from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, vehic
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
+from sitl_emu.mavlink.signing import ARMED_TEXT, MavlinkSigning, SetupResult
 from sitl_emu.mavlink.telemetry.streams import StreamMode, Streams
 from sitl_emu.mavlink.wire.fastpack import ENCODER, frame_message
+from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, KEY_LEN, is_signed
+from sitl_emu.px4 import Severity
 
 if TYPE_CHECKING:
     from pymavlink.dialects.v20.development import MAVLink_message
@@ -67,6 +70,9 @@ class NodeServices(NodeView, Protocol):
     @property
     def sysid(self) -> int: ...
 
+    @property
+    def signing(self) -> MavlinkSigning: ...
+
     def broadcast(self, msg: OutMessage) -> None: ...
 
     def forward(self, msg: MAVLink_message, origin: Endpoint, target_system: int, target_component: int) -> None: ...
@@ -89,8 +95,9 @@ class Endpoint:
     GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
 
     def __init__(self, name: str, link: UdpLink, node: NodeServices, mode: StreamMode,
-                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0) -> None:
+                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0, link_id: int = 0) -> None:
         self.link_name = name
+        self.link_id = link_id  # PX4's mavlink instance number: the link id of what it signs
         self.link = link
         self.node = node
         self.sysid = node.sysid
@@ -99,6 +106,7 @@ class Endpoint:
         # send() continues (one sequence per link, whichever way a message was built)
         self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
         self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/wire/fastpack.py): same calls, cheaper messages
+        self.signing = node.signing  # the vehicle's MAVLink 2 signing, shared by its links (mavlink/signing.py)
         self._parser = _new_parser()
         self.stats = EndpointStats()
         self.streams = Streams(mode, stream_delay_us)
@@ -134,7 +142,11 @@ class Endpoint:
         """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
         mav = self.mav
         try:
-            data = frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent)
+            if self.signing.key is None:
+                data = frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent)
+            else:  # with a key, PX4 signs everything it sends
+                data = self.signing.sign(frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent, IFLAG_SIGNED),
+                                         self.link_id, self.node.epoch_unix_us + self._now_us)
         except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
             self.stats.tx_pack_errors += 1
             if self.stats.tx_pack_errors == 1:
@@ -169,6 +181,12 @@ class Endpoint:
         if src == (self.sysid, self.compid):  # our own messages looped back (PX4 ignores these)
             self.stats.rx_own_echo += 1
             return
+        if self.signing.key is not None and not self.signing.accept(msg.get_msgbuf(), msg.get_msgId(), *src):
+            self.stats.rx_signing_rejected += 1  # the MAVLink parser drops it: MAVLINK_FRAMING_BAD_SIGNATURE
+            return
+        if msg_type == "SETUP_SIGNING":  # handled and consumed by the mavlink module (check_for_signing)
+            self._setup_signing(msg)
+            return
         self.stats.rx_messages += 1
         self.seen_components.add(src)
         self.wake_handlers()
@@ -181,6 +199,15 @@ class Endpoint:
             log.error("%s link: error handling %s: %r", self.link_name, msg_type, err,
                       exc_info=log.isEnabledFor(logging.DEBUG))
         self._forward(msg)
+
+    def _setup_signing(self, msg: MAVLink_message) -> None:
+        key = bytes(getattr(msg, "secret_key", b"")).ljust(KEY_LEN, b"\0")[:KEY_LEN]
+        timestamp = int(getattr(msg, "initial_timestamp", 0))
+        result = self.signing.setup(key, timestamp, is_signed(msg.get_msgbuf()), self.node.snapshot().armed,
+                                    self.node.epoch_unix_us + self._now_us)
+        log.info("%s link: SETUP_SIGNING: %s", self.link_name, result.value)
+        if result is SetupResult.REJECTED_ARMED:
+            self.vehicle.report(Severity.CRITICAL, "mavlink", ARMED_TEXT, is_event=False)
 
     def _forward(self, msg: MAVLink_message) -> None:
         """Mavlink::forward_message (both SITL links run with -f): pass on what is not only for us, unchanged.

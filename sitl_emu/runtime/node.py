@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from sitl_emu.mavlink.context import LinkVehicle
 from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
 from sitl_emu.mavlink.link import Address, UdpLink
+from sitl_emu.mavlink.signing import MavlinkSigning
 from sitl_emu.mavlink.telemetry.streams import StreamMode
 from sitl_emu.runtime.timeline import TickVehicle
 from sitl_emu.types import VehicleSnapshot
@@ -78,8 +79,11 @@ class VehicleNode:
         except OSError:
             api_link.close()
             raise
-        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us)
-        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us)
+        # one signing key for the vehicle's links (mavlink/signing.py); `serve` gives it its key file
+        self.signing = MavlinkSigning()
+        # link ids are PX4 SITL's mavlink instances: the GCS link starts first (px4-rc.mavlink)
+        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us, link_id=1)
+        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us, link_id=0)
         self.endpoints: tuple[Endpoint, ...] = (self.api, self.gcs)
         self._event_seq = -1
         self._snapshot: VehicleSnapshot | None = None

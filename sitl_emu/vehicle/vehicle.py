@@ -41,6 +41,7 @@ from sitl_emu.types import (
     AttitudeSetpoint,
     CommandAck,
     FollowTargetSample,
+    GroundTruth,
     HomePosition,
     ManualControlSetpoint,
     OffboardControlMode,
@@ -264,6 +265,12 @@ class Vehicle:
         if c.nav_state in AUTO_MODES and self._setpoint_type is SetpointType.LAND:
             return LandedState.LANDING
         return LandedState.IN_AIR
+
+    def ground_truth(self) -> GroundTruth:
+        """The physics' true state now, with its geodetic position (SIH's groundtruth topics; HIL_STATE_QUATERNION)."""
+        s = self._state
+        lat, lon, alt = ned_to_global(self.ref, s.pos_ned_m)
+        return GroundTruth(s.pos_ned_m, s.vel_ned_m_s, s.acc_ned_m_s2, s.q_wxyz, s.rates_frd_rad_s, lat, lon, alt)
 
     @property
     def estimate(self) -> RigidBodyState:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from sitl_emu.mavlink.telemetry import actuators as ta
+from sitl_emu.mavlink.telemetry import ground_truth as tg
 from sitl_emu.mavlink.telemetry import health as th
 from sitl_emu.mavlink.telemetry import messages as tm
 from sitl_emu.mavlink.telemetry import sensors as ts
@@ -78,6 +79,11 @@ BUILDERS: dict[int, tm.Builder] = {
     12901: ts.open_drone_id_location,
     12904: ts.open_drone_id_system,
 }
+# streams in PX4's list that no SITL link starts with: on SET_MESSAGE_INTERVAL or REQUEST_MESSAGE only
+ON_DEMAND_STREAMS: dict[int, tm.Builder] = {
+    115: tg.hil_state_quaternion,  # SIH's ground truth (MAVSDK telemetry.set_rate_ground_truth)
+}
+STREAMS: dict[int, tm.Builder] = {**BUILDERS, **ON_DEMAND_STREAMS}
 # messages PX4 sends only on request (REQUEST_MESSAGE), not as periodic streams
 ON_REQUEST: dict[int, tm.Builder] = {
     148: lambda ctx, snap: autopilot_version(ctx.mav, ctx.sysid),
@@ -149,14 +155,14 @@ class Streams:
 
     # --- configuration (SET/GET_MESSAGE_INTERVAL) ------------------------------------------------------------
     def known(self, msg_id: int) -> bool:
-        return msg_id in BUILDERS
+        return msg_id in STREAMS
 
     def set_interval(self, msg_id: int, interval_us: float) -> bool:
         """mavlink_receiver.cpp set_message_interval: <0 stop, 0 default rate, >0 that interval. False: no stream.
 
         PX4 turns the interval into a rate (1e6 / interval) and configure_stream deletes a stream whose rate is not
         above 1e-6 Hz, so an interval of 1e12 µs or more (infinity too) stops the stream as well."""
-        if msg_id == HEARTBEAT_ID or msg_id not in BUILDERS:
+        if msg_id == HEARTBEAT_ID or msg_id not in STREAMS:
             return False
         if interval_us < -1e-5 or interval_us >= MAX_INTERVAL_US:
             self._interval_us.pop(msg_id, None)
@@ -187,7 +193,7 @@ class Streams:
     # --- sending -----------------------------------------------------------------------------------------------
     def build(self, msg_id: int, ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
         """The message now, for REQUEST_MESSAGE; None if we have no such message or no data for it."""
-        builder = BUILDERS.get(msg_id) or ON_REQUEST.get(msg_id)
+        builder = STREAMS.get(msg_id) or ON_REQUEST.get(msg_id)
         return builder(ctx, snap) if builder is not None else None
 
     def emit_due(self, ctx: EndpointContext, get_snapshot: Callable[[], VehicleSnapshot]) -> int:
@@ -202,7 +208,7 @@ class Streams:
         sent = 0
         for msg_id in due:
             try:
-                msg = tm.heartbeat(ctx, snap) if msg_id == HEARTBEAT_ID else BUILDERS[msg_id](ctx, snap)
+                msg = tm.heartbeat(ctx, snap) if msg_id == HEARTBEAT_ID else STREAMS[msg_id](ctx, snap)
             except Exception as err:  # a bad snapshot value must cost one message, not the link
                 self._build_failed(msg_id, err)
                 continue

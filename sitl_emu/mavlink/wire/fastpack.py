@@ -7,8 +7,9 @@ objects; at ~700 messages per simulated second per vehicle that was most of the 
   message object when it is sent, so a value out of its wire range fails at the same place).
 - `frame_message(msg, seq, sysid, compid)` frames a Packed or any pymavlink message object (what handlers build
   with `ctx.mav`) as MAVLink 2: trailing zero bytes of the payload cut (at least one byte kept), incompat/compat
-  flags 0, X.25 (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra. No signing: PX4 SITL
-  does not sign (MAV_SIGN_CFG 0), nor do we. The caller owns the sequence number (Endpoint: its `mav.seq`).
+  flags 0 (incompat flags as given: MAVLINK_IFLAG_SIGNED for a frame wire/signing.py then signs), X.25
+  (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra. The caller owns the sequence number
+  (Endpoint: its `mav.seq`).
 
 The field order, struct layout and crc_extra come from the pymavlink message classes themselves, so the wire format is
 theirs. Each class gets two small functions generated from that metadata, mirroring pymavlink's own generated
@@ -85,9 +86,9 @@ class Packed:
         return frame_message(self, mav.seq, mav.srcSystem, mav.srcComponent)
 
 
-def frame_message(msg: MAVLink_message | Packed, seq: int, sysid: int, compid: int) -> bytes:
+def frame_message(msg: MAVLink_message | Packed, seq: int, sysid: int, compid: int, incompat_flags: int = 0) -> bytes:
     """The MAVLink 2 frame of a Packed or of any pymavlink message object, exactly as pymavlink's
-    MAVLink_message._pack builds it, unsigned (a struct.error etc. for a value out of range)."""
+    MAVLink_message._pack builds it, without a signature block (a struct.error etc. for a value out of range)."""
     if type(msg) is Packed:
         spec = msg.spec
         payload = spec.pack(*msg.values)
@@ -96,7 +97,7 @@ def frame_message(msg: MAVLink_message | Packed, seq: int, sysid: int, compid: i
         payload = spec.payload_of(msg)
     body = payload.rstrip(b"\0") or payload[:1]
     msg_id = spec.msg_id
-    head = _HEADER.pack(len(body), 0, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
+    head = _HEADER.pack(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
     return MAGIC_V2 + head + _CRC.pack(x25_crc(head + spec.crc_extra, 0xFFFF))
 
 
