@@ -17,7 +17,7 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly flightview
+	$(BIN)/mypy sitl_emu joyfly flightview px4common
 	$(BIN)/python -m pytest -q
 	$(MAKE) test-compiled
 
@@ -32,13 +32,13 @@ test-compiled: $(STAMP)
 
 compiled-check:
 	rm -rf $(CHECK_DIR) && mkdir -p $(CHECK_DIR)
-	cp -r sitl_emu joyfly flightview tests tools examples pyproject.toml README.md $(CHECK_DIR)/
+	cp -r sitl_emu joyfly flightview px4common tests tools examples pyproject.toml README.md $(CHECK_DIR)/
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m compiled
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly flightview
+	$(BIN)/mypy sitl_emu joyfly flightview px4common
 
 bench: $(STAMP)
 	$(BIN)/python -m bench

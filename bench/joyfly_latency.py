@@ -22,7 +22,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from joyfly.clock import WallClock
 from joyfly.demo import EmbeddedVehicle
 from joyfly.link.transport import UdpTransport
 from joyfly.link.vehicle_link import VehicleLink
@@ -30,6 +29,7 @@ from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.setpoints import Setpoint
+from px4common.clock import WallClock
 
 
 def main() -> None:

@@ -17,9 +17,7 @@ import click
 from flightview.launch import ViewOptions
 from flightview.options import view_options, view_settings
 from joyfly.cli_joystick import joystick
-from joyfly.cli_style import CONTEXT, TOOL, FiniteRange, OneLineGroup, UserError
-from joyfly.clock import ScaledClock, WallClock
-from joyfly.config import BOUNDS, CONTROLS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
+from joyfly.config import BOUNDS, CONTROLS, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
@@ -32,7 +30,10 @@ from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
 from joyfly.view import add_browser_view, check_view_options
+from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError
+from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
 
+TOOL = "joyfly"
 D = FlyOptions()
 
 

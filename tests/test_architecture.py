@@ -1,5 +1,6 @@
 """The arrows ARCHITECTURE.md forbids: the vehicle core knows no MAVLink, no runtime, no clock; joyfly's stick side
-knows nothing of the link or the session; joyfly imports sitl_emu only in its demo."""
+knows nothing of the link or the session; joyfly imports sitl_emu only in its demo; px4common, what both programs
+share, is a leaf that only they import."""
 
 from __future__ import annotations
 
@@ -46,3 +47,26 @@ def test_the_stick_side_knows_neither_the_link_nor_the_session(path: Path) -> No
 def test_joyfly_speaks_only_mavlink_to_sitl_emu_except_in_its_demo(path: Path) -> None:
     if path.name != "demo.py":
         assert not {m for m in imports_of(path) if m.startswith("sitl_emu")}, path.name
+
+
+@pytest.mark.parametrize("path", sources("px4common"), ids=lambda p: p.name)
+def test_the_shared_package_imports_neither_program(path: Path) -> None:
+    assert not {m for m in imports_of(path) if m.startswith(("sitl_emu", "joyfly", "flightview"))}, path.name
+
+
+@pytest.mark.parametrize("path", sources("flightview"), ids=lambda p: p.name)
+def test_only_the_two_programs_import_the_shared_package(path: Path) -> None:
+    assert not {m for m in imports_of(path) if m.startswith("px4common")}, path.name
+
+
+def test_the_shared_package_holds_what_both_programs_use() -> None:
+    """A module in px4common that one program alone imports belongs in that program."""
+    users: dict[str, set[str]] = {}
+    for program in ("sitl_emu", "joyfly"):
+        for path in sources(program):
+            for module in imports_of(path):
+                if module.startswith("px4common."):
+                    users.setdefault(module, set()).add(program)
+    shared = {f"px4common.{p.stem}" for p in sources("px4common") if p.stem != "__init__"}
+    assert {m: u for m, u in users.items() if u != {"sitl_emu", "joyfly"}} == {}
+    assert shared == set(users), f"imported by neither program: {sorted(shared - set(users))}"

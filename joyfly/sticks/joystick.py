@@ -27,7 +27,6 @@ import select
 import stat
 from dataclasses import dataclass
 
-from joyfly.clock import WallClock
 from joyfly.sticks.js_events import (
     AXIS_MAX,
     EVENT_FORMAT,
@@ -48,6 +47,7 @@ from joyfly.sticks.js_events import (
 )
 from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
+from px4common.clock import WallClock
 
 __all__ = [  # the record format is re-exported: callers import the joystick side from here
     "AXIS_MAX", "EVENT_FORMAT", "EVENT_SIZE", "JS_EVENT_AXIS", "JS_EVENT_BUTTON", "JS_EVENT_INIT", "DeviceInfo",

@@ -17,20 +17,15 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from flightview.options import view_options, view_settings
+from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
+from px4common.clock import SPEED_MAX, SPEED_MIN
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli.options import (
-    CONTEXT,
     MAX_SYSID,
     PORT_MAX,
     SEED_MAX,
-    SPEED_MAX,
-    SPEED_MIN,
     TOOL,
-    FiniteRange,
-    OneLineGroup,
     UsageProblem,
-    UserError,
-    WholeRange,
     check_host,
     check_instances,
     check_own_ports,
