@@ -9,5 +9,5 @@ mode_executor.py (FlightModeManager: which task runs for the mode in force and w
 
 May import: the kernel (px4, types, geo), params/, control/ (plain maths, takeoff state), motion_planning/,
 navigator/ (the plans, the mission progression, navigator requests), commander/manual_control.py (the centred
-sticks). Never vehicle/, mavlink/, runtime/, the faces, or a clock.
+sticks), px4common/manual_defaults.py. Never vehicle/, mavlink/, runtime/, the faces, or a clock.
 """
