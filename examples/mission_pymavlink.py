@@ -11,6 +11,8 @@ the MAVLink mission protocol (MISSION_COUNT, a MISSION_ITEM_INT for each MISSION
 MAV_CMD_MISSION_START then arms the vehicle and flies it in AUTO.MISSION. The script prints each
 MISSION_ITEM_REACHED and the vehicle's texts until the vehicle has landed and disarmed. It sends a ground
 station's HEARTBEAT every second: PX4 sends its texts (STATUSTEXT) only to a link where a ground station is.
+A vehicle that flew before may wait disarmed in a mode that cannot arm (after an OFFBOARD flight PX4 stays in OFFBOARD
+with HEARTBEAT system_status UNINIT): the script then switches it to Hold first, as a ground station would.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from pymavlink import mavutil
 ALT_M = 5.0
 WAYPOINTS_NE_M = ((10.0, 0.0), (10.0, 10.0))
 EARTH_RADIUS_M = 6371000.0
+HOLD = (4, 3)  # PX4 main mode AUTO, sub-mode LOITER: Hold, a mode that can arm wherever the position is known
+MAV_STATE_STANDBY = 3  # HEARTBEAT system_status of a disarmed PX4 whose arming checks pass in its current mode
+READY_TIMEOUT_S = 60.0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -49,10 +54,34 @@ def heartbeat(mav: mavutil.mavfile) -> None:
     mav.mav.heartbeat_send(mavutil.mavlink.MAV_TYPE_GCS, mavutil.mavlink.MAV_AUTOPILOT_INVALID, 0, 0, 0)
 
 
-def wait_ready(mav: mavutil.mavfile) -> tuple[float, float]:
-    """Wait until the vehicle can arm (HEARTBEAT system_status STANDBY) and knows home; home's lat/lon."""
-    while mav.recv_match(type="HEARTBEAT", blocking=True, timeout=30).system_status != 3:  # MAV_STATE_STANDBY
-        pass
+def wait_ready(mav: mavutil.mavfile, timeout_s: float = READY_TIMEOUT_S) -> tuple[float, float]:
+    """Wait until the vehicle can arm (HEARTBEAT system_status STANDBY) and knows home; home's lat/lon.
+
+    PX4 says UNINIT while its arming checks fail in the current mode: while the estimator starts, and in a mode that
+    cannot arm, such as OFFBOARD without setpoints, where a vehicle stays after an OFFBOARD flight. A disarmed
+    vehicle in any mode but Hold is switched to Hold (again every 5 s while it is not ready); after `timeout_s` the
+    script says what it saw and stops."""
+    deadline, next_ask, last = time.monotonic() + timeout_s, 0.0, None
+    while time.monotonic() < deadline:
+        msg = mav.recv_match(type="HEARTBEAT", blocking=True, timeout=1)
+        if msg is None or msg.get_srcSystem() != mav.target_system:
+            continue
+        last = msg
+        if msg.system_status == MAV_STATE_STANDBY:
+            break
+        armed = msg.base_mode & mavutil.mavlink.MAV_MODE_FLAG_SAFETY_ARMED
+        if not armed and ((msg.custom_mode >> 16) & 0xFF, msg.custom_mode >> 24) != HOLD and \
+                time.monotonic() >= next_ask:
+            print(f"the vehicle is disarmed in {mavutil.mode_string_v10(msg)}, where it cannot arm: switching to Hold")
+            mav.mav.command_long_send(mav.target_system, mav.target_component, mavutil.mavlink.MAV_CMD_DO_SET_MODE,
+                                      0, mavutil.mavlink.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED, *HOLD, 0, 0, 0, 0)
+            next_ask = time.monotonic() + 5.0
+    else:
+        seen = "no HEARTBEAT" if last is None else (
+            f"HEARTBEAT system_status {last.system_status}, mode {mavutil.mode_string_v10(last)}")
+        raise SystemExit(f"the vehicle was not ready to arm (HEARTBEAT system_status {MAV_STATE_STANDBY}, STANDBY) "
+                         f"within {timeout_s:g} s; last seen: {seen}. Is it armed, or are its pre-flight checks "
+                         "failing?")
     msg = mav.recv_match(type="HOME_POSITION", blocking=True, timeout=30)
     if msg is None:
         raise SystemExit("no HOME_POSITION from the vehicle")

@@ -12,20 +12,22 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from flightview.live import LiveView
-from flightview.server import ViewError, ViewerServer, check_port_free, import_rerun, open_browser, start_server
+from flightview.server import ViewError, ViewerServer, check_ports, import_rerun, open_browser, start_server
 
 
 @dataclass(frozen=True, slots=True)
 class ViewOptions:
-    """--view (or --view-port, which implies it), --view-port (None: a free port), --record-view FILE.rrd."""
+    """--view (or --view-port / --view-grpc-port, which imply it), --view-port (the page's; None: a free port),
+    --view-grpc-port (the data stream's, Rerun's gRPC proxy; None: a free port), --record-view FILE.rrd."""
 
     view: bool = False
     port: int | None = None
     record: Path | None = None
+    grpc_port: int | None = None
 
     @property
     def serve(self) -> bool:
-        return self.view or self.port is not None
+        return self.view or self.port is not None or self.grpc_port is not None
 
     @property
     def wanted(self) -> bool:
@@ -51,8 +53,7 @@ def check_view(options: ViewOptions) -> None:
     if not options.wanted:
         return
     import_rerun()
-    if options.port:
-        check_port_free(options.port)
+    check_ports(options.port, options.grpc_port)
     if options.record is not None:
         _check_writable(options.record)
 
@@ -63,7 +64,7 @@ def open_view(app_id: str, keys: Sequence[str], options: ViewOptions, say: Calla
     if not options.wanted:
         return None
     check_view(options)
-    server = start_server(options.port) if options.serve else None
+    server = start_server(options.port, options.grpc_port) if options.serve else None
     try:
         live = LiveView(app_id, keys, server, options.record)
     except BaseException:

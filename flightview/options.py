@@ -9,22 +9,28 @@ from typing import Any
 import click
 
 from flightview.launch import ViewOptions
+from flightview.server import INSTALL_COMMAND
 
 PORT_RANGE = click.IntRange(1, 65535)
 
 
 def view_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """--view, --view-port, --record-view on a click command (passed as view, view_port, record_view)."""
+    """--view, --view-port, --view-grpc-port, --record-view on a click command (passed as view, view_port,
+    view_grpc_port, record_view)."""
     command = click.option("--record-view", type=click.Path(dir_okay=False, path_type=Path), default=None,
                            metavar="FILE.rrd", help="Save the view's recording to this file (replay it with "
                                                     "`rerun FILE.rrd`); works with or without --view.")(command)
+    command = click.option("--view-grpc-port", type=PORT_RANGE, default=None,
+                           help="Port of the view's data stream (Rerun's gRPC proxy, which the page reads) on "
+                                "127.0.0.1 (implies --view) [default: a free one].")(command)
     command = click.option("--view-port", type=PORT_RANGE, default=None,
                            help="Port of the view's web page on 127.0.0.1 (implies --view) [default: a free one].")(
         command)
     return click.option("--view", is_flag=True, help="Show the flight live in a web browser on this machine: the "
                          "vehicle, trail, setpoint, home and fence in 3D, and plots (needs the view extra: "
-                         "pip install 'joyfly[view]').")(command)
+                         f"{INSTALL_COMMAND} in the joyfly clone).")(command)
 
 
-def view_settings(view: bool = False, view_port: int | None = None, record_view: Path | None = None) -> ViewOptions:
-    return ViewOptions(view=view, port=view_port, record=record_view)
+def view_settings(view: bool = False, view_port: int | None = None, record_view: Path | None = None,
+                  view_grpc_port: int | None = None) -> ViewOptions:
+    return ViewOptions(view=view, port=view_port, record=record_view, grpc_port=view_grpc_port)

@@ -4,7 +4,7 @@ The SDK's own rr.serve_grpc() and rr.serve_web_viewer() listen on every address 
 (rerun-sdk 0.41), so the view runs Rerun's command-line viewer from the installed package as a child process,
 `rerun --serve-web --bind 127.0.0.1 --port GRPC --web-viewer-port WEB`: it serves the web viewer (HTML, JS, Wasm,
 no internet) and a gRPC proxy that the logging side connects to; the browser page reads from that proxy. Both ports
-are picked free on 127.0.0.1 unless --view-port gives the web page's.
+are picked free on 127.0.0.1 unless --view-port gives the web page's and --view-grpc-port the proxy's.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import contextlib
 import ctypes
 import importlib.util
 import os
+import shlex
 import shutil
 import signal
 import socket
@@ -29,8 +30,20 @@ from typing import IO
 LOOPBACK = "127.0.0.1"
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 START_TIMEOUT_S = 20.0  # the viewer program starts in well under a second; a busy 2-core machine may take longer
-INSTALL_HINT = ("--view needs the Rerun viewer, which is not installed: pip install 'joyfly[view]' "
-                "(or pip install rerun-sdk).")
+SOURCE_ROOT = Path(__file__).resolve().parent.parent  # the clone, when joyfly runs from one (pip install -e)
+INSTALL_COMMAND = "pip install -e '.[view]'"  # the view extra, from the clone (README, -h)
+
+
+def install_hint() -> str:
+    """How to install the view extra into the Python running now, as one command that works from anywhere: README's
+    `pip install -e '.[view]'` with this Python and this clone's path (Rerun's SDK alone where there is no clone)."""
+    target = f"-e {shlex.quote(f'{SOURCE_ROOT}[view]')}" if (SOURCE_ROOT / "pyproject.toml").exists() else \
+        "'rerun-sdk>=0.41'"
+    return f"{shlex.quote(sys.executable)} -m pip install {target}"
+
+
+def missing_extra() -> str:
+    return f"--view needs the Rerun viewer, which is not installed: {install_hint()}"
 
 
 class ViewError(Exception):
@@ -42,7 +55,7 @@ def import_rerun() -> object:
     try:
         import rerun
     except ImportError:
-        raise ViewError(INSTALL_HINT) from None
+        raise ViewError(missing_extra()) from None
     return rerun
 
 
@@ -65,6 +78,17 @@ def check_port_free(port: int, option: str = "--view-port") -> None:
                             "leave it out to use a free one.") from None
 
 
+def check_ports(web_port: int | None, grpc_port: int | None) -> None:
+    """ViewError in one sentence if the ports given are one port or cannot be listened on."""
+    if web_port and web_port == grpc_port:
+        raise ViewError(f"--view-port and --view-grpc-port are both {web_port}: the page and its data stream need "
+                        "a port each.")
+    if web_port:
+        check_port_free(web_port, "--view-port")
+    if grpc_port:
+        check_port_free(grpc_port, "--view-grpc-port")
+
+
 def rerun_program() -> str:
     """The viewer program installed with rerun-sdk (the rerun_cli package's binary itself: the `rerun` script on PATH
     is a Python wrapper whose child would outlive a stopped wrapper)."""
@@ -77,7 +101,7 @@ def rerun_program() -> str:
                 return str(candidate)
     found = shutil.which("rerun")
     if found is None:
-        raise ViewError(INSTALL_HINT)
+        raise ViewError(missing_extra())
     return found
 
 
@@ -125,14 +149,15 @@ class ViewerServer:
         self.errors.close()
 
 
-def start_server(web_port: int | None = None) -> ViewerServer:
-    """Start Rerun's web viewer and gRPC proxy on 127.0.0.1 (web_port None or 0: a free port); wait until both
+def start_server(web_port: int | None = None, grpc_port: int | None = None) -> ViewerServer:
+    """Start Rerun's web viewer and gRPC proxy on 127.0.0.1 (a port None or 0: a free one); wait until both
     listen. ViewError (one sentence) when a port is in use or the program fails."""
     import_rerun()
-    if web_port:
-        check_port_free(web_port)
+    check_ports(web_port, grpc_port)
     web = web_port or free_port()
-    grpc = free_port()
+    grpc = grpc_port or free_port()
+    while grpc == web:
+        grpc = free_port()
     command = [rerun_program(), "--serve-web", "--bind", LOOPBACK, "--port", str(grpc), "--web-viewer-port", str(web),
                "--server-memory-limit", "256MiB"]
     # its stderr goes to a file, not a pipe: a chatty viewer never blocks on a full pipe (ViewerServer.stop closes it)

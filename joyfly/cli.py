@@ -25,20 +25,21 @@ from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
-from joyfly.session.manual_session import MANUAL_CONTROLS
+from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
-from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError
+from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
 from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
 
 TOOL = "joyfly"
 D = FlyOptions()
 
 
-@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
-@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s")
+@click.group(name=TOOL, cls=OneLineGroup, version_message=VERSION_MESSAGE, context_settings=CONTEXT)
+@click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output on stderr (-v info, -vv debug).")
 def main(verbose: int) -> None:
     """Fly a PX4 quadrotor (PX4 SITL or `sitl-emu serve`) with a joystick over MAVLink."""
@@ -67,7 +68,7 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 
 @main.command(short_help="Fly a vehicle with a joystick.")
 @_opt("--joy", str, "Joystick: a /dev/input/js* device, a FIFO of js_event records, a --record recording, "
-                    "raw:FILE (a file of js_event records), script:FILE or replay:FILE; other files are refused.")
+                    "raw:FILE (a capture of js_event records), script:FILE or replay:FILE; other files are refused.")
 @_opt("--url", str, "Vehicle connection: MAVROS-style udp://[bind]:port@host:port, or udpin:/udpout:/tcp:/serial.")
 @_opt("--profile", str, "Controller profile: auto or a name from `joyfly joystick profiles`.")
 @_opt("--control", click.Choice(list(CONTROLS)), "How joyfly flies. OFFBOARD setpoints: velocity: the sticks set "
@@ -98,8 +99,8 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
       "vehicle's clock says otherwise.")
 @click.option("--config", "config_path", default=None, help="TOML file with any of these options and a [profile].")
 @view_options
-def fly(config_path: str | None, view: bool, view_port: int | None, record_view: Path | None,
-        **cli_options: Any) -> None:
+def fly(config_path: str | None, view: bool, view_port: int | None, view_grpc_port: int | None,
+        record_view: Path | None, **cli_options: Any) -> None:
     """Connect, take off to --alt in OFFBOARD (or arm in PX4's Position/Altitude mode with --control position/altitude)
     and fly with the joystick; Ctrl-C lands (see --on-exit)."""
     try:
@@ -107,7 +108,7 @@ def fly(config_path: str | None, view: bool, view_port: int | None, record_view:
         opts = build_options(file_options, cli_options, source=config_path)
     except (ConfigError, JoystickError) as err:
         raise UserError(str(err)) from None
-    view_opts = view_settings(view, view_port, record_view)
+    view_opts = view_settings(view, view_port, record_view, view_grpc_port)
     check_view_options(view_opts)
     sys.exit(run_fly(opts, profile_table, view_options=view_opts))
 
@@ -133,6 +134,10 @@ def run_fly(opts: FlyOptions, profile_table: dict[str, Any], out: Any = None,
     view = make_view(out)
     out.write(f"joyfly: joystick {sticks.name} ({sticks.path}), profile {sticks.profile.name}; "
               f"vehicle on {transport.description}; Ctrl-C to land and quit\n")
+    if opts.control in MANUAL_CONTROLS:
+        warning = takeoff_warning(sticks.source, sticks.profile, MANUAL_MODES[opts.control][2])
+        if warning is not None:
+            view.note(Note(clock.now(), Level.WARN, warning))
     session = make_session(VehicleLink(transport, clock), sticks, clock, opts.session_settings(), on_note=view.note)
     watch = SpeedWatch(opts.speed, lambda text: view.note(Note(clock.now(), Level.WARN, text)))
     session.link.on_message.append(watch.observe)
@@ -162,17 +167,22 @@ def throttle_problem(control: str, profile: Any) -> str | None:
 @click.option("--wind", default=None, metavar="SPEED@FROM[,TURBULENCE]",
               help="Wind on the built-in emulator, as `sitl-emu serve --wind`: e.g. 5@270 (5 m/s from the west), "
                    "5@270,light|moderate|severe or a W20 in m/s.")
+@click.option("--gcs-remote", default=None, metavar="HOST:PORT",
+              help="Send the built-in emulator's ground-station telemetry there (127.0.0.1:14550: a QGroundControl "
+                   "on this machine) [default: nowhere until a ground station talks to its port, which the demo "
+                   "prints].")
 @view_options
 def demo(url: str | None, speed: float, script_path: str | None, live: bool | None, control: str, wind: str | None,
-         view: bool, view_port: int | None, record_view: Path | None) -> None:
+         gcs_remote: str | None, view: bool, view_port: int | None, view_grpc_port: int | None,
+         record_view: Path | None) -> None:
     """A whole flight with no hardware: the built-in emulator, a scripted joystick, the live view, a summary."""
     from joyfly.demo import DemoError, run_demo
 
-    view_opts = view_settings(view, view_port, record_view)
+    view_opts = view_settings(view, view_port, record_view, view_grpc_port)
     check_view_options(view_opts)
     try:
         sys.exit(run_demo(url=url, speed=speed, script_path=script_path, live=live, control=control,
-                          view_options=view_opts, wind=wind))
+                          view_options=view_opts, wind=wind, gcs_remote=gcs_remote))
     except (DemoError, TransportError, JoystickError) as err:
         raise UserError(str(err)) from None
 

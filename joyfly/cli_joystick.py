@@ -43,13 +43,13 @@ def joystick() -> None:
 @joystick.command("list", short_help="List the joysticks and their profiles.")
 @click.option("--dev-dir", default=DEV_DIR, show_default=True, hidden=True, help="Where the js* nodes live.")
 def list_cmd(dev_dir: str) -> None:
-    """Every /dev/input/js* with its name, axes, buttons and the profile that matches it."""
+    """Every /dev/input/js* with its name, axes, buttons and the profile that matches it (none is an answer too:
+    exit status 0)."""
     found = list_devices(dev_dir)
     if not found:
-        raise click.ClickException(
-            f"No joystick found (no {dev_dir}/js*): plug one in, or fly a virtual one with "
-            "--joy script:examples/joystick_script.txt."
-        )
+        click.echo(f"No joystick found (no {dev_dir}/js*): plug one in, or fly a virtual one with "
+                   "--joy script:examples/joystick_script.txt.")
+        return
     for item in found:
         click.echo(_device_line(item))
 
@@ -75,7 +75,7 @@ def profiles_cmd() -> None:
 
 @joystick.command("test", short_help="Watch a joystick's axes and buttons live.")
 @click.option("--joy", "joy", default=None, help="A /dev/input/js* device, a FIFO of js_event records, a --record "
-              "recording, raw:FILE (a file of js_event records), script:FILE or replay:FILE (default: the first "
+              "recording, raw:FILE (a capture of js_event records), script:FILE or replay:FILE (default: the first "
               "/dev/input/js*).")
 @click.option("--profile", "profile_name", default="auto", show_default=True,
               help=f"Controller profile: auto or one of {', '.join(profile_names())}.")
@@ -139,6 +139,9 @@ def _ended(source: JoystickSource) -> bool:
 
 def _error_of(source: JoystickSource) -> str:
     inner = getattr(source, "source", source)
+    gone = getattr(inner, "gone", None)  # a stream that is no js_events, a raw capture that ended
+    if isinstance(gone, str):
+        return f"({gone})"
     if isinstance(inner, TimedSource) and inner.ended:
         return "(the virtual joystick reached its end)"
     if not isinstance(inner, JsDevice):

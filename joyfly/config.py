@@ -84,10 +84,9 @@ class Bound:
     why: str = ""
 
 
-# Every number a user can give, with its range (--alt also lies between --min-alt and --max-alt).
+# Every number a user can give, with its range; --alt has one range only: from --min-alt to --max-alt (validate).
 BOUNDS: dict[str, Bound] = {
     "step": Bound(0.1, 50.0, "m"),
-    "alt": Bound(0.0, 1000.0, "m"),
     "max_climb": Bound(0.1, 8.0, "m/s", " (PX4's MPC_Z_VEL_MAX_UP goes up to 8 m/s)"),
     "max_speed": Bound(0.1, 20.0, "m/s", " (PX4's MPC_XY_VEL_MAX goes up to 20 m/s)"),
     "max_yaw_rate": Bound(0.0, 400.0, "deg/s", " (PX4's MPC_MAN_Y_MAX goes up to 400 deg/s)"),
@@ -171,11 +170,12 @@ def _coerce(name: str, value: Any, origins: _Origins) -> Any:
     if isinstance(default, float):
         number = _number(value)
         if number is None:
-            bound = BOUNDS[name]
-            within = f"from {bound.lo:g} to {bound.hi:g} {bound.unit}"
             if name == "alt":  # checked against min-alt and max-alt, once they are known
                 within = (f"between min-alt and max-alt ({defaults.min_alt:g} and {defaults.max_alt:g} m unless you "
                           "change them)")
+            else:
+                bound = BOUNDS[name]
+                within = f"from {bound.lo:g} to {bound.hi:g} {bound.unit}"
             raise ConfigError(f"{origins.says(name, value)} is not a number: write a number {within}, for example "
                               f"{origins.example(name, default)}.")
         return number

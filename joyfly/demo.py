@@ -8,6 +8,8 @@ live view; and ends with a summary: distance flown, closest approach to the fenc
 
 from __future__ import annotations
 
+import importlib.util
+import socket
 import sys
 import threading
 import time
@@ -95,24 +97,47 @@ class VehicleTimeClock:
 class EmbeddedVehicle:
     """sitl_emu's vehicle node on free loopback ports, run in real time (x speed) in a daemon thread."""
 
-    def __init__(self, joyfly_port: int, speed: float, wind: str | None = None) -> None:
-        """`wind` is `sitl-emu serve --wind`'s SPEED@FROM_DEG[,TURBULENCE] text (None: calm air)."""
+    def __init__(self, joyfly_port: int, speed: float, wind: str | None = None, gcs_remote: str | None = None) -> None:
+        """`wind` is `sitl-emu serve --wind`'s SPEED@FROM_DEG[,TURBULENCE] text (None: calm air); `gcs_remote` a
+        HOST:PORT where the ground-station link sends its telemetry until a ground station talks to it (None: to a
+        socket of the demo's own that drops it, so that a QGroundControl on this machine sees nothing unasked)."""
         try:
             from sitl_emu.cli.main import build_params, build_vehicle
+            from sitl_emu.cli.options import UsageProblem, parse_address
             from sitl_emu.disturbance.wind import parse_wind
             from sitl_emu.runtime.node import LinkSettings, VehicleNode
             from sitl_emu.runtime.runner import RealTimeRunner
         except ImportError as exc:
             raise DemoError(f"The bundled emulator cannot be imported ({exc}): reinstall with `make demo`.") from None
-        settings = LinkSettings(bind_host="127.0.0.1", api_port=0, api_remote=("127.0.0.1", joyfly_port),
-                                gcs_port=0, gcs_remote=("127.0.0.1", 14550))
         try:
             wind_settings = parse_wind(wind) if wind is not None else None
         except ValueError as err:
             raise DemoError(f"--wind: {err}") from None
+        try:
+            gcs_address = parse_address(gcs_remote, "--gcs-remote") if gcs_remote is not None else None
+        except UsageProblem as err:
+            raise DemoError(str(err)) from None
+        self._sink: socket.socket | None = None
+        if gcs_address is None:
+            self._sink = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            self._sink.bind(("127.0.0.1", 0))
+            gcs_address = self._sink.getsockname()
+        self.gcs_remote: tuple[str, int] | None = None if self._sink else gcs_address
+        settings = LinkSettings(bind_host="127.0.0.1", api_port=0, api_remote=("127.0.0.1", joyfly_port),
+                                gcs_port=0, gcs_remote=gcs_address)
         self.node: Any = VehicleNode(build_vehicle(build_params(None, ()), None, 0, 1, wind_settings), settings)
         self.runner = RealTimeRunner([self.node], speed=speed)
         self._thread = threading.Thread(target=self.runner.run, name="sitl-emu", daemon=True)
+
+    @property
+    def gcs_port(self) -> int:
+        """The ground-station link's own port: a ground station that sends there first gets the telemetry."""
+        return int(self.node.gcs.link.port)
+
+    def describe_gcs(self) -> str:
+        sending = f"sending to {self.gcs_remote[0]}:{self.gcs_remote[1]}" if self.gcs_remote else \
+            "sending nowhere until a ground station talks to it (--gcs-remote HOST:PORT sends)"
+        return f"ground-station link on UDP {self.gcs_port}, {sending}"
 
     @property
     def api_address(self) -> tuple[str, int]:
@@ -129,7 +154,12 @@ class EmbeddedVehicle:
     def stop(self) -> None:
         self.runner.stop()
         self._thread.join(2.0)
+        self.close()
+
+    def close(self) -> None:
         self.node.close()
+        if self._sink is not None:
+            self._sink.close()
 
 
 def script_source(script_path: str | None, clock: Any, control: str = "velocity") -> MappedSource:
@@ -142,10 +172,10 @@ def script_source(script_path: str | None, clock: Any, control: str = "velocity"
 
 def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None = None, live: bool | None = None,
              out: TextIO | None = None, options: FlyOptions | None = None, control: str | None = None,
-             view_options: ViewOptions | None = None, wind: str | None = None) -> int:
+             view_options: ViewOptions | None = None, wind: str | None = None, gcs_remote: str | None = None) -> int:
     """Fly the demo; returns the exit status (0 when the flight ended landed and disarmed). `control` picks the way
     of flying (FlyOptions.control), position/altitude at QGroundControl's MANUAL_CONTROL rate; `wind` (SPEED@FROM_DEG
-    [,TURBULENCE]) blows on the built-in emulator."""
+    [,TURBULENCE]) blows on the built-in emulator, whose ground-station link sends to `gcs_remote` (HOST:PORT)."""
     from joyfly.run import fly_session
     from joyfly.view import add_browser_view
 
@@ -153,14 +183,12 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
     opts = options or FlyOptions()
     if control is not None:
         opts = replace(opts, control=control, rate=MANUAL_RATE_HZ if control in MANUAL_CONTROLS else opts.rate)
-    if url is not None and wind is not None:
-        raise DemoError("--wind blows on the built-in emulator only: give the vehicle at --url its own wind "
-                        "(sitl-emu serve --wind).")
+    _check_url_options(url, wind, gcs_remote)
     transport: Any = open_transport(url) if url else UdpTransport(("127.0.0.1", 0), None)
     emulator = None
     if url is None:
         try:
-            emulator = EmbeddedVehicle(transport.local_port, speed, wind)
+            emulator = EmbeddedVehicle(transport.local_port, speed, wind, gcs_remote)
         except DemoError:
             transport.close()
             raise
@@ -174,6 +202,8 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
     out.write(f"joyfly demo: {transport.description}, scripted joystick "
               f"{sticks.path}{f', x{speed:g} speed' if emulator and speed != 1 else ''}"
               f"{f', wind {wind}' if wind else ''}\n")
+    out.write(f"joyfly demo: {emulator.describe_gcs()}\n" if emulator else "")
+    out.write(_view_hint(view_options))
     settings = opts.session_settings(exit_when_landed=True)
     session = make_session(VehicleLink(transport, clock), sticks, clock, settings, on_note=view.note)
     try:
@@ -193,3 +223,21 @@ def run_demo(url: str | None = None, speed: float = 1.0, script_path: str | None
             emulator.stop()
     return status
 
+
+def _check_url_options(url: str | None, wind: str | None, gcs_remote: str | None) -> None:
+    """--wind and --gcs-remote are the built-in emulator's: refused with --url, in one sentence."""
+    if url is not None and wind is not None:
+        raise DemoError("--wind blows on the built-in emulator only: give the vehicle at --url its own wind "
+                        "(sitl-emu serve --wind).")
+    if url is not None and gcs_remote is not None:
+        raise DemoError("--gcs-remote sets the built-in emulator's ground-station link only: the vehicle at --url "
+                        "has its own (sitl-emu serve --gcs-remote).")
+
+
+def _view_hint(view_options: ViewOptions | None) -> str:
+    """Without the view extra (the demo does not need it), one line saying how to see the flight in 3D."""
+    if (view_options is not None and view_options.wanted) or importlib.util.find_spec("rerun") is not None:
+        return ""
+    from flightview.server import install_hint
+
+    return f"joyfly demo: to see the flight in 3D in a browser, {install_hint()} and add --view\n"

@@ -5,11 +5,13 @@ A program makes its click group a `OneLineGroup` named after the tool (`@click.g
 cls=OneLineGroup)`) and raises `UserError` (exit status 2) or `UserFailure` (1) with one sentence. Every error leaving
 a command passes through the group, which turns click's errors into `UserError` and names the tool on each. A
 subgroup that is a OneLineGroup too says its tool (`@click.group("joystick", cls=OneLineGroup, tool="joyfly")`), so
-its errors name the tool even when it runs alone; the outermost group has the last word.
+its errors name the tool even when it runs alone; the outermost group has the last word. Each command added to a
+OneLineGroup takes --version too, printing the group's `version_message` as the tool's own --version does.
 """
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 import os
 import sys
@@ -20,6 +22,8 @@ from typing import IO, Any
 import click
 
 CONTEXT = {"help_option_names": ["-h", "--help"]}
+DISTRIBUTION = "joyfly"  # the distribution both tools come in: its version is theirs
+VERSION_MESSAGE = "%(prog)s %(version)s"  # what --version prints, unless a group says otherwise
 
 
 class UserError(click.ClickException):
@@ -51,13 +55,32 @@ def one_line(err: click.ClickException) -> UserError:
     return UserFailure(text) if err.exit_code == 1 else UserError(text)
 
 
+def version_option(tool: str, message: str = VERSION_MESSAGE) -> click.Option:
+    """--version as on the tool itself, for one of its commands."""
+
+    def show(ctx: click.Context, param: click.Parameter, value: bool) -> None:
+        if value and not ctx.resilient_parsing:
+            click.echo(message % {"prog": tool, "version": importlib.metadata.version(DISTRIBUTION)})
+            ctx.exit()
+
+    return click.Option(["--version"], is_flag=True, expose_value=False, is_eager=True, callback=show,
+                        help="Show the version and exit.")
+
+
 class OneLineGroup(click.Group):
     """A click group whose errors, click's usage errors included, are one line (`UserError`) naming the tool (`tool`,
-    by default the group's name)."""
+    by default the group's name); each command added to it takes --version too, as the tool does."""
 
-    def __init__(self, *args: Any, tool: str | None = None, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, tool: str | None = None, version_message: str = VERSION_MESSAGE,
+                 **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self.tool = tool or self.name
+        self.version_message = version_message
+
+    def add_command(self, cmd: click.Command, name: str | None = None) -> None:
+        if not any("--version" in param.opts for param in cmd.params):
+            cmd.params.append(version_option(self.tool or "", self.version_message))
+        super().add_command(cmd, name)
 
     def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
                      **extra: Any) -> click.Context:

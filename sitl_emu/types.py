@@ -122,7 +122,8 @@ class VehicleEvent:
     def console_line(self) -> str:
         level = {Severity.INFO: "INFO", Severity.WARNING: "WARN", Severity.CRITICAL: "ERROR",
                  Severity.ERROR: "ERROR", Severity.EMERGENCY: "PANIC"}.get(self.severity, "INFO")
-        return f"{level:<5} [{self.module}] {self.text}"
+        # a text that names its module itself (the logger's "[logger] ./log/...ulg") gets the prefix once
+        return f"{level:<5} [{self.module}] {self.text.removeprefix(f'[{self.module}] ')}"
 
 
 @dataclass(frozen=True, slots=True)

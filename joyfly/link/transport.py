@@ -84,6 +84,21 @@ class UdpTransport:
         self.remote = addr
         return data
 
+    def vehicle_port_taken(self) -> bool | None:
+        """Whether a program on this machine holds the UDP port joyfly sends to (binding it fails: EADDRINUSE), so a
+        vehicle that stays silent there is alive but talks to another client; None when that address is not this
+        machine's (EADDRNOTAVAIL) or there is none yet: joyfly cannot tell."""
+        if self.remote is None:
+            return None
+        probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            probe.bind(self.remote)
+        except OSError as exc:
+            return True if exc.errno == errno.EADDRINUSE else None
+        finally:
+            probe.close()
+        return False
+
     def close(self) -> None:
         self._sock.close()
 

@@ -132,8 +132,14 @@ def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None
     return FlightStats(dist, margin, control_time, max(stats.max_alt_m, fence.alt_m(pos)))
 
 
-def no_vehicle_message(where: str, heard: bool, timeout_s: float) -> str:
-    """Why the session could not start, and what to do about it."""
+def no_vehicle_message(where: str, heard: bool, timeout_s: float, port_taken: bool | None = None) -> str:
+    """Why the session could not start, and what to do about it; `port_taken`: a program on this machine holds the
+    port the vehicle should answer from (the transport's vehicle_port_taken)."""
+    if not heard and port_taken:
+        return (f"No HEARTBEAT on {where} after {timeout_s:g} s, though a program holds that vehicle port on this "
+                "machine: the vehicle is probably busy with another client (PX4's API link, as sitl-emu serve's, "
+                "answers only the first client it hears, for good); quit that client and start joyfly on its port, "
+                "or restart the vehicle.")
     if heard:
         return (f"The vehicle on {where} sends HEARTBEATs but no LOCAL_POSITION_NED after {timeout_s:g} s: it has "
                 "no position estimate yet; wait for it, then retry.")

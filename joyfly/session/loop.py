@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from joyfly.session.core import MIN_SEND_GAP_S, Level, Phase, SessionView, no_vehicle_message
-from joyfly.session.retry import ExitPlan, Outcome
+from joyfly.session.retry import ExitPlan, Outcome, exits_by_disarming
 from joyfly.session.watch import SessionWatch
 from joyfly.sticks.mapping import fired
 from joyfly.types import Action
@@ -108,11 +108,23 @@ class SessionLoop(SessionWatch):
             if not self._watch_link(now):
                 self._tick_exit_timeout(now)
                 return
+        if self._sticks_gone_before_arming():
+            return
         self._watch_joystick(now)
         if self.phase not in (Phase.EXITING, Phase.CONNECTING):
             self._handle_buttons()
         getattr(self, _PHASE_METHODS[self.phase])(now)
         self._after_tick(now)
+
+    def _sticks_gone_before_arming(self) -> bool:
+        """A joystick gone for good (it sent no js_events, its capture ended) before anything armed ends the session
+        with its sentence; after that it is a lost joystick (hold, then land)."""
+        if self.phase not in (Phase.CONNECTING, Phase.PRESTREAM, Phase.ARMING, Phase.ENTERING) or self._maybe_armed():
+            return False
+        why: str | None = getattr(self.sticks, "gone", lambda: None)()
+        if why is not None:
+            self._fail(why)
+        return why is not None
 
     # --- buttons -----------------------------------------------------------------------------------------------
 
@@ -168,8 +180,9 @@ class SessionLoop(SessionWatch):
             self._on_connected()
         elif now - self._start_s > self.s.connect_timeout_s:
             st = self.link.state
+            taken: bool | None = getattr(self.link.transport, "vehicle_port_taken", lambda: None)()
             self._fail(no_vehicle_message(self.link.transport.description, st.last_heartbeat_s is not None,
-                                          self.s.connect_timeout_s))
+                                          self.s.connect_timeout_s, taken))
 
     def _on_connected(self) -> None:
         st = self.link.state
@@ -235,7 +248,8 @@ class SessionLoop(SessionWatch):
         if self.phase is Phase.CONNECTING or not self._maybe_armed():
             self._set_phase(Phase.DONE)
             return
-        self._note(Level.INFO, f"Exiting: {self.s.on_exit} (press Ctrl-C again to quit at once).")
+        what = "disarming on the ground" if exits_by_disarming(self.link.state) else self.s.on_exit
+        self._note(Level.INFO, f"Exiting: {what} (press Ctrl-C again to quit at once).")
         self._set_phase(Phase.EXITING)
 
     def _maybe_armed(self) -> bool:
@@ -252,6 +266,7 @@ class SessionLoop(SessionWatch):
         outcome = self._exit.update(now)
         if outcome is Outcome.DONE:
             done = "Landed and disarmed." if self.s.on_exit != "hold" else "The vehicle holds position."
+            done = "Disarmed on the ground." if self._exit.disarming else done
             self._note(Level.INFO, done)
             self._set_phase(Phase.DONE)
             return

@@ -16,8 +16,9 @@ PX4 takes a MANUAL_CONTROL stream that stops for a lost RC: Hold for COM_FAIL_AC
 in every mode but Land and Return (failsafe.cpp). So joyfly streams from the connection until it is done, with
 centred sticks whenever the pilot does not fly (before arming, while holding for a lost joystick, while landing on
 exit), and stops once the vehicle is disarmed or the user quits. Joystick lost: Hold (AUTO.LOITER), then NAV_LAND
-after --joy-timeout; Ctrl-C: NAV_LAND and wait for the disarm. During a link outage joyfly sends nothing (it no
-longer knows where the vehicle is, so it cannot keep the fence): PX4's failsafe holds, then returns. In Hold, Return
+after --joy-timeout; Ctrl-C: NAV_LAND and wait for the disarm (on the ground: disarm at once). During a link outage
+joyfly sends nothing (it no longer knows where the vehicle is, so it cannot keep the fence): PX4's failsafe holds,
+then returns. In Hold, Return
 or Land the sticks still stream: moving them hands control back as PX4 does (its pilot takeover), as does OFFBOARD.
 """
 

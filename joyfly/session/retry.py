@@ -14,6 +14,7 @@ from px4common.modes import AutoSubMode, MainMode
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
 REASON_GRACE_S = 0.25
 WARNING = 4  # MAV_SEVERITY_WARNING: CRITICAL "Arming denied: ..." and friends are below it
+MAV_LANDED_STATE_ON_GROUND = 1
 
 
 class Outcome(Enum):
@@ -104,7 +105,11 @@ EXIT_MODES = {"land": "AUTO.LAND", "rtl": "AUTO.RTL", "hold": "AUTO.LOITER"}  # 
 class ExitPlan:
     """--on-exit: NAV_LAND (land), NAV_RETURN_TO_LAUNCH (rtl) or DO_SET_MODE AUTO.LOITER (hold), retried on refusal,
     until the vehicle is disarmed (land, rtl) or out of joyfly's mode (hold: `in_control`, OFFBOARD by default).
-    The caller enforces the overall timeout."""
+    A vehicle armed on the ground (before its take-off, or after landing in a manual mode; or an ARM on its way) is
+    disarmed at once, as a pilot would: LAND there would only wait for PX4's auto-disarm (COM_DISARM_PRFLT, 10 s).
+    The disarm is a plain ARM_DISARM, which PX4 refuses in the air ("Disarming denied: not landed",
+    Commander::disarm): if the vehicle lifted off meanwhile, the --on-exit action follows. The caller enforces the
+    overall timeout."""
 
     def __init__(self, on_exit: str, link: VehicleLink, now_s: float,
                  in_control: Callable[[VehicleState], bool] | None = None) -> None:
@@ -112,16 +117,21 @@ class ExitPlan:
         self.link = link
         self.in_control = in_control or (lambda st: st.offboard)
         self.started_s = now_s
-        self.retry = Retry(f"Exit action {on_exit}", 3, now_s, settle_s=math.inf)
+        self.disarming = exits_by_disarming(link.state)
+        what = "Disarming on the ground" if self.disarming else f"Exit action {on_exit}"
+        self.retry = Retry(what, 1 if self.disarming else 3, now_s, settle_s=math.inf)
         self._gave_up = False
 
     @property
     def commanded_mode(self) -> str | None:
         """The mode the vehicle is in once it ACCEPTED the exit command (PX4 ACKs after switching), else None."""
         handle = self.retry.handle
-        return EXIT_MODES.get(self.on_exit) if handle is not None and handle.accepted else None
+        accepted = handle is not None and handle.accepted and not self.disarming
+        return EXIT_MODES.get(self.on_exit) if accepted else None
 
     def _send(self) -> CommandHandle:
+        if self.disarming:
+            return self.link.arm(False)
         if self.on_exit == "land":
             return self.link.land()
         if self.on_exit == "rtl":
@@ -132,7 +142,7 @@ class ExitPlan:
         """Out of joyfly's mode (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not
         show in the 1 Hz HEARTBEAT yet)."""
         st = self.link.state
-        if self.on_exit == "hold":
+        if self.on_exit == "hold" and not self.disarming:
             return not self.in_control(st)
         return not st.armed and st.last_heartbeat_s is not None and st.last_heartbeat_s > self.started_s
 
@@ -141,8 +151,18 @@ class ExitPlan:
         if self.done():
             return Outcome.DONE
         outcome = self.retry.update(now_s, self.link, self._send, lambda: False)
+        if self.disarming and outcome is not None:  # refused: it is flying after all, so the --on-exit action
+            self.disarming = False
+            self.retry = Retry(f"Exit action {self.on_exit}", 3, now_s, settle_s=math.inf)
+            return None
         if outcome is Outcome.FAILED:
             if self._gave_up:
                 return None
             self._gave_up = True
         return outcome
+
+
+def exits_by_disarming(st: VehicleState) -> bool:
+    """On the ground by the vehicle's own land detector (EXTENDED_SYS_STATE landed_state ON_GROUND), or not yet
+    armed by its HEARTBEAT (an ARM on its way): there the exit disarms."""
+    return st.landed_state == MAV_LANDED_STATE_ON_GROUND or (st.landed_state == 0 and not st.armed)

@@ -67,6 +67,9 @@ class SessionWatch(SessionCore):
 
     def _watch_joystick(self, now: float) -> None:
         change = self._joy.update(self.cmd.connected, now)
+        why: str | None = getattr(self.sticks, "gone", lambda: None)() if change is Change.LOST else None
+        if why is not None:
+            self._note(Level.WARN, why)
         if change is Change.LOST and self.phase is Phase.FLYING:
             self._hold_for_joystick()
         elif change is Change.LOST and self.phase is Phase.LANDING:

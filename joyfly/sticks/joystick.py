@@ -7,13 +7,14 @@
     writer connects and after it closes, `connected=False`; a new writer is picked up again;
   - a pseudo-terminal carrying js_event records (e.g. `socat` forwarding a remote joystick), read like a device;
   - a recording written by `--record` (its first line says so): replayed, as `replay:FILE` does;
-  - `raw:FILE`: a file of js_event records the user vouches for (e.g. `cat /dev/input/js0 > FILE`), read like
-    `tail -f` (events appended later are picked up); raw: also takes a character device that is no joystick;
-  - `script:FILE` and `replay:FILE`: virtual joysticks, see joyfly/sticks/virtual.py.
-Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (a text file, a
-binary: joyfly cannot tell records from bytes that merely parse), a directory, a character device that answers
-neither the js ioctls nor is a pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer.
-For a FIFO or a file the counts grow as events arrive and the name is the path.
+  - `raw:FILE`: a capture (`cat /dev/input/js0 > FILE`), checked and played by joyfly/sticks/raw_capture.py; or a
+    character device that is no joystick, read as one; `script:FILE`, `replay:FILE`: joyfly/sticks/virtual.py.
+Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (without raw:
+joyfly takes no file for a joystick), a directory, a character device that answers neither the js ioctls nor is a
+pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer. What a FIFO, a pty or a device sends
+is checked record by record (js_events.JsStreamCheck): the first one joydev never writes stops the reading for good
+(`gone`: before take-off the session ends with that sentence; in flight it is a lost joystick). For a FIFO the counts
+grow as events arrive and the name is the path.
 """
 
 from __future__ import annotations
@@ -38,13 +39,16 @@ from joyfly.sticks.js_events import (
     JoystickError,
     JsEvent,
     JsStateTracker,
+    JsStreamCheck,
     NoDeviceError,
     PermissionDeniedError,
+    not_js_events_error,
     pack_event,
     parse_events,
     permission_error,
     vanished_error,
 )
+from joyfly.sticks.raw_capture import RawCapture
 from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
 from px4common.clock import WallClock
@@ -63,8 +67,8 @@ _IOC_READ = 2
 _JS_MAGIC = ord("j")
 NAME_LEN = 128
 REOPEN_INTERVAL_S = 0.5
-# A joystick's kernel queue holds 64 events, one read; a source that never runs dry (raw:/dev/zero, a file still
-# growing fast) is read at most this many times per poll, so the session loop, its timeouts and Ctrl-C keep running.
+# A joystick's kernel queue holds 64 events, one read; a source that never runs dry (a pty flooded with records) is
+# read at most this many times per poll, so the session loop, its timeouts and Ctrl-C keep running.
 MAX_READS_PER_POLL = 16
 
 
@@ -82,10 +86,8 @@ def no_such_device_error(path: str, dev_dir: str = "/dev/input") -> JoystickErro
     others = [p for p in find_device_paths(dev_dir) if p != path]
     if others:
         return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
-    return NoDeviceError(
-        f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a virtual one with "
-        "--joy script:examples/joystick_script.txt."
-    )
+    return NoDeviceError(f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a "
+                         "virtual one with --joy script:examples/joystick_script.txt.")
 
 
 # ---------------------------------------------------------------------------------------------------------- device
@@ -141,13 +143,13 @@ def _is_joystick_or_pty(fd: int) -> bool:
 
 def refusal(fd: int, path: str, raw: bool = False) -> str | None:
     """Why the open file `fd` cannot be a joystick (one sentence), or None when it can; `raw` (the `raw:` spec) takes
-    the user's word for a regular file or a character device."""
+    the user's word for a character device (a regular file under raw: is a capture: joyfly/sticks/raw_capture.py)."""
     kind = _kind_of(fd)
     if kind == "directory":
         return f"{path} is a directory, not a joystick: pass {JOYSTICKS}."
     if kind == "other":
         return f"{path} is neither a joystick device nor a FIFO: pass {JOYSTICKS}."
-    if raw or kind == "fifo" or (kind == "device" and _is_joystick_or_pty(fd)):
+    if kind == "fifo" or (kind == "device" and (raw or _is_joystick_or_pty(fd))):
         return None
     if kind == "file":
         return (f"{path} is a regular file but not a joyfly recording (--record), so it is not read as a joystick: "
@@ -213,19 +215,19 @@ def list_devices(dev_dir: str = "/dev/input") -> list[DeviceInfo | JoystickError
 
 
 class JsDevice:
-    """A js device, a FIFO, a pty or (raw) a regular file of js_event records, read without ever blocking longer than
-    asked. Refuses at open what cannot be a joystick (see `refusal`), and again on every reopen."""
+    """A js device, a FIFO or a pty (or, with raw:, another character device) of js_event records, read without ever
+    blocking longer than asked. Refuses at open what cannot be a joystick (see `refusal`), and again on every reopen;
+    stops for good at the first record that is not a js_event (`gone`)."""
 
     def __init__(self, path: str, clock: Clock, dev_dir: str = "/dev/input", raw: bool = False) -> None:
-        self.path = path
-        self.clock = clock
-        self.dev_dir = dev_dir
-        self.raw = raw
+        self.path, self.clock, self.dev_dir, self.raw = path, clock, dev_dir, raw
+        self.refused: JoystickError | None = None  # what it sent is not js_event records: not read again
         self._fd: int | None = open_source_fd(path, dev_dir, raw)
         self.info = probe_fd(self._fd, path)
         self.name = self.info.name
         self.kind = self.info.kind
         self._tracker = JsStateTracker(self.info.axes, self.info.buttons)
+        self._check = JsStreamCheck(self.info.axes, self.info.buttons)
         self._pending = b""
         # A FIFO is "connected" only while a writer is attached (we learn that from its first bytes).
         self.connected = self.kind != "fifo"
@@ -239,10 +241,6 @@ class JsDevice:
         deadline = self.clock.now() + max(0.0, timeout_s)
         if self._fd is None and not self._try_reopen():
             self.clock.sleep(max(0.0, deadline - self.clock.now()))
-            return self.state()
-        if self.kind == "file":
-            if not self._read_available():
-                self.clock.sleep(max(0.0, timeout_s))
             return self.state()
         self._wait_readable(max(0.0, timeout_s))
         self._read_available()
@@ -263,12 +261,18 @@ class JsDevice:
         info = probe_fd(self._fd, self.path)
         self.info, self.name = info, info.name
         self._tracker = JsStateTracker(info.axes, info.buttons)  # the kernel re-sends the state as INIT events
+        self._check = JsStreamCheck(info.axes, info.buttons)  # a new stream (a FIFO's new writer)
         self._pending = b""
         self.connected = self.kind != "fifo"
         if self.connected:
             self.last_error = None
             log.info("joystick %s is back", self.path)
         return True
+
+    @property
+    def gone(self) -> str | None:
+        """Why this source gives no sticks any more (it sent something other than js_event records), or None."""
+        return None if self.refused is None else str(self.refused)
 
     def close(self) -> None:
         self._close_fd()
@@ -315,12 +319,20 @@ class JsDevice:
             self.last_error = None
             log.info("writer attached to FIFO %s", self.path)
         for ev in events:
+            why = self._check.check(ev)
+            if why is not None:
+                self._refuse(why)
+                return False
             self._tracker.apply(ev)
         return bool(events)
 
+    def _refuse(self, why: str) -> None:
+        self.refused = self.last_error = not_js_events_error(self.path, self._check.records, why)
+        log.warning("%s", self.refused)
+        self._close_fd()
+        self.connected = False
+
     def _at_eof(self) -> None:
-        if self.kind == "file":
-            return  # like tail -f: more records may be appended later
         if self.kind == "fifo":
             # The writer closed. Reopen at once so select() blocks again (a FIFO whose writer left stays readable at
             # EOF forever) and a new writer is picked up.
@@ -340,7 +352,7 @@ class JsDevice:
         self._next_reopen_s = self.clock.now() + REOPEN_INTERVAL_S
 
     def _try_reopen(self) -> bool:
-        if self.clock.now() < self._next_reopen_s:
+        if self.refused is not None or self.clock.now() < self._next_reopen_s:
             return False
         self._next_reopen_s = self.clock.now() + REOPEN_INTERVAL_S
         return self.reopen()
@@ -372,7 +384,8 @@ def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/in
     if spec.startswith("replay:"):
         return ReplaySource.from_file(spec[len("replay:") :], clock)
     if spec.startswith(RAW_PREFIX):
-        return JsDevice(spec[len(RAW_PREFIX) :], clock, dev_dir, raw=True)
+        path = spec[len(RAW_PREFIX) :]
+        return RawCapture.from_file(path, clock) if os.path.isfile(path) else JsDevice(path, clock, dev_dir, raw=True)
     if is_recording(spec):
         return ReplaySource.from_file(spec, clock)
     return JsDevice(spec, clock, dev_dir)

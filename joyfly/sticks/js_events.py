@@ -3,7 +3,8 @@ records (include/uapi/linux/joystick.h), the state they build, and the joystick 
 
 Axes run -32767..32767 (up on a stick is negative), buttons 1/0. On open, and again after the kernel's 64-event queue
 overflows, the driver re-sends the whole state as events flagged JS_EVENT_INIT (buttons first, then axes).
-No I/O here: joyfly/sticks/joystick.py reads devices, joyfly/sticks/virtual.py plays scripts and recordings.
+`JsStreamCheck` tells js_event records from bytes that merely come in 8-byte pieces (drivers/input/joydev.c is what
+writes real ones). No I/O here: joyfly/sticks/joystick.py reads devices, joyfly/sticks/raw_capture.py captures.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ JS_EVENT_INIT = 0x80
 EVENT_FORMAT = "IhBB"
 EVENT_SIZE = struct.calcsize(EVENT_FORMAT)  # 8
 AXIS_MAX = 32767
+ABS_CNT = 64  # the input layer's absolute axes (include/uapi/linux/input-event-codes.h): joydev numbers fewer
+TIME_WRAP_MS = 1 << 32  # time_ms is the kernel's jiffies in ms, a u32 that wraps (5 minutes after boot, first)
 
 
 class JoystickError(Exception):
@@ -46,6 +49,13 @@ def permission_error(path: str) -> JoystickError:
 
 def vanished_error(path: str) -> JoystickError:
     return DeviceVanishedError(f"The joystick {path} vanished (unplugged?): plug it back in and joyfly reopens it.")
+
+
+def not_js_events_error(path: str, record: int, why: str) -> JoystickError:
+    """A FIFO, a pty or a device that sent a record joydev never writes (`why`: JsStreamCheck's words)."""
+    return JoystickError(f"{path} sends something other than js_event records (record {record} has {why}): joyfly "
+                         "stopped reading it; give --joy a joystick device, or a FIFO fed a joystick's records "
+                         "(`cat /dev/input/js0 > FIFO`).")
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,3 +104,45 @@ def _set_grow(values: list[int], index: int, value: int) -> None:
     if index >= len(values):
         values.extend([0] * (index + 1 - len(values)))
     values[index] = value
+
+
+class JsStreamCheck:
+    """Whether records are what joydev writes, one record at a time: `check(ev)` returns None, or why not (words to
+    follow "record N has ..."). What joydev never writes:
+    - a type other than JS_EVENT_BUTTON or JS_EVENT_AXIS, each optionally with JS_EVENT_INIT;
+    - a button value other than 0 or 1 (joydev_event passes EV_KEY 0/1 and drops autorepeat's 2);
+    - a number at or beyond the count of its kind: the count the device declares (JSIOCGAXES/JSIOCGBUTTONS, given
+      here), else the count the leading INIT events declare (joydev sends one per axis and per button on open), else
+      ABS_CNT for an axis;
+    - a time before the previous record's (modulo the u32 wrap).
+    """
+
+    def __init__(self, axes: int = 0, buttons: int = 0) -> None:
+        self.declared = {JS_EVENT_AXIS: axes, JS_EVENT_BUTTON: buttons}  # 0: not declared (yet)
+        self._leading = not (axes or buttons)  # the INIT events at the start declare the counts
+        self._prev_ms: int | None = None
+        self.records = 0  # checked so far, the last one included
+
+    def check(self, ev: JsEvent) -> str | None:
+        self.records += 1
+        kind = ev.type & ~JS_EVENT_INIT
+        if kind not in (JS_EVENT_AXIS, JS_EVENT_BUTTON):
+            return (f"type 0x{ev.type:02x}, where a js_event has 0x01 (button) or 0x02 (axis), plus 0x80 for the "
+                    "initial state")
+        if kind == JS_EVENT_BUTTON and ev.value not in (0, 1):
+            return f"button {ev.number} at {ev.value}, where a button is 0 or 1"
+        if self._prev_ms is not None and (ev.time_ms - self._prev_ms) % TIME_WRAP_MS >= TIME_WRAP_MS // 2:
+            return f"time {ev.time_ms} ms, before the {self._prev_ms} ms of the record before it"
+        self._prev_ms = ev.time_ms
+        return self._check_number(kind, ev)
+
+    def _check_number(self, kind: int, ev: JsEvent) -> str | None:
+        word, words = ("axis", "axes") if kind == JS_EVENT_AXIS else ("button", "buttons")
+        if self._leading and ev.type & JS_EVENT_INIT:
+            self.declared[kind] = max(self.declared[kind], ev.number + 1)
+            return None if kind == JS_EVENT_BUTTON or ev.number < ABS_CNT else f"axis {ev.number}, beyond {ABS_CNT}"
+        self._leading = False
+        count = self.declared[kind] or (ABS_CNT if kind == JS_EVENT_AXIS else 0)
+        if count and ev.number >= count:
+            return f"{word} {ev.number}, where the joystick has {count} {word if count == 1 else words}"
+        return None

@@ -197,6 +197,15 @@ class MappedSource:
         state = self.last_state
         return [] if state is None or not state.axes else rest_problems(self.profile, state)
 
+    def gone(self) -> str | None:
+        """Why the joystick gives no sticks any more, for good (a stream of something other than js_events, a raw
+        capture that ended: their `gone`), or None."""
+        inner: Any = self.source
+        while hasattr(inner, "source"):  # through a --record RecordingSource
+            inner = inner.source
+        why = getattr(inner, "gone", None)
+        return why if isinstance(why, str) else None
+
     def close(self) -> None:
         self.source.close()
 

@@ -75,6 +75,11 @@ class TimedSource:
         self._current = JoyState(time_s=clock.now(), axes=(), buttons=(), connected=True)
 
     @property
+    def steps(self) -> tuple[Step, ...]:
+        """Everything it will play, in order."""
+        return tuple(self._steps)
+
+    @property
     def ended(self) -> bool:
         return self._next >= len(self._steps) and not self._current.connected
 

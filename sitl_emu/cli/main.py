@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import signal
 import sys
 import time
 from pathlib import Path
@@ -25,6 +24,7 @@ from sitl_emu.cli.options import (
     PORT_MAX,
     SEED_MAX,
     TOOL,
+    VERSION_MESSAGE,
     UsageProblem,
     check_host,
     check_instances,
@@ -32,12 +32,13 @@ from sitl_emu.cli.options import (
     parse_address,
     parse_home,
 )
+from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
 from sitl_emu.console.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
 from sitl_emu.mavlink.link_errors import PortInUseError
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
-from sitl_emu.runtime.runner import RealTimeRunner, stop_on_signals
+from sitl_emu.runtime.runner import RealTimeRunner
 from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
 if TYPE_CHECKING:  # imported where used, so that `--help` stays quick
@@ -176,13 +177,16 @@ def _wind_option(text: str | None) -> WindSettings | None:
         raise UsageProblem(f"--wind: {err}") from None
 
 
-@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
-@click.version_option(package_name="joyfly", prog_name=TOOL, message="%(prog)s %(version)s (the joyfly package)")
+@click.group(name=TOOL, cls=OneLineGroup, version_message=VERSION_MESSAGE, context_settings=CONTEXT)
+@click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
-def main(verbose: int) -> None:
+@click.pass_context
+def main(ctx: click.Context, verbose: int) -> None:
     """A PX4-protocol quadrotor emulator speaking MAVLink over UDP."""
     level = logging.WARNING - 10 * min(verbose, 2)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    if ctx.invoked_subcommand != "serve":
+        EARLY.release()  # serve owns SIGINT and SIGTERM (sitl_emu/cli/signals.py); the others, as inherited
 
 
 @main.command(short_help="Run emulated PX4 quadrotors on UDP.")
@@ -227,10 +231,11 @@ def main(verbose: int) -> None:
                    "ground stations' log download.")
 @click.option("--no-log", is_flag=True, help="Write no flight logs.")
 @view_options
+@owning_signals  # SIGINT and SIGTERM end serve from its first line, whatever its phase (sitl_emu/cli/signals.py)
 def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str, instance: int, speed: float,
           count: int, batch_ms: float, home: str | None, assignments: tuple[str, ...], params_file: Path | None,
           params_reset: bool, seed: int, no_console: bool, wind_text: str | None, log_dir: Path, no_log: bool,
-          **view: Any) -> None:
+          signals: ShutdownSignals, **view: Any) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
         _check_view(view)
@@ -242,6 +247,9 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
         check_own_ports([settings.for_instance(i) for i in range(instance, instance + count)])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
+        if signals.received:  # SIGINT or SIGTERM during the imports or the checks: no port is opened
+            _say_exiting()
+            return
         stores: list[ParamStore] = []
         vehicles: list[Vehicle] = []
 
@@ -266,14 +274,15 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
+    signals.stop_with(runner.stop)  # a signal from now on (or one already received) stops the loop, or never starts it
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
-    live = _start_view(vehicles, nodes, view, runner)
-    console = attach_console(vehicles, runner, not no_console)
+    live = None if runner.stopped else _start_view(vehicles, nodes, view, runner)
+    console = None if runner.stopped else attach_console(vehicles, runner, not no_console)
     try:
-        _run_until_signalled(runner, console)
+        _run_until_signalled(runner, console, signals)
     finally:
         if live is not None:
             live.close()
@@ -336,20 +345,20 @@ def _save_all(stores: list[ParamStore]) -> None:
                 click.echo(f"{TOOL}: cannot save the parameters to {store.path}: {err.strerror}.", err=True)
 
 
-def _run_until_signalled(runner: RealTimeRunner, console: Console | None) -> None:
+def _run_until_signalled(runner: RealTimeRunner, console: Console | None, signals: ShutdownSignals) -> None:
     """Run until `shutdown`, SIGTERM or Ctrl-C; on a signal print PX4's "PX4 Exiting..." (main.cpp sig_int_handler,
     with its leading newline that ends the prompt line)."""
-    with stop_on_signals(runner) as received:
-        try:
-            runner.run()
-        except KeyboardInterrupt:  # Ctrl-C before the handler was in place
-            received.append(signal.SIGINT)
+    runner.run()
     if console is not None:
         console.stop()
-    if received:
-        with contextlib.suppress(OSError, ValueError):  # stdout already gone: nothing to tell
-            click.echo(f"\n{SHUTDOWN_LINE}")
-            sys.stdout.flush()
+    if signals.received:
+        _say_exiting()
+
+
+def _say_exiting() -> None:
+    with contextlib.suppress(OSError, ValueError):  # stdout already gone: nothing to tell
+        click.echo(f"\n{SHUTDOWN_LINE}")
+        sys.stdout.flush()
 
 
 main.add_command(campaign)  # sitl_emu/campaign/cli.py (issue 16)

@@ -18,6 +18,7 @@ TOOL = "sitl-emu"
 PORT_MAX = 65535
 SEED_MAX = 2**32 - 1  # numpy takes any non-negative integer; 32 bits are plenty
 MAX_SYSID = 251  # --instance 250 is the last: system id 251
+VERSION_MESSAGE = "%(prog)s %(version)s (the joyfly package)"  # what --version prints, on the tool and its commands
 
 
 class UsageProblem(Exception):

@@ -205,7 +205,10 @@ class Commander:
         return self._checks_pass
 
     def system_status(self) -> MavState:
-        """HEARTBEAT.system_status (HEARTBEAT.hpp)."""
+        """HEARTBEAT.system_status as PX4's src/modules/mavlink/streams/HEARTBEAT.hpp sets it: armed, ACTIVE (CRITICAL
+        in a failsafe); disarmed, STANDBY only while the arming checks pass in the current mode, else UNINIT. So a
+        vehicle left in OFFBOARD after an OFFBOARD flight says UNINIT until it gets setpoints or another mode, as
+        recorded from PX4 SITL (shared reference px4-recorded-facts.md, section 5)."""
         if self.nav_state is NavState.TERMINATION and self.armed:
             return MavState.FLIGHT_TERMINATION
         if self.armed:

@@ -163,7 +163,11 @@ class Shell:
             return 0, log_line("ERROR", "commander", f"argument {args[0]} unsupported.")
         main, sub = main_sub(nav_state)
         # base_mode 1 = custom; PX4 passes NaN as sub mode for non-AUTO modes, read as 0 by the (uint8) cast.
-        self._send(MavCmd.DO_SET_MODE, 1.0, float(main), float(sub))
+        ack = self._send(MavCmd.DO_SET_MODE, 1.0, float(main), float(sub))
+        if ack is not None and ack.result == MavResult.TEMPORARILY_REJECTED:
+            # PX4 says printRejectMode's text only to a ground station (source component 190, reference 3.3), so
+            # its console stays silent; ours says it, so that a refusal is never silent here either.
+            return 0, log_line("ERROR", "commander", f"Switching to {UI_NAMES[nav_state]} is currently not available")
         return 0, ""
 
     def _status(self) -> str:

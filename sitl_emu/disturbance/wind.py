@@ -89,9 +89,9 @@ def parse_wind(text: str) -> WindSettings:
         speed, from_deg = float(parts[0]), float(parts[1])
     except ValueError:
         raise ValueError(f"wind {text!r}: SPEED and FROM_DEG must be numbers, e.g. 5@270") from None
-    if not (math.isfinite(speed) and math.isfinite(from_deg)) or not 0.0 <= speed <= MAX_WIND_M_S:
+    if not (math.isfinite(speed) and 0.0 <= speed <= MAX_WIND_M_S):
         raise ValueError(f"wind {text!r}: the speed is 0 to {MAX_WIND_M_S:g} m/s (PX4's SIH_WIND_N/E range)")
-    if not -360.0 <= from_deg <= 360.0:
+    if not (math.isfinite(from_deg) and -360.0 <= from_deg <= 360.0):
         raise ValueError(f"wind {text!r}: the direction it blows from is in degrees, -360 to 360")
     return WindSettings(speed, from_deg % 360.0, turbulence_w20(parts[2]) if len(parts) == 3 else 0.0)
 

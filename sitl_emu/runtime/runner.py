@@ -16,12 +16,9 @@ from __future__ import annotations
 import logging
 import select
 import selectors
-import signal
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
-from types import FrameType
+from collections.abc import Callable, Sequence
 
 from sitl_emu.runtime.node import READ_API, READ_GCS, VehicleNode
 from sitl_emu.runtime.timeline import Timeline
@@ -166,26 +163,3 @@ class RealTimeRunner:
     def _warn_lag(self, lag_us: int) -> None:
         if self.dropped_us == 0:
             log.warning("cannot keep up with --speed %g: simulated time falls behind the wall clock", self.speed)
-
-
-@contextmanager
-def stop_on_signals(runner: RealTimeRunner) -> Iterator[list[int]]:
-    """While inside, SIGINT (Ctrl-C) and SIGTERM stop `runner` after its current iteration; yields the list of the
-    signals received.
-
-    PX4 SITL treats both alike (platforms/posix/src/px4/common/main.cpp register_sig_handler: SIGINT and SIGTERM go
-    to sig_int_handler, which prints "PX4 Exiting..." and asks everything to stop). Stopping the loop, rather than
-    letting KeyboardInterrupt fly through whatever the vehicle was computing, lets the caller shut down in order.
-    """
-    received: list[int] = []
-
-    def on_signal(signum: int, frame: FrameType | None) -> None:
-        received.append(signum)
-        runner.stop()
-
-    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield received
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)

@@ -111,6 +111,7 @@ def test_bad_values_in_a_params_file_name_the_file_and_line(tmp_path: Path, monk
     (("--url", "/dev/ttyUSB0:12"), "the baud rate 12 is out of range; use 50 to 4000000"),
     (("--url", "carrier-pigeon"), "use udp://:14540@127.0.0.1:14557 (MAVROS style)"),
     (("--alt", "50"), "--alt 50 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),
+    (("--alt", "-3"), "--alt -3 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),  # one range
     (("--alt", "nan"), "--alt nan is not a number"),
     (("--alt", "high"), "'--alt': 'high' is not a valid float"),
     (("--speed", "50000"), "--speed 50000 is out of range: use 0.1 to 100 times real time"),

@@ -53,10 +53,11 @@ def test_group_help_lists_whole_summaries(tool: str, path: tuple[str, ...]) -> N
         assert "..." not in commands, commands
 
 
-@pytest.mark.parametrize("tool", TOOLS)
-def test_version_comes_from_the_package_metadata(tool: str) -> None:
-    result = invoke(tool, "--version")
-    assert result.exit_code == 0
+@pytest.mark.parametrize(("tool", "path"), ALL, ids=[" ".join((t, *p)) for t, p in ALL])
+def test_version_on_every_command_comes_from_the_package_metadata(tool: str, path: tuple[str, ...]) -> None:
+    result = invoke(tool, *path, "--version")
+    assert result.exit_code == 0, result.output
+    assert result.output == invoke(tool, "--version").output
     assert result.output.startswith(f"{tool} {version('joyfly')}")
 
 

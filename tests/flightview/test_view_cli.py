@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 from click.testing import CliRunner
+from support import REPO_ROOT
 from support.view_process import listening_sockets, require_rerun, view_process, wait_until
 
 from joyfly.cli import main as joyfly_main
@@ -40,7 +41,8 @@ def test_view_without_the_extra_says_how_to_install_it(main: Any, args: list[str
     assert code == 2
     lines = output.strip().splitlines()
     assert len(lines) == 1, output
-    assert "pip install 'joyfly[view]'" in lines[0]
+    # README's and -h's `pip install -e '.[view]'`, with this Python and this clone, so it works as printed
+    assert lines[0].endswith(f"is not installed: {sys.executable} -m pip install -e '{REPO_ROOT}[view]'"), lines[0]
     assert not list(tmp_path.glob("*.params"))  # nothing started
 
 
@@ -103,3 +105,43 @@ def _entities(record: Path) -> set[str]:
     printed = subprocess.run([rerun_program(), "rrd", "print", str(record)], capture_output=True, text=True,
                              timeout=60, check=True).stdout
     return {word.rstrip(":,") for word in printed.split() if word.startswith(("/world/", "/plots/"))}
+
+
+def test_both_view_ports_can_be_set(tmp_path: Path) -> None:
+    """--view-port sets the page's port, --view-grpc-port the data stream's (Rerun's gRPC proxy) that the page reads."""
+    require_rerun()
+    web, grpc = _free_tcp_ports(2)
+    args = ["sitl_emu", *SERVE, "--view-port", str(web), "--view-grpc-port", str(grpc)]
+    with view_process(args, tmp_path) as view:
+        assert {web, grpc} <= {s.laddr.port for s in listening_sockets(view.proc.pid)}
+        assert view.url.startswith(f"http://127.0.0.1:{web}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{grpc}%2Fproxy")
+
+
+@pytest.mark.parametrize("same", [False, True])
+def test_a_grpc_port_in_use_or_shared_with_the_page_is_one_sentence(same: bool, tmp_path: Path,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    require_rerun()
+    monkeypatch.chdir(tmp_path)
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        web = port if same else _free_tcp_ports(1)[0]
+        code, output = run(joyfly_main, ["demo", "--view-port", str(web), "--view-grpc-port", str(port)], tmp_path)
+    assert code == 2
+    assert output.strip().splitlines() == [output.strip()]
+    if same:
+        assert f"--view-port and --view-grpc-port are both {port}" in output
+    else:
+        assert f"Port {port} on 127.0.0.1 is in use" in output and "--view-grpc-port" in output
+
+
+def _free_tcp_ports(n: int) -> list[int]:
+    socks = [socket.socket() for _ in range(n)]
+    try:
+        for sock in socks:
+            sock.bind(("127.0.0.1", 0))
+        return [int(sock.getsockname()[1]) for sock in socks]
+    finally:
+        for sock in socks:
+            sock.close()

@@ -10,7 +10,9 @@ import subprocess
 import sys
 
 import pytest
+from support import REPO_ROOT
 
+from flightview.server import install_hint
 from joyfly.demo import DemoError, EmbeddedVehicle, run_demo
 
 SPEED = 10.0  # the built-in emulator: joyfly reads its simulated clock, so timeouts stay in step when slow
@@ -83,12 +85,15 @@ def test_demo_wind_reaches_the_built_in_emulator() -> None:
     try:
         assert vehicle.node.vehicle.faults.wind is not None
     finally:
-        vehicle.node.close()
+        vehicle.close()
 
 
 @pytest.mark.parametrize(("kwargs", "said"), [
     ({"wind": "5@999"}, "--wind: wind '5@999': the direction it blows from is in degrees, -360 to 360"),
     ({"wind": "5@270", "url": "udp://127.0.0.1:14540@127.0.0.1:14557"}, "--wind blows on the built-in emulator only"),
+    ({"gcs_remote": "127.0.0.1:14550", "url": "udp://127.0.0.1:14540@127.0.0.1:14557"},
+     "--gcs-remote sets the built-in emulator's ground-station link only"),
+    ({"gcs_remote": "127.0.0.1:99999"}, "--gcs-remote"),
 ])
 def test_demo_refuses_bad_wind_in_one_sentence(kwargs: dict[str, str], said: str) -> None:
     with pytest.raises(DemoError, match="^" + re.escape(said)):
@@ -99,3 +104,33 @@ def test_demo_cli_bad_wind_exits_2() -> None:
     proc = subprocess.run([sys.executable, "-m", "joyfly", "demo", "--wind", "north"], stdin=subprocess.DEVNULL,
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and "--wind" in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+
+
+def test_the_demo_sends_no_ground_station_telemetry_to_14550_unless_asked() -> None:
+    """A QGroundControl on this machine (UDP 14550) sees nothing of the demo by default: the ground-station link
+    sends to a socket of the demo's own until a ground station talks to its port."""
+    vehicle = EmbeddedVehicle(0, 1.0)
+    try:
+        assert vehicle.node.gcs.link.remote != ("127.0.0.1", 14550)
+        assert vehicle.gcs_remote is None
+        assert vehicle.describe_gcs().startswith(f"ground-station link on UDP {vehicle.gcs_port}, sending nowhere")
+    finally:
+        vehicle.close()
+
+
+def test_gcs_remote_sends_the_telemetry_there_and_the_demo_says_how_to_get_the_view(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "rerun", None)  # as without the view extra, which the demo does not need
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as gcs:
+        gcs.bind(("127.0.0.1", 0))
+        gcs.settimeout(30)
+        port = gcs.getsockname()[1]
+        out = io.StringIO()
+        assert run_demo(speed=SPEED, live=False, out=out, gcs_remote=f"127.0.0.1:{port}") == 0, out.getvalue()
+        data = gcs.recv(65535)
+    assert data[:1] == b"\xfd"  # MAVLink 2 from the ground-station link
+    lines = out.getvalue().splitlines()
+    assert lines[1].startswith("joyfly demo: ground-station link on UDP ")
+    assert lines[1].endswith(f"sending to 127.0.0.1:{port}")
+    assert lines[2] == f"joyfly demo: to see the flight in 3D in a browser, {install_hint()} and add --view"
+    assert install_hint() == f"{sys.executable} -m pip install -e '{REPO_ROOT}[view]'"  # README's, from this clone

@@ -372,11 +372,13 @@ def test_ctrl_c_while_the_arm_command_is_on_its_way_does_not_leave_the_vehicle_a
     while not world.vehicle.received("CMD400") and world.clock.now() < 5.0:
         world.session.run_once()
     assert world.session.phase is Phase.ARMING and not world.session.link.state.armed
+    asked_s = world.clock.now()
     world.session.request_exit()  # the ARM is accepted a moment later; the HEARTBEAT shows it up to 1 s after
     world.run_until(20.0)
-    assert world.session.phase is Phase.DONE
-    assert "Exiting: land" in world.notes() and world.vehicle.received("CMD21")
-    assert not world.vehicle.armed
+    assert world.session.phase is Phase.DONE and not world.vehicle.armed
+    # on the ground the exit disarms (issue 25.6): ARM_DISARM 0 after the ARM, and no LAND
+    assert "Exiting: disarming on the ground" in world.notes() and not world.vehicle.received("CMD21")
+    assert [round(m.param1) for t, m in world.vehicle.received("CMD400") if t >= asked_s][-1] == 0
 
 
 def test_a_vehicle_restarted_before_joyfly_connected_is_simply_flown() -> None:

@@ -71,9 +71,9 @@ class Run:
     armed: bool
 
 
-def start(vehicle: Vehicle, spec: str) -> subprocess.Popen[str]:
+def start(vehicle: Vehicle, spec: str, *extra: str) -> subprocess.Popen[str]:
     return subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", spec, "--url", vehicle.url,
-                             "--speed", str(SPEED), "--connect-timeout", "60"], cwd=ROOT,
+                             "--speed", str(SPEED), "--connect-timeout", "60", *extra], cwd=ROOT,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -134,10 +134,12 @@ def test_dev_null_fails_at_once(vehicle: Vehicle) -> None:
     assert_refused(fly(vehicle, "/dev/null"), vehicle, "/dev/null", "not a joystick")
 
 
-def _at_rest_events() -> bytes:
-    """What the kernel sends on open for the script profile's layout (7 buttons up, 4 axes centred)."""
+def _at_rest_events(span_s: float = 60.0) -> bytes:
+    """A capture of the script profile's layout at rest for span_s: what the kernel sends on open (7 buttons up,
+    4 axes centred), then axis 0 reported centred every 0.5 s (a capture lasts until its last record)."""
+    moves = [pack_event(JS_EVENT_AXIS, 0, 0, time_ms=500 * k) for k in range(1, int(span_s * 2) + 1)]
     return b"".join([pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, i, 0) for i in range(7)]
-                    + [pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, i, 0) for i in range(4)])
+                    + [pack_event(JS_EVENT_AXIS | JS_EVENT_INIT, i, 0) for i in range(4)] + moves)
 
 
 def _recording(path: Path) -> None:
@@ -161,6 +163,53 @@ def test_a_raw_stream_named_as_such_and_a_recording_do_fly(vehicle: Vehicle, tmp
     assert "Traceback" not in run.stderr
     name = str(path) if kind == "raw" else "joyfly script"  # raw records: the path; a recording: its device's name
     assert f"joystick {name} ({path})" in run.stdout, run.stdout
+
+
+def test_random_bytes_as_a_raw_capture_never_arm_the_vehicle(vehicle: Vehicle, tmp_path: Path) -> None:
+    """Issue 25.1: 4 kB of random bytes given as raw:FILE armed, took off and hovered for minutes; the records are
+    now checked at open, so joyfly refuses the file in one sentence before it sends any MAVLink."""
+    blob = tmp_path / "rand.bin"
+    blob.write_bytes(random.Random(25).randbytes(4096))
+    assert_refused(fly(vehicle, f"raw:{blob}"), vehicle, f"raw:{blob} is not a joystick capture", "record 1")
+
+
+def test_random_bytes_through_a_fifo_never_arm_the_vehicle(vehicle: Vehicle, tmp_path: Path) -> None:
+    """A FIFO is checked record by record as it arrives: bytes that are no js_events end joyfly before it arms."""
+    fifo = tmp_path / "js0"
+    os.mkfifo(fifo)
+    proc = start(vehicle, str(fifo))
+    writer = os.open(fifo, os.O_WRONLY)  # blocks until joyfly opened its end
+    try:
+        os.write(writer, random.Random(7).randbytes(4096))
+        stdout, stderr = proc.communicate(timeout=60.0)
+    finally:
+        os.close(writer)
+        proc.kill()
+    assert proc.returncode == 1 and not vehicle.armed, stdout + stderr
+    lines = stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"joyfly: {fifo} sends something other than js_event records")
+    assert "Armed" not in stdout
+
+
+def test_a_raw_capture_that_ends_in_flight_holds_then_lands(vehicle: Vehicle, tmp_path: Path) -> None:
+    """A capture's end is a joystick that went away: hold, then land after --joy-timeout; joyfly then ends."""
+    capture = tmp_path / "events.bin"
+    capture.write_bytes(_at_rest_events(span_s=25.0))
+    proc = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", f"raw:{capture}", "--url", vehicle.url,
+                             "--speed", str(SPEED), "--joy-timeout", "3"], cwd=ROOT, stdin=subprocess.DEVNULL,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    armed = False
+    end = time.monotonic() + 90.0
+    while proc.poll() is None and time.monotonic() < end:
+        armed |= vehicle.armed
+        time.sleep(0.05)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=30.0)
+    assert armed and proc.returncode == 0 and not vehicle.armed, stdout + stderr
+    assert "OFFBOARD: you have control" in stdout and "reached its end (its records span 25.0 s)" in stdout
+    assert "Joystick lost: holding position" in stdout and "Joystick still lost after 3 s: landing." in stdout
+    assert "Landed and disarmed" in stdout and "The joystick is gone" in stdout
 
 
 def test_a_fifo_still_waits_for_its_writer(vehicle: Vehicle, tmp_path: Path) -> None:
@@ -191,3 +240,67 @@ def test_the_example_script_flies_and_lands(vehicle: Vehicle) -> None:
     assert not any(f"{button} pressed" in out for button in ("ARM", "TAKEOFF", "OFFBOARD"))
     distance = next(line for line in out.splitlines() if line.startswith("distance flown"))
     assert float(distance.split()[2]) > 25.0  # climb, the square, the fence push and back
+
+
+def _fly_to_the_end(vehicle: Vehicle, spec: str, *extra: str, wall_s: float = 90.0) -> tuple[int | None, str, bool]:
+    """`joyfly fly` until it ends by itself (or wall_s: then Ctrl-C); (exit status, output, whether it ever armed)."""
+    proc = start(vehicle, spec, *extra)
+    armed = False
+    end = time.monotonic() + wall_s
+    while proc.poll() is None and time.monotonic() < end:
+        armed |= vehicle.armed
+        time.sleep(0.05)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    try:
+        stdout, stderr = proc.communicate(timeout=30.0)
+    finally:
+        proc.kill()
+    return proc.returncode, stdout + stderr, armed
+
+
+def test_the_position_mode_example_script_takes_off_flies_and_lands(vehicle: Vehicle) -> None:
+    """Issue 25.8: the README's script has no throttle in time, so in Position mode it never left the ground; the
+    example for Position mode takes off with the throttle, flies its square and lands, without a warning."""
+    status, out, armed = _fly_to_the_end(vehicle, "script:examples/joystick_script_position.txt",
+                                         "--control", "position")
+    assert status == 0 and armed and not vehicle.armed, out
+    assert "Takeoff detected" in out and "LAND pressed: landing" in out and "Landed and disarmed" in out, out
+    assert "not take off" not in out and "cannot take off" not in out  # no warning at the start
+    distance = next(line for line in out.splitlines() if line.startswith("distance flown"))
+    assert float(distance.split()[2]) > 8.0, out  # the climb and the square
+
+
+def test_position_mode_with_a_script_that_never_takes_off_in_time_warns_at_start(vehicle: Vehicle) -> None:
+    proc = start(vehicle, "script:examples/joystick_script.txt", "--control", "position")
+    assert proc.stdout is not None
+    first = [proc.stdout.readline() for _ in range(2)]
+    proc.send_signal(signal.SIGINT)
+    try:
+        stdout, stderr = proc.communicate(timeout=30.0)
+    finally:
+        proc.kill()
+    warning = first[1]
+    assert "examples/joystick_script.txt first pushes the throttle up at 20 s" in warning, [*first, stdout, stderr]
+    assert "will likely not take off" in warning and "examples/joystick_script_position.txt" in warning
+
+
+def test_a_second_joyfly_on_another_port_is_told_the_vehicle_is_busy(vehicle: Vehicle) -> None:
+    """Issue 25.9: the vehicle answers its first client only (PX4's API link); a second joyfly used to be told to
+    start a vehicle."""
+    first = start(vehicle, "script:examples/joystick_script.txt")
+    try:
+        end = time.monotonic() + 40.0
+        while not vehicle.armed and time.monotonic() < end:
+            time.sleep(0.05)
+        assert vehicle.armed
+        other = f"udp://127.0.0.1:{free_udp_port()}@{vehicle.url.rsplit('@', 1)[1]}"
+        second = subprocess.run([sys.executable, "-m", "joyfly", "fly", "--joy", "script:examples/joystick_script.txt",
+                                 "--url", other, "--speed", str(SPEED), "--connect-timeout", "4"], cwd=ROOT,
+                                stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=60)
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=60.0)
+    lines = second.stderr.splitlines()
+    assert second.returncode == 1 and len(lines) == 1, second.stdout + second.stderr
+    assert "the vehicle is probably busy with another client" in lines[0] and "sitl-emu serve`" not in lines[0]

@@ -44,6 +44,8 @@ def test_top_level_keys_work_without_a_fly_table(tmp_path: Path) -> None:
     ({"control": "rate"}, "--control rate is not a choice here: use one of velocity, step, position, altitude."),
     ({"min_alt": 5.0, "max_alt": 4.0}, "--min-alt 5 must be below --max-alt (4 m)"),
     ({"alt": 20.0}, "--alt 20 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),
+    ({"alt": -3.0}, "--alt -3 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),  # one range only
+    ({"alt": 2000.0}, "--alt 2000 is out of range: use 0.5 to 10 m (from --min-alt to --max-alt)"),
     ({"max_alt": 2.0}, "the default --alt 3 is out of range: use 0.5 to 2 m"),
     ({"fence": -1.0}, "--fence -1 is out of range: use 0 to 10000 m (0 turns the fence off)."),
     ({"max_speed": "fast"}, "--max-speed fast is not a number: write a number from 0.1 to 20 m/s"),

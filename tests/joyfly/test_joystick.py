@@ -101,31 +101,32 @@ def test_fifo_split_record_is_joined(tmp_path):
     src.close()
 
 
-def test_raw_file_is_read_and_followed(tmp_path):
+def test_raw_file_is_a_capture_played_with_its_own_timing(tmp_path):
+    """raw:FILE used to be read like `tail -f`, for ever: now its records play at their own times, then it is gone."""
     path = tmp_path / "events.bin"
-    path.write_bytes(init_burst([0, 0], [0, 0]) + pack_event(JS_EVENT_AXIS, 1, -20000))
+    path.write_bytes(init_burst([0, 0], [0, 0]) + pack_event(JS_EVENT_AXIS, 1, -20000, time_ms=500))
     clock = FakeClock()
     src = open_joystick(f"raw:{path}", clock)
     assert src.name == str(path) and src.path == str(path)
     state = src.poll(0.1)
-    assert state.axes == (0, -20000) and state.connected
-    with path.open("ab") as fh:
-        fh.write(pack_event(JS_EVENT_BUTTON, 3, 1))
-    state = src.poll(0.1)
-    assert state.buttons == (0, 0, 0, 1) and state.connected
-    before = clock.now()
-    src.poll(0.25)  # nothing new: waits the timeout (on the injected clock), still connected
-    assert clock.now() - before == pytest.approx(0.25)
+    assert state.axes == (0, 0) and state.connected
+    state = src.poll(1.0)  # waits for the record due at 0.5 s, which is the last: the capture ends with it
+    assert state.axes == (0, -20000) and not state.connected
+    assert clock.now() - 100.0 == pytest.approx(0.5)
     src.close()
 
 
-def test_a_source_that_never_runs_dry_is_read_a_bounded_amount_per_poll():
-    """raw:/dev/zero (or /dev/urandom) never reports "nothing more": each poll must still return, so the session's
-    timeouts and Ctrl-C keep working (it used to drain forever)."""
-    src = open_joystick("raw:/dev/zero", FakeClock())
+def test_a_stream_of_zeros_is_no_joystick_and_is_not_read_again():
+    """raw:/dev/zero (or /dev/urandom) never runs dry: its first record (type 0x00) is no js_event, so joyfly stops
+    reading it at once, and says why (it used to take the zeros for axis 0 at rest and fly on them)."""
+    clock = FakeClock()
+    src = open_joystick("raw:/dev/zero", clock)
     for _ in range(3):
-        src.poll(0.0)
-    assert src.state().connected
+        assert src.poll(0.1).connected is False
+    assert "/dev/zero sends something other than js_event records (record 1 has type 0x00" in str(src.gone)
+    assert src.fileno() is None
+    clock.sleep(5.0)
+    assert src.poll(0.1).connected is False  # never reopened
     src.close()
 
 

@@ -110,3 +110,19 @@ def test_a_lost_joystick_holds_then_lands_without_px4s_stick_loss_failsafe(sim: 
     f.run(60.0)
     assert f.session.phase is Phase.DONE and not sim.vehicle(0).snapshot().armed
     assert "Landing at current position" in f.notes() and "Failsafe" not in f.notes()
+
+
+def test_ctrl_c_armed_on_the_ground_disarms_at_once_instead_of_landing(sim: Sim) -> None:
+    """Issue 25.6: armed in Position mode, the throttle not yet pushed: Ctrl-C disarms as a pilot would; a LAND there
+    only waited for PX4's auto-disarm."""
+    f = fly(sim, [(0.0, CENTRE)])
+    f.run(5.0)
+    assert f.session.phase is Phase.FLYING and sim.vehicle(0).snapshot().armed, f.notes()
+    asked_s = sim.clock.now()
+    f.session.request_exit()
+    while sim.vehicle(0).snapshot().armed and sim.clock.now() < asked_s + 15.0:
+        f.session.run_once()
+    assert sim.clock.now() - asked_s < 1.0, f.notes()  # disarmed within a second (LAND took several)
+    f.run(asked_s + 3.0)
+    assert f.session.phase is Phase.DONE and "Exiting: disarming on the ground" in f.notes()
+    assert "Disarmed on the ground." in f.notes() and "Landing at current position" not in f.notes()

@@ -41,6 +41,17 @@ def test_command_runs_and_its_event_prints_as_console_line():
     assert "INFO  [commander] Armed by internal command\n" in out.getvalue()
 
 
+def test_a_text_that_names_its_module_prints_it_once():
+    """The flight logger's text is "[logger] ./log/...ulg" (its STATUSTEXT, as PX4's); the console line names the
+    module once, as PX4's console does."""
+    vehicle = FakeVehicle()
+    vehicle.report(Severity.INFO, "logger", "[logger] ./log/2026-01-02/03_04_05.ulg")
+    out = io.StringIO()
+    Console([vehicle], stream_in=io.StringIO(""), stream_out=out).pump()
+    assert out.getvalue().startswith("INFO  [logger] ./log/2026-01-02/03_04_05.ulg\n")
+    assert vehicle.events_after(-1)[-1].statustext_text == "[logger] ./log/2026-01-02/03_04_05.ulg\t"
+
+
 def test_boot_events_then_prompt():
     vehicle = FakeVehicle()
     vehicle.report(Severity.INFO, "commander", "Ready for takeoff!")

@@ -262,3 +262,21 @@ def test_mission_summary(vehicle):
     ]
     assert "mission" in shell.execute("help")
     assert shell.execute("mission clear").startswith("Usage: mission")
+
+
+@pytest.mark.parametrize(("word", "name"), [("offboard", "Offboard"), ("posctl", "Position")])
+def test_a_mode_refused_in_the_air_says_so(word: str, name: str):
+    """In the air without setpoints (OFFBOARD) or sticks (Position), PX4 refuses the mode; the console says it in
+    PX4's words (printRejectMode) instead of nothing."""
+    from sitl_emu.vehicle.vehicle import Vehicle
+
+    vehicle = Vehicle()
+    vehicle.run_until(3_000_000)  # ready to arm
+    shell = Shell(vehicle)
+    shell.execute("commander takeoff")
+    vehicle.run_until(12_000_000)
+    assert vehicle.snapshot().armed and vehicle.snapshot().nav_state == NavState.AUTO_LOITER
+    assert shell.execute(f"commander mode {word}") == (
+        f"ERROR [commander] Switching to {name} is currently not available\n")
+    assert vehicle.snapshot().nav_state == NavState.AUTO_LOITER
+    assert shell.execute("commander mode auto:rtl") == ""  # accepted: nothing to say

@@ -32,7 +32,7 @@ def require_rerun() -> None:
     try:
         import rerun  # noqa: F401
     except ImportError:
-        pytest.skip("rerun-sdk is not installed: pip install 'joyfly[view]' to run the view's tests.")
+        pytest.skip("rerun-sdk is not installed: pip install -e '.[view]' to run the view's tests.")
 
 
 @contextmanager

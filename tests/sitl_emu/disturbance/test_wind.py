@@ -105,6 +105,14 @@ def test_parse_wind_refuses(text: str):
         parse_wind(text)
 
 
+@pytest.mark.parametrize(("text", "blamed"), [("5@inf", "direction"), ("5@nan", "direction"), ("5@-inf", "direction"),
+                                              ("5@400", "direction"), ("inf@270", "speed"), ("nan@270", "speed"),
+                                              ("101@270", "speed")])
+def test_parse_wind_blames_the_field_that_is_wrong(text: str, blamed: str):
+    with pytest.raises(ValueError, match=f"wind '{text}': the {blamed} "):
+        parse_wind(text)
+
+
 def _hover(wind: WindSettings | None, seconds: float) -> Vehicle:
     v = Vehicle(wind=wind)
     v.run_for(2.5)
