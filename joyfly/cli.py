@@ -1,7 +1,8 @@
 """`joyfly fly`, `joyfly demo` and `joyfly joystick ...`: parse options, build the pieces, run, report.
 
 Errors a user can hit (no joystick, port in use, no vehicle, arming refused) end in one sentence and a non-zero exit
-status; Ctrl-C / SIGTERM perform --on-exit and exit 0; a second Ctrl-C quits at once.
+status; Ctrl-C / SIGTERM perform --on-exit and exit 0 (3 if the vehicle went outside the fence, 4 if a flight ended
+in the air: joyfly/run.py); a second Ctrl-C quits at once.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from joyfly.link.vehicle_link import VehicleLink
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
+from joyfly.session.fence_watch import FENCE_ACTIONS, FENCE_GRACE_S
 from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.joystick import JoystickError
@@ -86,6 +88,9 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 @_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick (OFFBOARD), deg/s.")
 @_opt("--fence", float, "Half-width of the square fence around this flight's home (where joyfly arms the vehicle), "
       "metres; 0 disables. In position/altitude control joyfly limits the sticks near it.")
+@_opt("--fence-action", click.Choice(list(FENCE_ACTIONS)), "When the vehicle is outside the fence (wind joyfly's "
+      f"setpoints cannot beat): joyfly warns at once and, if it stays outside {FENCE_GRACE_S:g} s, warn: only warns; "
+      "hold: PX4's Hold; rtl: PX4's Return; land: lands where it is. A breach makes the exit status 3.")
 @_opt("--min-alt", float, "Lowest altitude, metres above home.")
 @_opt("--max-alt", float, "Highest altitude, metres above home.")
 @_opt("--rate", float, "Stream rate, Hz: setpoints (OFFBOARD), or MANUAL_CONTROL (position, altitude).",

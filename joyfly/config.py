@@ -10,6 +10,7 @@ Command-line options win over the file, the file over the defaults::
     control = "velocity"      # or "step" (OFFBOARD), "position" or "altitude" (PX4's manual modes)
     max-speed = 3.0
     fence = 8.0
+    fence-action = "land"     # or "warn", "hold", "rtl"
     on-exit = "rtl"
 
     [profile]
@@ -27,6 +28,7 @@ from typing import Any
 
 from joyfly.link.transport import UrlError, parse_url
 from joyfly.session.core import SessionSettings
+from joyfly.session.fence_watch import FENCE_ACTIONS
 from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.profiles import read_config
@@ -55,6 +57,7 @@ class FlyOptions:
     max_speed: float = 5.0  # m/s horizontal
     max_yaw_rate: float = 45.0  # deg/s
     fence: float = 5.0  # m half-width of the square around home; 0 disables
+    fence_action: str = "land"  # when the vehicle stays outside the fence: warn | hold | rtl | land
     min_alt: float = 0.5  # m above home
     max_alt: float = 10.0  # m above home
     rate: float = 20.0  # Hz setpoint stream (OFFBOARD); --control position/altitude: MANUAL_RATE_HZ unless given
@@ -69,8 +72,8 @@ class FlyOptions:
                         max_climb_m_s=self.max_climb, max_yaw_rate_rad_s=math.radians(self.max_yaw_rate))
         return SessionSettings(alt_m=self.alt, rate_hz=self.rate, on_exit=self.on_exit,
                                joy_timeout_s=self.joy_timeout, connect_timeout_s=self.connect_timeout,
-                               fence_m=self.fence, min_alt_m=self.min_alt, max_alt_m=self.max_alt, limits=limits,
-                               **extra)
+                               fence_m=self.fence, fence_action=self.fence_action, min_alt_m=self.min_alt,
+                               max_alt_m=self.max_alt, limits=limits, **extra)
 
 
 OPTION_NAMES = tuple(f.name for f in fields(FlyOptions))
@@ -99,7 +102,7 @@ BOUNDS: dict[str, Bound] = {
     "connect_timeout": Bound(1.0, 3600.0, "s"),
     "speed": Bound(SPEED_MIN, SPEED_MAX, "times real time", " (the vehicle's sitl-emu serve --speed; 1 for PX4 SITL)"),
 }
-CHOICES: dict[str, tuple[str, ...]] = {"control": CONTROLS, "on_exit": ON_EXIT}
+CHOICES: dict[str, tuple[str, ...]] = {"control": CONTROLS, "on_exit": ON_EXIT, "fence_action": FENCE_ACTIONS}
 
 
 def load_file(path: str) -> tuple[dict[str, Any], dict[str, Any]]:

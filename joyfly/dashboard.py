@@ -9,6 +9,7 @@ import math
 from typing import TextIO
 
 from joyfly.session.core import FlightStats, Level, Note, Phase, SessionView
+from joyfly.session.fence_watch import FENCE_TOLERANCE_M
 from joyfly.term import LiveBlock
 from joyfly.types import StickCommand
 
@@ -29,10 +30,21 @@ def fmt_vec(v: tuple[float, float, float] | None) -> str:
     return "(   -   ,    -   ,    -   )" if v is None else f"({v[0]:+7.2f}, {v[1]:+7.2f}, {v[2]:+7.2f})"
 
 
-def fmt_margin(margin_m: float) -> str:
+def fmt_margin(margin_m: float | None, alert: str = "") -> str:
+    """The fence margin: "-" unknown (no home yet), "off", metres inside (+), on the fence, or OUTSIDE it (`alert`:
+    the breach under way, e.g. "BREACH: land in 3 s")."""
+    if margin_m is None:
+        return "-"
     if math.isinf(margin_m):
         return "off"
-    return f"{margin_m:+.2f} m" + ("  OUTSIDE" if margin_m < 0 else "")
+    mark = "" if margin_m >= 0 else "  on the fence" if margin_m >= -FENCE_TOLERANCE_M else "  OUTSIDE"
+    return f"{margin_m:+.2f} m{f'  {alert}' if alert and margin_m < 0 else mark}"
+
+
+def _margin(view: SessionView) -> float | None:
+    """The vehicle's fence margin now (None: no position, or no home for this flight yet)."""
+    pos = view.pos_ned_m
+    return view.fence.margin_m(pos) if pos is not None and view.home_known else None
 
 
 def stick_line(cmd: StickCommand) -> str:
@@ -58,7 +70,7 @@ def render(view: SessionView) -> list[str]:
     """The live block for one view snapshot."""
     link = "waiting" if _link_word(view) == "waiting" else _link_word(view).upper()
     pos = view.pos_ned_m
-    margin = view.fence.margin_m(pos) if pos is not None else math.inf
+    margin = _margin(view)
     stream = "streaming" if view.streaming else "not streaming"
     what = "setpoints" if view.control == "OFFBOARD" else "MANUAL_CONTROL"
     joy = "ok" if view.joystick_ok else "LOST (holding)" if view.phase is Phase.FLYING else "LOST"
@@ -66,24 +78,46 @@ def render(view: SessionView) -> list[str]:
         f"t {view.time_s:7.1f} s  {view.phase_text or view.phase.value:<28} link {link:<4} ({view.link_description})",
         f"mode {view.mode:<14} {'ARMED' if view.armed else 'disarmed':<9} {_LANDED.get(view.landed_state, '?'):<10}"
         f" {what} {stream}",
-        f"position NED {fmt_vec(pos)} m   alt {view.fence.alt_m(pos) if pos else 0.0:5.2f} m",
+        f"position NED {fmt_vec(pos)} m   alt {_alt(view)}",
         _sent_line(view),
-        f"fence margin {fmt_margin(margin)}   closest {fmt_margin(view.stats.min_fence_margin_m)}   joystick {joy}",
+        f"fence margin {fmt_margin(margin, view.fence_alert)}   closest {fmt_margin(view.stats.min_fence_margin_m)}   "
+        f"joystick {joy}",
         stick_line(view.stick),
     ]
     lines += [f"vehicle: {text}" for text in view.statustexts[-3:]]
     return lines
 
 
+def _alt(view: SessionView) -> str:
+    pos = view.pos_ned_m
+    return f"{view.fence.alt_m(pos):5.2f} m" if pos is not None and view.home_known else "  -"
+
+
+def breach_words(stats: FlightStats) -> str:
+    """How often the vehicle went outside the fence, and how far: "once, 7.62 m outside at the deepest"."""
+    times = "once" if stats.fence_breaches == 1 else f"{stats.fence_breaches} times"
+    return f"{times}, {stats.deepest_breach_m:.2f} m outside at the deepest"
+
+
+def fence_line(stats: FlightStats) -> str:
+    """The summary's fence line: the breaches and the deepest, or how close the vehicle came."""
+    if stats.fence_breaches:
+        return f"fence breached        {breach_words(stats)}"
+    closest = stats.min_fence_margin_m
+    if math.isinf(closest):
+        return "closest to the fence  n/a"
+    if closest < 0:
+        return (f"closest to the fence  {-closest:.2f} m past it, within joyfly's {FENCE_TOLERANCE_M:g} m "
+                "tolerance: no breach")
+    return f"closest to the fence  {closest:.2f} m inside"
+
+
 def summary_lines(stats: FlightStats, control: str = "OFFBOARD", extra: list[str] | None = None) -> list[str]:
-    """The flight's summary: distance, closest approach to the fence, time in joyfly's mode (`control`), the lines
-    of the way of flying (`extra`), and the highest altitude (always the last line)."""
-    closest = "n/a" if math.isinf(stats.min_fence_margin_m) else f"{stats.min_fence_margin_m:.2f} m inside"
-    if stats.min_fence_margin_m < 0:
-        closest = f"{-stats.min_fence_margin_m:.2f} m OUTSIDE"
+    """The flight's summary: distance, the fence (breaches, or the closest approach), time in joyfly's mode
+    (`control`), the lines of the way of flying (`extra`), and the highest altitude (always the last line)."""
     return [
         f"distance flown        {stats.distance_m:6.1f} m",
-        f"closest to the fence  {closest}",
+        fence_line(stats),
         f"{'time in ' + control:<22}{stats.control_time_s:6.1f} s",
         *(extra or []),
         f"highest               {stats.max_alt_m:6.1f} m above home",
@@ -145,13 +179,13 @@ class PlainLog:
         self._key = key
         self._next_s = view.time_s + PLAIN_PERIOD_S
         pos = view.pos_ned_m
-        margin = view.fence.margin_m(pos) if pos is not None else math.inf
+        margin = _margin(view)
         sp = view.setpoint.pos_ned_m if view.setpoint is not None else None
         sent = f"sent {view.manual.describe()}" if view.manual is not None else f"sp {fmt_vec(sp)}"
         phase = view.phase_text or view.phase.value
         self.out.write(f"[{view.time_s:7.2f}] {phase}; {view.mode} {'armed' if view.armed else 'disarmed'}"
                        f"; link {_link_word(view)}; pos {fmt_vec(pos)} {sent}"
-                       f"; fence margin {fmt_margin(margin)}\n")
+                       f"; fence margin {fmt_margin(margin, view.fence_alert)}\n")
         self.out.flush()
 
     def close(self, keep: bool = True) -> None:

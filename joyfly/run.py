@@ -2,6 +2,8 @@
 (what happened, the summary, or in what state the vehicle was left).
 
 The first Ctrl-C or SIGTERM asks the session to perform --on-exit; a second one quits at once (exit status 130).
+Exit status: 0 a flight (or none) that ended well, 1 a failure joyfly reports, 3 the vehicle breached the fence,
+4 a flight ended without a landing, 130 quit at once.
 """
 
 from __future__ import annotations
@@ -14,14 +16,18 @@ from typing import Any
 
 import click
 
-from joyfly.dashboard import summary_lines
+from joyfly.dashboard import breach_words, summary_lines
 from joyfly.session.core import Phase
 from joyfly.session.loop import SessionLoop
+
+EXIT_FENCE_BREACHED = 3  # the flight went outside the fence (joyfly/session/fence_watch.py)
+EXIT_NOT_LANDED = 4  # a flight ended in the air: the vehicle restarted, or was left flying (not --on-exit hold)
 
 
 def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     """Run the session with Ctrl-C/SIGTERM handling, close everything, then say how it ended; returns the exit
-    status (0 done, 1 failed, 130 quit at once by a second Ctrl-C)."""
+    status (0 done, 1 failed, 3 the fence was breached, 4 a flight ended in the air, 130 quit at once by a second
+    Ctrl-C)."""
     interrupted = False
     try:
         with exit_signals(session):
@@ -35,15 +41,29 @@ def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     if interrupted:
         out.write(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}\n")
         return 130
+    unlanded = session.landing_missing()
     if session.armed_seen:
-        lines = summary_lines(session.stats, session.control_label(), session.summary_extra())
-        out.writelines(line + "\n" for line in lines)
+        extra = session.summary_extra() + ([f"landing               none: {unlanded}"] if unlanded else [])
+        out.writelines(line + "\n" for line in summary_lines(session.stats, session.control_label(), extra))
     elif session.phase is not Phase.FAILED:
         out.write(f"joyfly: {nothing_flown(session)}\n")
+    return closing_status(session, unlanded)
+
+
+def closing_status(session: SessionLoop, unlanded: str | None) -> int:
+    """Say on stderr what went wrong, if anything; the exit status of the worst (failed, not landed, breach)."""
     if session.phase is Phase.FAILED:
         click.echo(f"joyfly: {session.error}", err=True)
         return 1
-    return 0
+    status = 0
+    if session.stats.fence_breaches:
+        click.echo(f"joyfly: the vehicle went outside the {session.fence.half_width_m:g} m fence "
+                   f"({breach_words(session.stats)}).", err=True)
+        status = EXIT_FENCE_BREACHED
+    if unlanded:
+        click.echo(f"joyfly: the flight ended without a landing: {unlanded}.", err=True)
+        status = EXIT_NOT_LANDED
+    return status
 
 
 def nothing_flown(session: SessionLoop) -> str:

@@ -7,11 +7,12 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import Protocol
 
 from joyfly.link.vehicle_link import VehicleLink, VehicleState
+from joyfly.session.fence_watch import FenceWatch, breach_alert
 from joyfly.session.retry import ExitPlan, Retry
 from joyfly.session.watchdogs import JoystickWatch, LinkWatch
 from joyfly.sticks.manual import ManualInput
@@ -62,6 +63,7 @@ class SessionSettings:
     exit_timeout_s: float = 60.0
     exit_when_landed: bool = False  # `joyfly demo`: finish once the vehicle has landed and disarmed
     fence_m: float = 5.0
+    fence_action: str = "land"  # warn | hold | rtl | land: when the vehicle stays outside the fence (fence_watch.py)
     min_alt_m: float = 0.5
     max_alt_m: float = 10.0
     limits: Limits = field(default_factory=Limits)
@@ -88,6 +90,8 @@ class FlightStats:
     min_fence_margin_m: float = math.inf
     control_time_s: float = 0.0  # time in joyfly's mode: OFFBOARD, or POSCTL/ALTCTL with --control position/altitude
     max_alt_m: float = 0.0
+    fence_breaches: int = 0  # times the vehicle went outside the fence (further than FENCE_TOLERANCE_M)
+    deepest_breach_m: float = 0.0  # the furthest outside it went
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,6 +118,8 @@ class SessionView:
     control: str = "OFFBOARD"  # the mode joyfly flies in
     manual: ManualInput | None = None  # the last MANUAL_CONTROL sent (--control position/altitude), else None
     phase_text: str = ""  # the phase in words for this way of flying ("" = phase.value)
+    fence_alert: str = ""  # the breach under way and what joyfly will do about it ("" = none)
+    home_known: bool = True  # False until joyfly knows this flight's home (after a restart: the old one is void)
 
 
 def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None, st: VehicleState, fence: Fence,
@@ -129,7 +135,8 @@ def update_stats(stats: FlightStats, prev_pos: tuple[float, float, float] | None
     margin = min(stats.min_fence_margin_m, fence.margin_m(pos)) if in_air else stats.min_fence_margin_m
     controlled = st.offboard if in_control is None else in_control
     control_time = stats.control_time_s + (dt_s if controlled else 0.0)
-    return FlightStats(dist, margin, control_time, max(stats.max_alt_m, fence.alt_m(pos)))
+    return replace(stats, distance_m=dist, min_fence_margin_m=margin, control_time_s=control_time,
+                   max_alt_m=max(stats.max_alt_m, fence.alt_m(pos)))
 
 
 def no_vehicle_message(where: str, heard: bool, timeout_s: float, port_taken: bool | None = None) -> str:
@@ -204,6 +211,10 @@ class SessionCore:
         self._restart_s = -math.inf  # when joyfly last reported a restart of the vehicle
         self._link_note_s = -math.inf  # when joyfly last said the link is lost (LINK_REMINDER_S apart)
         self._home_from_vehicle = False  # True when joyfly took over a flying vehicle: its HOME_POSITION is home
+        self.home_known = False  # the fence's home is this flight's (set where joyfly arms, or the vehicle's own)
+        self.fence_watch = FenceWatch()
+        self.airborne_mode: str | None = None  # the vehicle's mode while last known armed in the air, else None
+        self.unlanded: str | None = None  # why a flight of this session ended in the air (the vehicle restarted)
 
     def in_control(self, st: VehicleState) -> bool:
         """Whether the vehicle is in the mode joyfly flies it in (OFFBOARD here; ManualSession: POSCTL/ALTCTL)."""
@@ -219,6 +230,16 @@ class SessionCore:
     def summary_extra(self) -> list[str]:
         """Lines the flight's summary adds for this way of flying."""
         return []
+
+    def landing_missing(self) -> str | None:
+        """Why a flight of this session ended without a landing, or None: the vehicle restarted in the air, or
+        joyfly ends with the vehicle last known armed in the air (unless the user asked --on-exit hold)."""
+        if self.unlanded is not None:
+            return self.unlanded
+        if self.airborne_mode is None or (self.exit_requested and self.s.on_exit == "hold"):
+            return None
+        heard = "" if self.link.state.link_ok(self.clock.now()) else " (the link is lost: as last heard)"
+        return f"joyfly ends with the vehicle armed in the air in {self.airborne_mode}{heard}"
 
     @property
     def finished(self) -> bool:
@@ -297,4 +318,5 @@ class SessionCore:
             fence=self.fence, stats=self.stats, statustexts=tuple(t.text for t in list(self.link.statustexts)[-5:]),
             notes=tuple(self.notes[-5:]), link_description=self.link.transport.description,
             heard=st.last_heartbeat_s is not None, control=self.control_label(), manual=self.manual_sent,
-            phase_text=self.phase_text())
+            phase_text=self.phase_text(), home_known=self.home_known,
+            fence_alert=breach_alert(self.fence_watch, self.s.fence_action, self.phase is Phase.FLYING, now))

@@ -108,6 +108,7 @@ class SessionLoop(SessionWatch):
             if not self._watch_link(now):
                 self._tick_exit_timeout(now)
                 return
+            self._watch_fence(now)
         if self._sticks_gone_before_arming():
             return
         self._watch_joystick(now)
@@ -160,7 +161,7 @@ class SessionLoop(SessionWatch):
     def _home_here(self) -> None:
         """Centre the fence (and measure altitudes from) where joyfly arms the vehicle: PX4 sets its home there when
         it arms (COM_HOME_EN, Commander::arm), so a HOME_POSITION read before arming is the last flight's home."""
-        self._home_from_vehicle = False
+        self._home_from_vehicle, self.home_known = False, True
         self.fence = replace(self.fence, home_ned_m=self._vehicle_pos())
 
     # --- phases around the flight --------------------------------------------------------------------------------
@@ -191,7 +192,7 @@ class SessionLoop(SessionWatch):
         self.link.request_home()
         self._restarts_seen = st.restarts  # a restart before we flew is nothing to report
         if st.armed:  # taking over a flight: PX4 set its home when it armed (until HOME_POSITION comes: here)
-            self._home_from_vehicle = True
+            self._home_from_vehicle = self.home_known = True
             self.fence = replace(self.fence, home_ned_m=st.home_ned_m or self._vehicle_pos())
         if self.exit_requested:
             self._set_phase(Phase.DONE)

@@ -6,8 +6,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from joyfly.link.vehicle_link import LINK_TIMEOUT_S
-from joyfly.session.core import STREAMING_PHASES, Level, Phase, SessionCore, restarted_message
+from joyfly.link.vehicle_link import LINK_TIMEOUT_S, MAIN_AUTO, SUB_AUTO_LOITER
+from joyfly.session.core import STALE_S, STREAMING_PHASES, Level, Phase, SessionCore, restarted_message
+from joyfly.session.fence_watch import FenceChange, breach_message
 from joyfly.session.watchdogs import Change
 
 LINK_REMINDER_S = 30.0  # while the link stays lost, say so again this often (a silent wait looks like a hang)
@@ -15,6 +16,8 @@ LINK_REMINDER_S = 30.0  # while the link stays lost, say so again this often (a 
 
 class SessionWatch(SessionCore):
     """The watchdog steps of the flight session's tick."""
+
+    fly_again: str  # what the OFFBOARD button does after a Hold, in the notes (SessionLoop)
 
     def _watch_vehicle(self, now: float) -> None:
         """Once connected: a restart of the vehicle ends the flight; otherwise note that it is (still) armed, and
@@ -25,15 +28,73 @@ class SessionWatch(SessionCore):
             self._on_restart(now)
             return
         self.armed_seen |= st.armed
+        self.airborne_mode = st.mode if st.armed and not st.on_ground else None
         if self._home_from_vehicle and st.home_ned_m is not None and st.home_ned_m != self.fence.home_ned_m:
             self.fence = replace(self.fence, home_ned_m=st.home_ned_m)
 
     def _on_restart(self, now: float) -> None:
+        """The flight is over: say so, and forget what belonged to it (the setpoint, and the home, which the new
+        vehicle's frame knows nothing of: the fence margin is unknown until joyfly arms it again)."""
         quitting = self.exit_requested or self.s.exit_when_landed
         self._note(Level.WARN, restarted_message(self.link.state, quitting))
-        self._restart_s = now
-        self.sp, self._last_pos, self._home_from_vehicle = None, None, False
+        if self.airborne_mode is not None:  # last heard flying: the flight ended without a landing
+            self.unlanded = f"the vehicle restarted while it flew in {self.airborne_mode} (last heard armed in the air)"
+        self._restart_s, self.airborne_mode = now, None
+        self.sp, self._last_pos, self._home_from_vehicle, self.home_known = None, None, False, False
+        self.fence_watch.reset()
         self._set_phase(Phase.DONE if quitting else Phase.GROUNDED)
+
+    def _watch_fence(self, now: float) -> None:
+        """Warn at once when the flying vehicle is outside joyfly's fence, say when it is back, and carry out
+        --fence-action once it has stayed outside for the grace time (joyfly/session/fence_watch.py)."""
+        st, watch = self.link.state, self.fence_watch
+        if st.stamped_s is None or now - st.stamped_s > STALE_S:
+            return  # no news of the vehicle's position: nothing to judge, and a breach under way goes on
+        change = watch.update(self._fence_margin(), now)
+        self.stats = replace(self.stats, fence_breaches=watch.count, deepest_breach_m=watch.deepest_m)
+        if change is FenceChange.OUT and watch.breach is not None:
+            self._note(Level.WARN, breach_message(watch.breach.depth_m, self.fence.half_width_m, self.s.fence_action))
+        elif change is FenceChange.BACK:
+            self._note(Level.INFO, "The vehicle is back inside the fence.")
+        if watch.due(now):
+            self._fence_act(now)
+
+    def _fence_margin(self) -> float | None:
+        """The flying vehicle's fence margin (negative outside); None when there is nothing to judge: no fence or
+        no home yet, no position, on the ground or disarmed."""
+        st = self.link.state
+        pos = st.pos_ned_m
+        if not self.fence.enabled or not self.home_known or pos is None or not st.armed or st.on_ground:
+            return None
+        return self.fence.margin_m(pos)
+
+    def _fence_act(self, now: float) -> None:
+        """--fence-action, once the vehicle stayed outside for the grace time without coming back, if joyfly flies
+        it (in another mode a failsafe, another ground station or the pilot's own command is in charge: joyfly does
+        not fight it)."""
+        action, st, breach = self.s.fence_action, self.link.state, self.fence_watch.breach
+        assert breach is not None  # due() says so
+        where = (f"The vehicle has been outside the fence for {now - breach.since_s:.1f} s and is not coming back "
+                 f"({breach.depth_m:.1f} m outside)")
+        if action == "warn":
+            self._note(Level.WARN, f"{where}: joyfly only warns (--fence-action warn); fly it back, or press LAND "
+                                   "or RETURN.")
+        elif self.phase is not Phase.FLYING:
+            self._note(Level.WARN, f"{where}, in {st.mode}, which joyfly does not command: --fence-action {action} "
+                                   "is not carried out.")
+        elif action == "hold":
+            self._note(Level.WARN, f"{where}: holding in AUTO.LOITER (--fence-action hold); press OFFBOARD to "
+                                   f"{self.fly_again}.")
+            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self._set_phase(Phase.PAUSED)
+        elif action == "rtl":
+            self._note(Level.WARN, f"{where}: returning to launch (--fence-action rtl).")
+            self.link.return_to_launch()
+            self._set_phase(Phase.LANDING)
+        else:
+            self._note(Level.WARN, f"{where}: landing where it is (--fence-action land).")
+            self.link.land()
+            self._set_phase(Phase.LANDING)
 
     def _watch_link(self, now: float) -> bool:
         st = self.link.state

@@ -35,7 +35,7 @@ def test_live_block_has_link_mode_position_setpoint_sticks_margin_and_texts() ->
 
 
 def test_outside_the_fence_and_lost_link_stand_out() -> None:
-    text = "\n".join(render(view(pos=(5.4, 0.0, -3.0), link_ok=False)))
+    text = "\n".join(render(view(pos=(6.2, 0.0, -3.0), link_ok=False)))
     assert "OUTSIDE" in text and "link LOST" in text
 
 
@@ -68,8 +68,23 @@ def test_make_view_picks_plain_lines_without_a_terminal() -> None:
 
 
 def test_summary_reports_distance_fence_and_offboard_time() -> None:
-    text = "\n".join(summary_lines(FlightStats(31.5, -0.2, 29.0, 4.1)))
-    assert "31.5 m" in text and "0.20 m OUTSIDE" in text and "29.0 s" in text
+    text = "\n".join(summary_lines(FlightStats(31.5, 0.8, 29.0, 4.1)))
+    assert "31.5 m" in text and "closest to the fence  0.80 m inside" in text and "29.0 s" in text
+
+
+def test_summary_words_a_breach_as_one_with_its_depth_and_an_overshoot_at_the_fence_as_none() -> None:
+    breached = "\n".join(summary_lines(FlightStats(31.5, -32.9, 29.0, 4.1, fence_breaches=2, deepest_breach_m=32.9)))
+    assert "fence breached        2 times, 32.90 m outside at the deepest" in breached
+    assert "OUTSIDE" not in breached and "closest" not in breached
+    overshoot = "\n".join(summary_lines(FlightStats(31.5, -0.004, 29.0, 4.1)))
+    assert "closest to the fence  0.00 m past it, within joyfly's 1 m tolerance: no breach" in overshoot
+    assert "OUTSIDE" not in overshoot and "breached" not in overshoot
+
+
+def test_the_live_block_shows_a_breach_and_the_time_before_the_fence_action() -> None:
+    text = "\n".join(render(replace(view(pos=(12.0, 0.0, -3.0)), fence_alert="BREACH: land in 3 s")))
+    assert "fence margin -7.00 m  BREACH: land in 3 s" in text
+    assert "fence margin -0.20 m  on the fence" in "\n".join(render(view(pos=(5.2, 0.0, -3.0))))
 
 
 def test_no_vehicle_yet_reads_waiting_not_lost_even_once_joyfly_stops() -> None:

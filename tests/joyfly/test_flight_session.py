@@ -387,3 +387,91 @@ def test_a_vehicle_restarted_before_joyfly_connected_is_simply_flown() -> None:
     world.vehicle.reboot()  # its boot time goes back from 3 s to 0 while joyfly waits for the joystick
     world.run_until(12.0)
     assert world.session.phase is Phase.FLYING and "restarted" not in world.notes()
+
+
+def _breach_notes(world: World) -> list[tuple[float, str]]:
+    return [(n.time_s, n.text) for n in world.session.notes if "outside the fence" in n.text]
+
+
+@pytest.mark.parametrize(("action", "command", "phase"), [("land", "CMD21", Phase.LANDING),
+                                                          ("rtl", "CMD20", Phase.LANDING),
+                                                          ("hold", "CMD176", Phase.PAUSED)])
+def test_a_vehicle_blown_out_of_the_fence_is_warned_at_once_and_the_fence_action_follows(
+        action: str, command: str, phase: Phase) -> None:
+    world = airborne(fence_action=action)
+    world.vehicle.wind_m_s = (0.0, 8.0)  # stronger than the fake's 5 m/s: it cannot come back
+    world.run_until(9.0)
+    (out_s, warning), = _breach_notes(world)
+    assert 6.0 < out_s < 9.0
+    assert f"--fence-action {action} acts if it stays outside for 5 s without coming back" in warning
+    assert any(n.level.name == "WARN" and n.text == warning for n in world.session.notes)
+    assert "BREACH" in "\n".join(render(world.session.view()))
+    def sent() -> list[float]:  # (DO_SET_MODE: to Hold, not OFFBOARD)
+        return [t for t, m in world.vehicle.received(command) if command != "CMD176" or m.param3 == 3]
+
+    assert not sent()
+    world.run_until(out_s + 5.5)
+    assert sent() and out_s + 4.9 < sent()[0] < out_s + 5.3, world.notes()
+    assert world.session.phase is phase and "has been outside the fence for" in world.notes()
+    assert world.session.stats.fence_breaches == 1 and world.session.stats.deepest_breach_m > 2.0
+
+
+def test_fence_action_warn_only_warns_and_a_vehicle_that_comes_back_is_said_to_be_back() -> None:
+    world = airborne(fence_action="warn")
+    world.vehicle.wind_m_s = (0.0, 8.0)
+    world.run_until(14.0)
+    world.vehicle.wind_m_s = (0.0, 0.0)
+    world.run_until(24.0)
+    assert "joyfly only warns (--fence-action warn)" in world.notes()
+    assert "The vehicle is back inside the fence." in world.notes()
+    assert world.session.phase is Phase.FLYING and world.vehicle.custom_mode == OFFBOARD
+    assert not world.vehicle.received("CMD21") and not world.vehicle.received("CMD20")
+    assert world.session.stats.fence_breaches == 1
+
+
+def test_a_gust_that_carries_the_vehicle_out_for_a_moment_is_said_but_not_acted_upon() -> None:
+    world = airborne()  # --fence-action land, the default
+    world.vehicle.wind_m_s = (0.0, 8.0)
+    world.run_until(8.8)
+    world.vehicle.wind_m_s = (0.0, 0.0)
+    world.run_until(20.0)
+    assert len(_breach_notes(world)) == 1 and "back inside" in world.notes()
+    assert world.session.phase is Phase.FLYING and not world.vehicle.received("CMD21")
+
+
+def test_pushing_against_the_fence_in_calm_air_is_no_breach() -> None:
+    world = airborne([(7.0, StickCommand(forward=1.0, right=1.0)), (17.0, StickCommand())])
+    world.run_until(20.0)
+    assert world.session.stats.fence_breaches == 0 and not _breach_notes(world)
+
+
+@pytest.mark.parametrize(("wind_after_m_s", "acts"), [(4.0, False), (4.9, True)])
+def test_a_vehicle_on_its_way_back_is_let_come_back_and_one_the_wind_holds_outside_is_landed(
+        wind_after_m_s: float, acts: bool) -> None:
+    world = airborne()
+    world.vehicle.wind_m_s = (0.0, 8.0)  # carried out, then a wind the fake (5 m/s at most) beats by 1 or 0.1 m/s
+    world.run_until(9.5)
+    world.vehicle.wind_m_s = (0.0, wind_after_m_s)
+    world.run_until(14.0)
+    alert = "\n".join(render(world.session.view()))
+    world.run_until(30.0)
+    land = world.vehicle.received("CMD21")
+    if acts:
+        (out_s, _), = _breach_notes(world)[:1]
+        assert land and out_s + 4.9 < land[0][0] < out_s + 6.0, world.notes()
+        assert "and is not coming back" in world.notes()
+    else:
+        assert "BREACH: coming back" in alert and "back inside the fence" in world.notes()
+        assert not land and world.session.phase is Phase.FLYING
+
+
+def test_a_breach_is_said_once_even_when_the_vehicles_position_pauses_during_it() -> None:
+    world = airborne(fence_action="warn")
+    world.vehicle.wind_m_s = (0.0, 8.0)
+    world.run_until(10.0)
+    world.vehicle.speak = False  # a second without telemetry: its position is stale, the link not yet lost
+    world.run_until(11.0)
+    world.vehicle.speak = True
+    world.run_until(14.0)
+    assert len([text for _, text in _breach_notes(world) if "m outside the fence (5 m" in text]) == 1, world.notes()
+    assert world.session.stats.fence_breaches == 1

@@ -292,3 +292,16 @@ def test_quitting_at_once_says_px4s_rc_loss_failsafe_takes_over() -> None:
     world = airborne()
     assert "manual-control-loss failsafe holds it for COM_FAIL_ACT_T (5 s)" in left_behind(world.session)
     assert "left armed in POSCTL" in left_behind(world.session)
+
+
+def test_a_vehicle_blown_out_of_the_fence_in_position_mode_is_warned_and_landed_after_the_grace() -> None:
+    world = airborne(fence_m=5.0)
+    world.vehicle.wind_m_s = (8.0, 0.0)  # PX4's Position mode holds where the sticks leave it; this wind wins
+    world.run_until(20.0)
+    out = [n for n in world.session.notes if "m outside the fence (5 m around home)" in n.text]
+    assert len(out) == 1 and out[0].level.name == "WARN", world.notes()
+    land = world.commands(21)
+    assert land and out[0].time_s + 4.9 < land[0][0] < out[0].time_s + 5.3
+    assert "landing where it is (--fence-action land)" in world.notes()
+    assert world.session.stats.fence_breaches == 1
+    assert "fence breached        once" in "\n".join(summary_lines(world.session.stats))

@@ -52,6 +52,7 @@ class FakeVehicle:
     home: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])  # PX4 sets it where it arms (COM_HOME_EN)
     log: list[tuple[float, str, Any]] = field(default_factory=list)  # (time, kind, detail) of what it received
     texts: list[str] = field(default_factory=list)
+    wind_m_s: tuple[float, float] = (0.0, 0.0)  # north, east: carries it along in the air beyond what it commands
 
     def __post_init__(self) -> None:
         self.mav = mavlink2.MAVLink(_Out(self.transport), srcSystem=1, srcComponent=1)
@@ -217,6 +218,9 @@ class FakeVehicle:
         alpha = min(1.0, dt / 0.3)
         self.vel = [v + alpha * (t - v) for v, t in zip(self.vel, target, strict=True)]
         self.pos = [p + v * dt for p, v in zip(self.pos, self.vel, strict=True)]
+        if not self.landed:
+            self.pos[0] += self.wind_m_s[0] * dt
+            self.pos[1] += self.wind_m_s[1] * dt
         if self.pos[2] >= 0.0:
             self.pos[2] = 0.0
             self.vel = [0.0, 0.0, 0.0] if self.vel[2] >= 0 else self.vel
