@@ -31,7 +31,7 @@ test: $(STAMP)
 
 # The opt-in compiled build, checked in a scratch copy (your tree is left as it is): build it, then the tests of the
 # vehicle core, Sim and the link (the `compiled` marker, given in tests/conftest.py), including
-# tests/sitl_emu/core/test_speedups_exact.py (compiled and pure Python fly bit-identically).
+# tests/sitl_emu/vehicle/test_speedups_exact.py (compiled and pure Python fly bit-identically).
 CHECK_DIR := build/compiled-check
 test-compiled: $(STAMP)
 	@if ! command -v "$$($(BIN)/python -c 'import sysconfig; print((sysconfig.get_config_var("CC") or "cc").split()[0])')" \
