@@ -40,6 +40,25 @@ def test_the_vehicle_core_knows_no_mavlink_runtime_or_clock(path: Path) -> None:
     assert not bad, f"{path.name} imports {sorted(bad)}"
 
 
+# Inside the vehicle core the arrows point one way: vehicle/ -> flight_tasks/ -> commander/ -> navigator/ ->
+# motion_planning/ (ARCHITECTURE.md); each folder's __init__.py says the same.
+BELOW: dict[str, tuple[str, ...]] = {
+    "sitl_emu/motion_planning": ("sitl_emu.navigator", "sitl_emu.commander", "sitl_emu.flight_tasks",
+                                 "sitl_emu.vehicle"),
+    "sitl_emu/navigator": ("sitl_emu.commander", "sitl_emu.flight_tasks", "sitl_emu.vehicle"),
+    "sitl_emu/commander": ("sitl_emu.flight_tasks", "sitl_emu.vehicle"),
+    "sitl_emu/flight_tasks": ("sitl_emu.vehicle",),
+}
+
+
+@pytest.mark.parametrize("path", [p for folder in BELOW for p in sources(folder)],
+                         ids=lambda p: str(p.relative_to(REPO_ROOT)))
+def test_the_vehicle_cores_folders_import_only_downwards(path: Path) -> None:
+    folder = str(path.parent.relative_to(REPO_ROOT))
+    bad = {m for m in imports_of(path) if any(m == f or m.startswith(f + ".") for f in BELOW[folder])}
+    assert not bad, f"{path.name} imports {sorted(bad)}"
+
+
 @pytest.mark.parametrize("path", sources("joyfly/sticks"), ids=lambda p: p.name)
 def test_the_stick_side_knows_neither_the_link_nor_the_session(path: Path) -> None:
     assert not {m for m in imports_of(path) if m.startswith(("joyfly.link", "joyfly.session"))}

@@ -62,6 +62,7 @@ DEFAULT_MODULES = (
     "sitl_emu/flight_tasks/sticks.py",
     "sitl_emu/flight_tasks/auto.py",
     "sitl_emu/flight_tasks/core.py",
+    "sitl_emu/navigator/setpoint.py",
     "sitl_emu/flight_tasks/manual.py",
     "sitl_emu/flight_tasks/mission.py",
     "sitl_emu/flight_tasks/orbit.py",

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight_tasks import auto, orbit
-from sitl_emu.flight_tasks.auto import SetpointType
 from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
@@ -30,6 +29,7 @@ from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
 from sitl_emu.navigator.mission_store import MissionStore
+from sitl_emu.navigator.setpoint import SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import (
