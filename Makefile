@@ -25,13 +25,13 @@ demo: $(DEMO_STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly flightview
+	$(BIN)/mypy sitl_emu joyfly flightview px4common
 	$(BIN)/python -m pytest -q
 	$(MAKE) test-compiled
 
 # The opt-in compiled build, checked in a scratch copy (your tree is left as it is): build it, then the tests of the
 # vehicle core, Sim and the link (the `compiled` marker, given in tests/conftest.py), including
-# tests/sitl_emu/core/test_speedups_exact.py (compiled and pure Python fly bit-identically).
+# tests/sitl_emu/vehicle/test_speedups_exact.py (compiled and pure Python fly bit-identically).
 CHECK_DIR := build/compiled-check
 test-compiled: $(STAMP)
 	@if ! command -v "$$($(BIN)/python -c 'import sysconfig; print((sysconfig.get_config_var("CC") or "cc").split()[0])')" \
@@ -40,13 +40,13 @@ test-compiled: $(STAMP)
 
 compiled-check:
 	rm -rf $(CHECK_DIR) && mkdir -p $(CHECK_DIR)
-	cp -r sitl_emu joyfly flightview tests tools examples pyproject.toml README.md $(CHECK_DIR)/
+	cp -r sitl_emu joyfly flightview px4common tests tools examples pyproject.toml README.md $(CHECK_DIR)/
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m compiled
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/mypy sitl_emu joyfly flightview
+	$(BIN)/mypy sitl_emu joyfly flightview px4common
 
 bench: $(STAMP)
 	$(BIN)/python -m bench

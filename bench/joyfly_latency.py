@@ -27,7 +27,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from joyfly.clock import WallClock
 from joyfly.demo import EmbeddedVehicle
 from joyfly.link.transport import UdpTransport
 from joyfly.link.vehicle_link import VehicleLink
@@ -36,6 +35,7 @@ from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT
 from joyfly.sticks.mapping import MappedSource, open_sticks
 from joyfly.sticks.sdl_api import sdl_api
 from joyfly.sticks.setpoints import Setpoint
+from px4common.clock import WallClock
 
 
 def main() -> None:

@@ -16,9 +16,10 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from px4common.clock import ScaledClock
 from sitl_emu.px4 import MavCmd
 from sitl_emu.testing.client import FlightClient, FlightResult, fly_square
-from sitl_emu.testing.sim import ScaledWallClock, Sim
+from sitl_emu.testing.sim import Sim
 
 REPO = Path(__file__).resolve().parent.parent
 TICKS_S = os.sysconf("SC_CLK_TCK")
@@ -62,7 +63,7 @@ def start_server(speed: float = 1.0, extra: tuple[str, ...] = ()) -> Server:
     sink.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
     sink.bind(("127.0.0.1", 0))
     api, gcs = _free_port(), _free_port()
-    clock = ScaledWallClock(speed)
+    clock = ScaledClock(speed)
     client = FlightClient(("127.0.0.1", api), clock)
     client_port = client.sock.getsockname()[1]
     args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs),

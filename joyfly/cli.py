@@ -18,9 +18,7 @@ import click
 from flightview.launch import ViewOptions
 from flightview.options import view_options, view_settings
 from joyfly.cli_joystick import joystick
-from joyfly.cli_style import CONTEXT, TOOL, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
-from joyfly.clock import ScaledClock, WallClock
-from joyfly.config import BOUNDS, CONTROLS, SPEED_MAX, SPEED_MIN, ConfigError, FlyOptions, build_options, load_file
+from joyfly.config import BOUNDS, CONTROLS, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
 from joyfly.link.signing_key import SigningKeyError, read_signing_key
 from joyfly.link.speedwatch import SpeedWatch
@@ -38,11 +36,14 @@ from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
+from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
+from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
 
+TOOL = "joyfly"
 D = FlyOptions()
 
 
-@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
+@click.group(name=TOOL, cls=OneLineGroup, version_message=VERSION_MESSAGE, context_settings=CONTEXT)
 @click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output on stderr (-v info, -vv debug).")
 def main(verbose: int) -> None:

@@ -15,8 +15,6 @@ from typing import Any, TextIO
 import click
 
 from joyfly.cli_calibrate import calibrate
-from joyfly.cli_style import CONTEXT, FiniteRange, OneLineGroup
-from joyfly.clock import WallClock
 from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.js_seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
@@ -30,11 +28,13 @@ from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
+from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup
+from px4common.clock import WallClock
 
 DEV_DIR = "/dev/input"
 
 
-@click.group("joystick", cls=OneLineGroup, context_settings=CONTEXT,
+@click.group("joystick", cls=OneLineGroup, tool="joyfly", context_settings=CONTEXT,
              short_help="List and test joysticks (no vehicle needed).")
 def joystick() -> None:
     """Find joysticks and check what they send (no vehicle needed)."""

@@ -37,14 +37,12 @@ from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.profiles import read_config
 from joyfly.sticks.setpoints import Limits
+from px4common.clock import SPEED_MAX, SPEED_MIN
 
 DEFAULT_URL = "udp://:14540@127.0.0.1:14557"
 CONTROLS = ("velocity", "step", *MANUAL_CONTROLS)
 ON_EXIT = ("land", "hold", "rtl")
 MIN_RATE_HZ = 10.0  # PX4 needs a setpoint younger than COM_OF_LOSS_T = 1 s; 10 Hz leaves room for lost datagrams
-# --speed: the vehicle's simulated seconds per wall second; the same range as `sitl-emu serve --speed`
-# (sitl_emu/cli/options.py; a test keeps them equal).
-SPEED_MIN, SPEED_MAX = 0.1, 100.0
 
 
 class ConfigError(Exception):

@@ -17,7 +17,6 @@ from dataclasses import replace
 from typing import Any, TextIO
 
 from flightview.launch import ViewOptions
-from joyfly.clock import ScaledClock
 from joyfly.config import FlyOptions
 from joyfly.dashboard import make_view
 from joyfly.link.transport import UdpTransport, open_transport
@@ -28,6 +27,7 @@ from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.mapping import MappedSource
 from joyfly.sticks.profiles import load_profile
 from joyfly.sticks.virtual import ScriptSource
+from px4common.clock import ScaledClock
 
 # The demo flight (joyfly takes off by itself at the start; the sticks then fly a square and push the fence).
 # Format: joyfly/sticks/virtual.py. With the default options full stick = 5 m/s, the fence is 5 m around home.

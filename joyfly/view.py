@@ -15,9 +15,9 @@ from typing import Any
 from flightview.launch import ViewHandle, ViewOptions
 from flightview.scene import FenceBox, Frame, euler_to_q
 from flightview.server import ViewError
-from joyfly.cli_style import UserError
 from joyfly.session.core import Note, SessionView
 from joyfly.sticks.setpoints import Fence
+from px4common.cli_style import UserError
 
 VEHICLE_KEY = "vehicle"
 

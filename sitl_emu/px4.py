@@ -1,4 +1,6 @@
-"""PX4's numbering, in one place: nav_state, custom_mode (main/sub), landed state, commands, results, severities.
+"""PX4's numbering, in one place for the emulator: nav_state, custom_mode (main/sub), landed state, commands, results,
+severities. What joyfly needs too (the main and sub modes, custom_mode's layout and names, MAV_RESULT) is defined in
+px4common (modes.py, results.py) and imported here.
 
 Sources (see ../shared/reference/px4-behaviour.md section 2):
 - nav_state numbers: PX4 msg/versioned/VehicleStatus.msg
@@ -11,6 +13,10 @@ from __future__ import annotations
 
 from enum import IntEnum
 from typing import Final
+
+from px4common.modes import AutoSubMode, MainMode, PosctlSubMode, custom_mode_name, encode_custom_mode
+from px4common.modes import decode_custom_mode as decode_custom_mode  # the emulator imports PX4's numbering from here
+from px4common.results import MavResult as MavResult
 
 
 class NavState(IntEnum):
@@ -36,40 +42,6 @@ class NavState(IntEnum):
     AUTO_PRECLAND = 20
     ORBIT = 21
     AUTO_VTOL_TAKEOFF = 22
-
-
-class MainMode(IntEnum):
-    MANUAL = 1
-    ALTCTL = 2
-    POSCTL = 3
-    AUTO = 4
-    ACRO = 5
-    OFFBOARD = 6
-    STABILIZED = 7
-    RATTITUDE_LEGACY = 8
-    SIMPLE = 9
-    TERMINATION = 10
-    ALTITUDE_CRUISE = 11
-
-
-class AutoSubMode(IntEnum):
-    READY = 1
-    TAKEOFF = 2
-    LOITER = 3
-    MISSION = 4
-    RTL = 5
-    LAND = 6
-    FOLLOW_TARGET = 8
-    PRECLAND = 9
-    VTOL_TAKEOFF = 10
-    GUIDED_COURSE = 19
-    DESCEND = 20
-
-
-class PosctlSubMode(IntEnum):
-    POSCTL = 0
-    ORBIT = 1
-    SLOW = 2
 
 
 class LandedState(IntEnum):
@@ -183,18 +155,6 @@ RELATIVE_FRAMES: Final = frozenset({MavFrame.GLOBAL_RELATIVE_ALT, MavFrame.GLOBA
 GLOBAL_FRAMES: Final = ABSOLUTE_FRAMES | RELATIVE_FRAMES
 
 
-class MavResult(IntEnum):
-    """MAV_RESULT, the COMMAND_ACK result."""
-
-    ACCEPTED = 0
-    TEMPORARILY_REJECTED = 1
-    DENIED = 2
-    UNSUPPORTED = 3
-    FAILED = 4
-    IN_PROGRESS = 5
-    CANCELLED = 6
-
-
 class Severity(IntEnum):
     """MAV_SEVERITY; PX4's mavlink_log_critical -> CRITICAL, _warning -> WARNING, _info -> INFO."""
 
@@ -280,19 +240,6 @@ UI_NAMES: dict[NavState, str] = {
     NavState.AUTO_VTOL_TAKEOFF: "VTOL Takeoff",
 }
 
-# MAVROS / pymavlink style names ("AUTO.LOITER"), for logs and the console.
-_MAIN_NAMES = {
-    MainMode.MANUAL: "MANUAL",
-    MainMode.ALTCTL: "ALTCTL",
-    MainMode.POSCTL: "POSCTL",
-    MainMode.ACRO: "ACRO",
-    MainMode.OFFBOARD: "OFFBOARD",
-    MainMode.STABILIZED: "STABILIZED",
-    MainMode.RATTITUDE_LEGACY: "RATTITUDE",
-    MainMode.TERMINATION: "TERMINATION",
-    MainMode.ALTITUDE_CRUISE: "ALTITUDE_CRUISE",
-}
-
 # `commander mode <name>` (Commander.cpp custom_command) -> nav_state
 SHELL_MODE_NAMES: dict[str, NavState] = {
     "manual": NavState.MANUAL,
@@ -332,22 +279,13 @@ def main_sub(nav_state: NavState) -> tuple[int, int]:
 
 
 def custom_mode(nav_state: NavState) -> int:
-    """HEARTBEAT.custom_mode = (sub << 24) | (main << 16)."""
-    main, sub = _NAV_TO_MAIN_SUB[nav_state]
-    return (int(sub) << 24) | (int(main) << 16)
-
-
-def decode_custom_mode(value: int) -> tuple[int, int]:
-    """custom_mode -> (main_mode, sub_mode)."""
-    return (value >> 16) & 0xFF, (value >> 24) & 0xFF
+    """HEARTBEAT.custom_mode of a nav_state."""
+    return encode_custom_mode(*_NAV_TO_MAIN_SUB[nav_state])
 
 
 def mode_name(nav_state: NavState) -> str:
     """The MAVROS/pymavlink name of a nav_state, e.g. 'AUTO.LOITER', 'OFFBOARD'."""
-    main, sub = _NAV_TO_MAIN_SUB[nav_state]
-    if main == MainMode.AUTO:
-        return "AUTO." + AutoSubMode(sub).name
-    return _MAIN_NAMES[MainMode(main)]
+    return custom_mode_name(custom_mode(nav_state))
 
 
 def nav_state_from_main_sub(main: int, sub: int) -> NavState | None:

@@ -1,10 +1,10 @@
-"""The test suite mirrors the packages: tests/sitl_emu/{core,mavlink,runtime,testing,log,...}/, tests/joyfly/,
-tests/cli/ (both command lines), with shared fakes and helpers in tests/support/ (on sys.path via pyproject's pytest
-settings) and the fixtures several folders use here.
+"""The test suite mirrors the packages: tests/sitl_emu/{vehicle,commander,navigator,flight_tasks,mavlink,...}/ as
+sitl_emu's folders, tests/joyfly/, tests/px4common/, tests/cli/ (both command lines), with shared fakes and helpers in
+tests/support/ (on sys.path via pyproject's pytest settings) and the fixtures several folders use here.
 
 The folders whose modules `make speedups` compiles (COMPILED_FOLDERS: the vehicle core, Sim, the link, the runners,
-the flight log, the disturbances) get the `compiled` marker here, and `make compiled-check` runs `pytest -m compiled`
-against the mypyc build.
+the flight log, the disturbances; COMPILED_FILES: the kernel's) get the `compiled` marker here, and
+`make compiled-check` runs `pytest -m compiled` against the mypyc build.
 """
 
 from __future__ import annotations
@@ -16,8 +16,11 @@ import pytest
 from support.mavsdk_waits import MAVSDK_SPEED
 from support.serve_process import serve
 
-COMPILED_FOLDERS = tuple(Path(__file__).parent / "sitl_emu" / name
-                         for name in ("core", "testing", "mavlink", "runtime", "log", "disturbance"))
+_SITL_EMU_TESTS = Path(__file__).parent / "sitl_emu"
+COMPILED_FOLDERS = tuple(_SITL_EMU_TESTS / name for name in (
+    "vehicle", "commander", "navigator", "flight_tasks", "motion_planning", "control",  # the vehicle core
+    "testing", "mavlink", "runtime", "log", "disturbance"))
+COMPILED_FILES = (_SITL_EMU_TESTS / "test_geo.py", _SITL_EMU_TESTS / "test_physics.py")  # the kernel's
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -26,7 +29,7 @@ def pytest_configure(config: pytest.Config) -> None:
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
-        if any(folder in item.path.parents for folder in COMPILED_FOLDERS):
+        if item.path in COMPILED_FILES or any(folder in item.path.parents for folder in COMPILED_FOLDERS):
             item.add_marker(pytest.mark.compiled)
 
 

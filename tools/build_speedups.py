@@ -25,6 +25,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = "sitl_emu"
+SHARED = "px4common"  # the package sitl_emu shares with joyfly: compiled modules import it, so the manifest tracks it
 GROUP = "sitl_emu._speedups_native"  # the shared library: sitl_emu/_speedups_native__mypyc<EXT_SUFFIX>
 MANIFEST = ROOT / PACKAGE / "_speedups_manifest.json"
 BUILD_DIR = Path("build") / "mypyc"
@@ -61,6 +62,7 @@ DEFAULT_MODULES = (
     "sitl_emu/flight_tasks/sticks.py",
     "sitl_emu/flight_tasks/auto.py",
     "sitl_emu/flight_tasks/core.py",
+    "sitl_emu/navigator/setpoint.py",
     "sitl_emu/flight_tasks/manual.py",
     "sitl_emu/flight_tasks/mission.py",
     "sitl_emu/flight_tasks/orbit.py",
@@ -130,7 +132,7 @@ def _module_path(name: str) -> str | None:
 
 
 def _imported_modules(rel_path: str) -> set[str]:
-    """The sitl_emu modules one source imports (absolute imports only, as the code base uses)."""
+    """The sitl_emu and px4common modules one source imports (absolute imports only, as the code base uses)."""
     tree = ast.parse((ROOT / rel_path).read_text(), rel_path)
     found: set[str] = set()
     for node in ast.walk(tree):
@@ -139,11 +141,12 @@ def _imported_modules(rel_path: str) -> set[str]:
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
             found.update(f"{node.module}.{alias.name}" for alias in node.names)
-    return {name for name in found if name.split(".")[0] == PACKAGE}
+    return {name for name in found if name.split(".")[0] in (PACKAGE, SHARED)}
 
 
 def dependency_sources(compiled: list[str]) -> list[str]:
-    """Every sitl_emu source the compiled modules import, transitively (mypyc may bake their constants in)."""
+    """Every sitl_emu or px4common source the compiled modules import, transitively (mypyc may bake their constants
+    in)."""
     seen: set[str] = set()
     todo = list(compiled)
     while todo:

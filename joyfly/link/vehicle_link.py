@@ -19,6 +19,8 @@ from joyfly.link.signing_key import keep_up, sign_with, wall_timestamp
 from joyfly.link.transport import Transport
 from joyfly.sticks.setpoints import FRAME_LOCAL_NED, Setpoint
 from joyfly.types import Clock
+from px4common.modes import MainMode, custom_mode_name, main_mode
+from px4common.results import MavResult, result_name
 
 log = logging.getLogger(__name__)
 
@@ -40,41 +42,6 @@ RESTART_STEP_S = 1.0
 # DEFAULT_RETRIES); PX4 ACKs commander commands within one commander cycle (~10-20 ms).
 COMMAND_TIMEOUT_S = 0.5
 COMMAND_TRANSMISSIONS = 3
-
-RESULT_NAMES = {0: "ACCEPTED", 1: "TEMPORARILY_REJECTED", 2: "DENIED", 3: "UNSUPPORTED", 4: "FAILED",
-                5: "IN_PROGRESS", 6: "CANCELLED"}
-MAV_RESULT_ACCEPTED = 0
-MAV_RESULT_IN_PROGRESS = 5
-
-# PX4 custom_mode = (sub_mode << 24) | (main_mode << 16) (src/modules/commander/px4_custom_mode.h)
-MAIN_ALTCTL = 2
-MAIN_POSCTL = 3
-MAIN_OFFBOARD = 6
-MAIN_AUTO = 4
-SUB_AUTO_LOITER = 3
-SUB_AUTO_RTL = 5
-SUB_AUTO_LAND = 6
-_MAIN_NAMES = {1: "MANUAL", 2: "ALTCTL", 3: "POSCTL", 5: "ACRO", 6: "OFFBOARD", 7: "STABILIZED", 8: "RATTITUDE",
-               10: "TERMINATION", 11: "ALTITUDE_CRUISE"}
-_AUTO_NAMES = {1: "AUTO.READY", 2: "AUTO.TAKEOFF", 3: "AUTO.LOITER", 4: "AUTO.MISSION", 5: "AUTO.RTL",
-               6: "AUTO.LAND", 8: "AUTO.FOLLOW_TARGET", 9: "AUTO.PRECLAND", 20: "AUTO.DESCEND"}
-
-
-def mode_name(custom_mode: int) -> str:
-    """MAVROS-style name of a PX4 custom_mode ("OFFBOARD", "AUTO.LOITER"), "CMODE(n)" if unknown."""
-    main, sub = (custom_mode >> 16) & 0xFF, (custom_mode >> 24) & 0xFF
-    name = _AUTO_NAMES.get(sub) if main == MAIN_AUTO else _MAIN_NAMES.get(main)
-    return name or f"CMODE({custom_mode})"
-
-
-def is_offboard(custom_mode: int) -> bool:
-    return (custom_mode >> 16) & 0xFF == MAIN_OFFBOARD
-
-
-def main_mode(custom_mode: int) -> int:
-    """PX4's main mode (MAIN_POSCTL, MAIN_AUTO...) of a custom_mode."""
-    return (custom_mode >> 16) & 0xFF
-
 
 @dataclass(frozen=True, slots=True)
 class VehicleState:
@@ -98,11 +65,11 @@ class VehicleState:
 
     @property
     def mode(self) -> str:
-        return mode_name(self.custom_mode) if self.last_heartbeat_s is not None else "-"
+        return custom_mode_name(self.custom_mode) if self.last_heartbeat_s is not None else "-"
 
     @property
     def offboard(self) -> bool:
-        return is_offboard(self.custom_mode)
+        return main_mode(self.custom_mode) == MainMode.OFFBOARD
 
     @property
     def on_ground(self) -> bool:
@@ -132,16 +99,16 @@ class CommandHandle:
 
     @property
     def done(self) -> bool:
-        return self.timed_out or (self.result is not None and self.result != MAV_RESULT_IN_PROGRESS)
+        return self.timed_out or (self.result is not None and self.result != MavResult.IN_PROGRESS)
 
     @property
     def accepted(self) -> bool:
-        return self.result == MAV_RESULT_ACCEPTED
+        return self.result == MavResult.ACCEPTED
 
     def describe(self) -> str:
         if self.timed_out:
             return "no answer from the vehicle"
-        return RESULT_NAMES.get(self.result or 0, str(self.result)) if self.result is not None else "pending"
+        return result_name(self.result) if self.result is not None else "pending"
 
 
 class _Writer:

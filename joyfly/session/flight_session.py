@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 from dataclasses import replace
 
-from joyfly.link.vehicle_link import MAIN_AUTO, MAIN_OFFBOARD, SUB_AUTO_LOITER, VehicleState
+from joyfly.link.vehicle_link import VehicleState
 from joyfly.session.core import (
     FlightStats,
     Level,
@@ -27,6 +27,7 @@ from joyfly.session.core import (
 from joyfly.session.loop import MAV_STATE_STANDBY, READY_WAIT_S, SessionLoop
 from joyfly.session.retry import Retry
 from joyfly.sticks.setpoints import initial_setpoint, next_setpoint
+from px4common.modes import AutoSubMode, MainMode
 
 __all__ = ["MAV_STATE_STANDBY", "READY_WAIT_S", "FlightSession", "FlightStats", "Level", "Note", "Phase",
            "SessionSettings", "SessionView", "StickSource"]
@@ -119,7 +120,7 @@ class FlightSession(SessionLoop):
         vehicle's refusal explain."""
         if now - self._hold_sent_s > 1.5:  # the 1 Hz HEARTBEAT shows the new mode within about a second
             self._note(Level.INFO, f"Switching the vehicle from {self.link.state.mode} to Hold before arming.")
-            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self.link.set_mode(MainMode.AUTO, AutoSubMode.LOITER)
             self._hold_sent_s = now
             self._hold_requests += 1
 
@@ -137,7 +138,7 @@ class FlightSession(SessionLoop):
             return
         if self._retry is None:
             self._retry = Retry("Switching to OFFBOARD", self.s.arm_attempts, now)
-        outcome = self._retry.update(now, self.link, lambda: self.link.set_mode(MAIN_OFFBOARD),
+        outcome = self._retry.update(now, self.link, lambda: self.link.set_mode(MainMode.OFFBOARD),
                                      lambda: self.link.state.offboard)
         self._report_retry(outcome)
 

@@ -10,12 +10,12 @@ import logging
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER
 from joyfly.session.core import MIN_SEND_GAP_S, Level, Phase, SessionView, no_vehicle_message
 from joyfly.session.retry import ExitPlan, Outcome, exits_by_disarming
 from joyfly.session.watch import SessionWatch
 from joyfly.sticks.mapping import fired
 from joyfly.types import Action
+from px4common.modes import AutoSubMode, MainMode
 
 MAV_STATE_STANDBY = 3  # HEARTBEAT.system_status once PX4's arming checks pass (px4-behaviour.md 2.4)
 READY_WAIT_S = 10.0  # then try to arm anyway, so the vehicle's refusal explains what is missing
@@ -149,7 +149,7 @@ class SessionLoop(SessionWatch):
         elif action is Action.HOLD and st.armed:
             self._note(Level.INFO,
                        f"HOLD pressed: the vehicle holds in AUTO.LOITER; press OFFBOARD to {self.fly_again}.")
-            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self.link.set_mode(MainMode.AUTO, AutoSubMode.LOITER)
             self._set_phase(Phase.PAUSED)
         elif action is Action.ARM and st.armed and st.on_ground and self.phase in self.disarm_phases:
             self._note(Level.INFO, "ARM held: disarming.")

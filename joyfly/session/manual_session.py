@@ -28,16 +28,7 @@ import math
 from collections.abc import Callable
 from dataclasses import replace
 
-from joyfly.link.vehicle_link import (
-    MAIN_ALTCTL,
-    MAIN_AUTO,
-    MAIN_POSCTL,
-    SUB_AUTO_LOITER,
-    CommandHandle,
-    VehicleLink,
-    VehicleState,
-    main_mode,
-)
+from joyfly.link.vehicle_link import CommandHandle, VehicleLink, VehicleState
 from joyfly.session.core import Level, Note, Phase, SessionSettings, StickSource
 from joyfly.session.loop import SessionLoop
 from joyfly.session.retry import Retry
@@ -51,14 +42,15 @@ from joyfly.sticks.manual_fence import (
     restart_estimate,
 )
 from joyfly.types import Clock
+from px4common.modes import AutoSubMode, MainMode, main_mode
 
 # --control -> (PX4 main mode, its name, in words)
 MANUAL_MODES: dict[str, tuple[int, str, str]] = {
-    "position": (MAIN_POSCTL, "POSCTL", "Position mode"),
-    "altitude": (MAIN_ALTCTL, "ALTCTL", "Altitude mode"),
+    "position": (MainMode.POSCTL, "POSCTL", "Position mode"),
+    "altitude": (MainMode.ALTCTL, "ALTCTL", "Altitude mode"),
 }
 MANUAL_CONTROLS = tuple(MANUAL_MODES)
-STICK_MODES = (MAIN_POSCTL, MAIN_ALTCTL)  # where joyfly's sticks fly the vehicle (PX4 may fall back to ALTCTL)
+STICK_MODES = (MainMode.POSCTL, MainMode.ALTCTL)  # where joyfly's sticks fly the vehicle (PX4 may fall back to ALTCTL)
 RATE_HZ = 25.0  # QGroundControl's joystick rate while the sticks move (its Axis Frequency default)
 FRESH_HEARTBEAT_S = 0.1  # a HEARTBEAT this long after a mode command shows its effect (PX4 ACKs after switching)
 # Centred sticks this long before joyfly's own switch to an auto mode (the exit, a lost joystick): PX4's stick
@@ -133,7 +125,7 @@ class ManualSession(SessionLoop):
         st, now = self.link.state, self.clock.now()
         mode = main_mode(st.custom_mode)
         # PX4 runs its POSCTL setpoint only in POSCTL, and restarts it from the vehicle's velocity until takeoff
-        est = self._est if mode == MAIN_POSCTL and st.landed_state != 1 else restart_estimate(st.vel_ned_m_s, now)
+        est = self._est if mode == MainMode.POSCTL and st.landed_state != 1 else restart_estimate(st.vel_ned_m_s, now)
         pilot, self._latched = interlock(to_manual(self.cmd), self._latched)  # it follows the stick in every phase
         if (not st.armed or self.phase not in PILOT_PHASES or self._joy_hold or self._joy.lost
                 or self.cmd.deadman_ok is False or st.pos_ned_m is None):
@@ -141,7 +133,7 @@ class ManualSession(SessionLoop):
             return CENTRED
         # landing by itself, the vehicle may go below --min-alt: a held throttle must not turn into a moving one
         fence = replace(self.fence, min_alt_m=-math.inf) if self.phase is Phase.LANDING else self.fence
-        out, self._est = limit_tracked(pilot, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, fence, mode == MAIN_ALTCTL,
+        out, self._est = limit_tracked(pilot, st.pos_ned_m, st.vel_ned_m_s, st.yaw_rad, fence, mode == MainMode.ALTCTL,
                                        est, now, self.model)
         return out
 
@@ -218,7 +210,7 @@ class ManualSession(SessionLoop):
         st = self.link.state
         lost_s = self._joy.lost_since
         if self._joy_hold and not self._hold_sent and lost_s is not None and now - lost_s >= STEADY_S:
-            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self.link.set_mode(MainMode.AUTO, AutoSubMode.LOITER)
             self._hold_sent = True
         if not st.armed:
             self._note(Level.WARN, "The vehicle disarmed: press ARM or TAKEOFF to fly again.")

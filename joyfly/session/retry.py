@@ -7,7 +7,8 @@ import math
 from collections.abc import Callable
 from enum import Enum
 
-from joyfly.link.vehicle_link import MAIN_AUTO, SUB_AUTO_LOITER, CommandHandle, VehicleLink, VehicleState
+from joyfly.link.vehicle_link import CommandHandle, VehicleLink, VehicleState
+from px4common.modes import AutoSubMode, MainMode
 
 # PX4 publishes the refusal STATUSTEXT in the same commander cycle as the ACK, but STATUSTEXT is a 20 Hz stream
 # (px4-behaviour.md 1.4), so the text may trail the ACK by up to 50 ms: wait a little before explaining.
@@ -135,7 +136,7 @@ class ExitPlan:
             return self.link.land()
         if self.on_exit == "rtl":
             return self.link.return_to_launch()
-        return self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+        return self.link.set_mode(MainMode.AUTO, AutoSubMode.LOITER)
 
     def done(self) -> bool:
         """Out of joyfly's mode (hold), or disarmed by a HEARTBEAT sent since the exit began (an ARM just sent may not

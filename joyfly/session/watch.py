@@ -6,10 +6,11 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from joyfly.link.vehicle_link import LINK_TIMEOUT_S, MAIN_AUTO, SUB_AUTO_LOITER
+from joyfly.link.vehicle_link import LINK_TIMEOUT_S
 from joyfly.session.core import STALE_S, STREAMING_PHASES, Level, Phase, SessionCore, restarted_message
 from joyfly.session.fence_watch import FenceChange, breach_message
 from joyfly.session.watchdogs import Change
+from px4common.modes import AutoSubMode, MainMode
 
 LINK_REMINDER_S = 30.0  # while the link stays lost, say so again this often (a silent wait looks like a hang)
 
@@ -85,7 +86,7 @@ class SessionWatch(SessionCore):
         elif action == "hold":
             self._note(Level.WARN, f"{where}: holding in AUTO.LOITER (--fence-action hold); press OFFBOARD to "
                                    f"{self.fly_again}.")
-            self.link.set_mode(MAIN_AUTO, SUB_AUTO_LOITER)
+            self.link.set_mode(MainMode.AUTO, AutoSubMode.LOITER)
             self._set_phase(Phase.PAUSED)
         elif action == "rtl":
             self._note(Level.WARN, f"{where}: returning to launch (--fence-action rtl).")

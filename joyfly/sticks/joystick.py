@@ -28,7 +28,6 @@ import select
 import stat
 from dataclasses import dataclass
 
-from joyfly.clock import WallClock
 from joyfly.sticks.js_events import (
     AXIS_MAX,
     EVENT_FORMAT,
@@ -52,6 +51,7 @@ from joyfly.sticks.js_events import (
 from joyfly.sticks.raw_capture import RawCapture
 from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
+from px4common.clock import WallClock
 
 __all__ = [  # the record format is re-exported: callers import the joystick side from here
     "AXIS_MAX", "EVENT_FORMAT", "EVENT_SIZE", "JS_EVENT_AXIS", "JS_EVENT_BUTTON", "JS_EVENT_INIT", "DeviceInfo",

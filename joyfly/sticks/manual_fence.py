@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 
 from joyfly.sticks.manual import ManualInput, from_throttle
 from joyfly.sticks.setpoints import Fence, Vec3
+from px4common import manual_defaults as px4
 
 G = 9.80665
 STICK_EPS = 1e-6
@@ -48,17 +49,18 @@ SNAP = 0.05  # a limited stick component this small (0.3 m/s^2 in POSCTL) is sen
 
 @dataclass(frozen=True, slots=True)
 class ManualModel:
-    """What PX4 does with the sticks (its parameter defaults) and the braking joyfly plans with."""
+    """What PX4 does with the sticks (its parameter defaults: px4common/manual_defaults.py) and the braking joyfly
+    plans with."""
 
-    vel_manual_m_s: float = 10.0  # MPC_VEL_MANUAL
-    acc_hor_m_s2: float = 3.0  # MPC_ACC_HOR
-    jerk_max_m_s3: float = 8.0  # MPC_JERK_MAX
-    tilt_max_deg: float = 35.0  # MPC_MAN_TILT_MAX
-    z_vel_up_m_s: float = 3.0  # MPC_Z_VEL_MAX_UP
-    z_vel_down_m_s: float = 1.5  # MPC_Z_VEL_MAX_DN
-    deadzone: float = 0.1  # MAN_DEADZONE
-    expo: float = 0.6  # the Sticks library's fixed expo (MPC_XY_MAN_EXPO / MPC_Z_MAN_EXPO's old default)
-    brake_acc_m_s2: float = 1.5  # planned deceleration: MPC_ACC_HOR / 2
+    vel_manual_m_s: float = px4.MPC_VEL_MANUAL
+    acc_hor_m_s2: float = px4.MPC_ACC_HOR
+    jerk_max_m_s3: float = px4.MPC_JERK_MAX
+    tilt_max_deg: float = px4.MPC_MAN_TILT_MAX
+    z_vel_up_m_s: float = px4.MPC_Z_VEL_MAX_UP
+    z_vel_down_m_s: float = px4.MPC_Z_VEL_MAX_DN
+    deadzone: float = px4.MAN_DEADZONE
+    expo: float = px4.STICK_EXPO
+    brake_acc_m_s2: float = px4.MPC_ACC_HOR / 2  # planned deceleration
     reaction_s: float = 1.2
     buffer_m: float = 0.5  # where the vehicle stops, inside the fence
     track_gain_1_s: float = 3.0  # how fast the stick pulls the speed to the allowance

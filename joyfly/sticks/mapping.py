@@ -18,13 +18,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from joyfly.clock import WallClock
 from joyfly.sticks.js_events import AXIS_MAX, JoystickError
 from joyfly.sticks.profiles import AxisMap, Profile, rest_problems
 from joyfly.sticks.sdl_mappings import SdlMappings
 from joyfly.sticks.sources import open_source, pick_profile
 from joyfly.sticks.virtual import record_to
 from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
+from px4common.clock import WallClock
 
 HOLD_EPS_S = 1e-6  # held times are float sums of poll intervals: 10 x 0.1 s must count as 1 s
 

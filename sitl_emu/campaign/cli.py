@@ -9,7 +9,8 @@ from typing import Any, NoReturn
 
 import click
 
-from sitl_emu.cli.options import SEED_MAX, FiniteRange, UserError, WholeRange
+from px4common.cli_style import FiniteRange, UserError, WholeRange
+from sitl_emu.cli.options import SEED_MAX
 
 __all__ = ["campaign"]
 

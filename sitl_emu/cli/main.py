@@ -16,21 +16,16 @@ from typing import TYPE_CHECKING, Any
 import click
 
 from flightview.options import view_options, view_settings
+from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
+from px4common.clock import SPEED_MAX, SPEED_MIN
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli.options import (
-    CONTEXT,
     MAX_SYSID,
     PORT_MAX,
     SEED_MAX,
-    SPEED_MAX,
-    SPEED_MIN,
     TOOL,
     VERSION_MESSAGE,
-    FiniteRange,
-    OneLineGroup,
     UsageProblem,
-    UserError,
-    WholeRange,
     check_host,
     check_instances,
     check_own_ports,
@@ -183,7 +178,7 @@ def _wind_option(text: str | None) -> WindSettings | None:
         raise UsageProblem(f"--wind: {err}") from None
 
 
-@click.group(name=TOOL, cls=OneLineGroup, context_settings=CONTEXT)
+@click.group(name=TOOL, cls=OneLineGroup, version_message=VERSION_MESSAGE, context_settings=CONTEXT)
 @click.version_option(package_name="joyfly", prog_name=TOOL, message=VERSION_MESSAGE)
 @click.option("-v", "--verbose", count=True, help="More log output (-v info, -vv debug).")
 @click.pass_context

@@ -1,13 +1,14 @@
 """The flight tasks, after PX4 src/modules/flight_mode_manager: one module per task, each turning a mode into setpoints.
 
-core.py (the shared machinery: inputs, settings, the base Task, FlightTaskAuto's core), auto.py (takeoff, hold,
-land, reposition: tasks/Auto with navigator takeoff.cpp, loiter.cpp, land.cpp), rtl.py (return: rtl_direct.cpp),
-mission.py (AUTO.MISSION flown from the navigator's items), orbit.py (tasks/Orbit), follow.py (tasks/AutoFollowTarget)
-with follow_estimator.py (its target estimator), manual.py (tasks/ManualAltitude, ManualPosition) with sticks.py
-(StickAccelerationXY, StickYaw, the expo curves), stabilized.py (Stabilized: sticks -> attitude and thrust),
-mode_executor.py (FlightModeManager: which task runs for the mode in force and which setpoint drives the controllers).
+core.py (the shared machinery: settings, the base Task, FlightTaskAuto's core; the tasks' input is
+navigator/setpoint.py's NavInput), auto.py (takeoff, hold, land, reposition: tasks/Auto with navigator takeoff.cpp,
+loiter.cpp, land.cpp), rtl.py (return: rtl_direct.cpp), mission.py (AUTO.MISSION flown from the navigator's items),
+orbit.py (tasks/Orbit), follow.py (tasks/AutoFollowTarget) with follow_estimator.py (its target estimator), manual.py
+(tasks/ManualAltitude, ManualPosition) with sticks.py (StickAccelerationXY, StickYaw, the expo curves), stabilized.py
+(Stabilized: sticks -> attitude and thrust), mode_executor.py (FlightModeManager: which task runs for the mode in
+force and which setpoint drives the controllers).
 
 May import: the kernel (px4, types, geo), params/, control/ (plain maths, takeoff state), motion_planning/,
-navigator/ (the plans, the mission progression, navigator requests), commander/manual_control.py (the centred
-sticks). Never vehicle/, mavlink/, runtime/, the faces, or a clock.
+navigator/ (the plans, the mission progression, navigator requests, NavInput), commander/manual_control.py (the
+centred sticks), px4common/manual_defaults.py. Never vehicle/, mavlink/, runtime/, the faces, or a clock.
 """

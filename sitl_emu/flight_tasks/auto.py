@@ -10,9 +10,10 @@ from __future__ import annotations
 import math
 
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight_tasks.core import AutoSettings, NavInput, SetpointType, Task, Waypoint
+from sitl_emu.flight_tasks.core import AutoSettings, Task, Waypoint
 from sitl_emu.flight_tasks.rtl import RtlTask
 from sitl_emu.motion_planning.smoothing import braking_distance
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3

@@ -1,4 +1,5 @@
-"""The shared machinery of the navigator tasks: inputs, settings, the base Task and PX4's FlightTaskAuto core.
+"""The shared machinery of the flight tasks: settings, the base Task and PX4's FlightTaskAuto core (their input,
+NavInput, and the setpoint types are the navigator's: navigator/setpoint.py).
 
 `AutoCore` turns a waypoint (type + target + yaw) into a smoothed trajectory setpoint the way PX4's
 `src/modules/flight_mode_manager/tasks/Auto/FlightTaskAuto.cpp` does: per-cycle trajectory constraints
@@ -14,14 +15,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import Enum
 from typing import Any, Final
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.control.takeoff import TakeoffState
-from sitl_emu.motion_planning.heading import HeadingSmoother
-from sitl_emu.motion_planning.heading import wrap_pi as wrap_pi  # the tasks import it from here
+from sitl_emu.motion_planning.heading import HeadingSmoother, wrap_pi
 from sitl_emu.motion_planning.smoothing import PositionSmoother
+from sitl_emu.navigator.setpoint import NO_FEEDFORWARD, NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
@@ -30,61 +30,6 @@ WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed 
 REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
 IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
-_NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
-
-
-class SetpointType(Enum):
-    """What drives the controllers: a navigator position_setpoint.type (IDLE, POSITION, TAKEOFF, LAND), the offboard
-    stream, or nothing (manual and termination modes, disarmed)."""
-
-    IDLE = "idle"
-    POSITION = "position"
-    TAKEOFF = "takeoff"
-    LAND = "land"
-    OFFBOARD = "offboard"
-    NONE = "none"
-
-
-@dataclass(slots=True)
-class NavInput:
-    """What the navigator tasks see of the vehicle, in the local NED frame (z = 0 is the ground at home).
-
-    `takeoff_state` is the control cascade's TakeoffHandling state: while it is before the ramp (disarmed, spoolup,
-    ready for takeoff) the trajectory is held at the vehicle, as PX4's FlightModeManager does; the default FLIGHT
-    disables that. `ref_alt_amsl_m` is the AMSL altitude of the local origin (only used for the RTL message, which
-    PX4 prints in AMSL).
-
-    Built on every tick, so not frozen and with its __init__ written out (the same as the generated one): a frozen
-    dataclass sets each field through object.__setattr__, and `make speedups` (mypyc) compiles only a written-out
-    __init__. Treat it as read-only.
-    """
-
-    time_us: int
-    pos_ned_m: Vec3
-    vel_ned_m_s: Vec3
-    yaw_rad: float
-    home_ned_m: Vec3
-    home_yaw_rad: float
-    landed: bool
-    armed: bool
-    takeoff_state: TakeoffState = TakeoffState.FLIGHT
-    ref_alt_amsl_m: float = 488.0
-    vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD  # the position controller's last velocity setpoint (NaN: none)
-
-    def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
-                 home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: TakeoffState = TakeoffState.FLIGHT,
-                 ref_alt_amsl_m: float = 488.0, vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD) -> None:
-        self.time_us = time_us
-        self.pos_ned_m = pos_ned_m
-        self.vel_ned_m_s = vel_ned_m_s
-        self.yaw_rad = yaw_rad
-        self.home_ned_m = home_ned_m
-        self.home_yaw_rad = home_yaw_rad
-        self.landed = landed
-        self.armed = armed
-        self.takeoff_state = takeoff_state
-        self.ref_alt_amsl_m = ref_alt_amsl_m
-        self.vel_sp_ned_m_s = vel_sp_ned_m_s
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,7 +134,7 @@ class AutoCore:
         if kind is SetpointType.IDLE:
             return self._idle(nav)
         self._set_constraints(nav, wp)
-        target, ff = wp.target_ned_m, _NO_FEEDFORWARD
+        target, ff = wp.target_ned_m, NO_FEEDFORWARD
         if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
         if wp.next_ned_m is not None and kind is SetpointType.POSITION:

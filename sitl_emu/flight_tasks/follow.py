@@ -23,11 +23,12 @@ from typing import Final
 
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import constrain, isfinite
-from sitl_emu.flight_tasks.core import NavInput, SetpointType, wrap_pi
 from sitl_emu.flight_tasks.follow_estimator import TargetEstimate, TargetEstimator, TargetFix
 from sitl_emu.flight_tasks.manual import TASK_PERIOD_US
 from sitl_emu.flight_tasks.sticks import stick_expo
+from sitl_emu.motion_planning.heading import wrap_pi
 from sitl_emu.motion_planning.smoothing import AxisSmoother, max_speed_from_distance
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, NAN3, ManualControlSetpoint, TrajectorySetpoint, Vec3

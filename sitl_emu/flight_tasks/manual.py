@@ -22,7 +22,6 @@ from typing import Final
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.control.takeoff import TakeoffState
-from sitl_emu.flight_tasks.core import NavInput, SetpointType
 from sitl_emu.flight_tasks.sticks import (
     FLT_EPSILON,
     NAN,
@@ -33,6 +32,7 @@ from sitl_emu.flight_tasks.sticks import (
     stick_tilt_acceleration,
 )
 from sitl_emu.motion_planning.smoothing import AxisSmoother
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import ManualControlSetpoint, TrajectorySetpoint

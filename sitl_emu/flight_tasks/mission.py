@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import math
 
-from sitl_emu.flight_tasks.core import NavInput, SetpointType, Task, Waypoint
+from sitl_emu.flight_tasks.core import Task, Waypoint
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.mission import MissionNavigator, MissionSettings, Setpoint
 from sitl_emu.navigator.mission_items import nav_items
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionStore
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 

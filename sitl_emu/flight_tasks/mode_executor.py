@@ -20,9 +20,7 @@ from dataclasses import dataclass
 
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight_tasks import auto as tasks
-from sitl_emu.flight_tasks import orbit as tasks_orbit
-from sitl_emu.flight_tasks.auto import SetpointType
+from sitl_emu.flight_tasks import auto, orbit
 from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
@@ -31,6 +29,7 @@ from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
 from sitl_emu.navigator.mission_store import MissionStore
+from sitl_emu.navigator.setpoint import SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import (
@@ -46,7 +45,7 @@ _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.A
                          NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
                          NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
 _STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
-FlightTask = tasks.Task | ManualAltitudeTask | tasks_orbit.FailedOrbitHold | FollowTargetTask
+FlightTask = auto.Task | ManualAltitudeTask | orbit.FailedOrbitHold | FollowTargetTask
 
 
 @dataclass(slots=True)
@@ -90,7 +89,7 @@ class ModeExecutor:
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
-        self.rtl_destination: Callable[[tasks.NavInput], tuple[Vec3, float] | None] | None = None
+        self.rtl_destination: Callable[[auto.NavInput], tuple[Vec3, float] | None] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
@@ -120,7 +119,7 @@ class ModeExecutor:
         if isinstance(self.task, FollowTargetTask):
             self.task.fix = fix
 
-    def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], tasks.NavInput],
+    def update(self, nav_state: NavState, armed: bool, now_us: int, nav_fn: Callable[[], auto.NavInput],
                commands: list[NavCommand], ref: GeoRef, dt_s: float,
                sticks: ManualControlSetpoint = CENTRED) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts); `sticks`
@@ -137,7 +136,7 @@ class ModeExecutor:
             return _NO_SETPOINT
         return self._run_task(self.task, now_us, nav_fn, dt_s, new_task, sticks)
 
-    def _stick_attitude(self, armed: bool, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
+    def _stick_attitude(self, armed: bool, nav_fn: Callable[[], auto.NavInput], dt_s: float,
                         sticks: ManualControlSetpoint) -> ExecutorOutput:
         """STABILIZED / MANUAL: the sticks' attitude and thrust, every tick (mc_att_control)."""
         if not armed:
@@ -149,7 +148,7 @@ class ModeExecutor:
         self._stabilized.sticks = sticks
         return ExecutorOutput(None, self._stabilized.update(nav, dt_s), SetpointType.NONE, False, ())
 
-    def _run_task(self, task: FlightTask, now_us: int, nav_fn: Callable[[], tasks.NavInput], dt_s: float,
+    def _run_task(self, task: FlightTask, now_us: int, nav_fn: Callable[[], auto.NavInput], dt_s: float,
                   new_task: bool, sticks: ManualControlSetpoint) -> ExecutorOutput:
         """The task's setpoint, computed every task.period_us (the last one is held in between)."""
         held = self._held
@@ -176,7 +175,7 @@ class ModeExecutor:
         return ExecutorOutput(None, self._offboard_att, SetpointType.OFFBOARD, False, ())
 
     # ---- task selection -----------------------------------------------------------------------------------------
-    def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], tasks.NavInput],
+    def _select_task(self, nav_state: NavState, armed: bool, nav_fn: Callable[[], auto.NavInput],
                      commands: list[NavCommand], ref: GeoRef) -> bool:
         """Start the task the mode (or a command) asks for; True if a new task started.
 
@@ -207,7 +206,7 @@ class ModeExecutor:
         commands.clear()
         return None if last.kind is NavCommandKind.TAKEOFF else last
 
-    def _start_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
+    def _start_task(self, nav_state: NavState, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
         takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
         if self._task_mode is NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
@@ -219,7 +218,7 @@ class ModeExecutor:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
             destination = self.rtl_destination(nav) if self.rtl_destination else None
-            self.task = tasks.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
+            self.task = auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
         elif nav_state is NavState.AUTO_MISSION:
             self.task = self._make_mission(nav, ref)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
@@ -232,9 +231,9 @@ class ModeExecutor:
             self.task = follow = FollowTargetTask(nav, self.params)
             follow.fix = self._target_fix
         else:
-            self.task = tasks.make_land(nav, self.params)
+            self.task = auto.make_land(nav, self.params)
 
-    def _mission_loiter(self, nav: tasks.NavInput) -> Vec3 | None:
+    def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus
         NAV_LOITER_RAD: navigator_main.cpp is_established_on_loiter), for RTL's climb."""
         task = self.task
@@ -242,30 +241,29 @@ class ModeExecutor:
             return None
         return task.loiter_point(nav)
 
-    def _make_mission(self, nav: tasks.NavInput, ref: GeoRef) -> tasks.Task:
+    def _make_mission(self, nav: auto.NavInput, ref: GeoRef) -> auto.Task:
         if self.missions is None:
             self.missions = MissionFlight(MissionStore())
         return MissionTask(nav, self.params, self.missions, ref, ref.alt_amsl_m - nav.home_ned_m[2])
-    def _orbit(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> FlightTask:
-        """The orbit flight task with a DO_ORBIT applied (tasks_orbit.apply_orbit)."""
-        task = self.task if isinstance(self.task, tasks_orbit.OrbitFlight) else None
-        orbit = command if command is not None and command.kind is NavCommandKind.ORBIT else None
-        return tasks_orbit.apply_orbit(task if self._task_mode is NavState.ORBIT else None, orbit, nav, self.params,
-                                       ref)
+    def _orbit(self, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef) -> FlightTask:
+        """The orbit flight task with a DO_ORBIT applied (orbit.apply_orbit)."""
+        task = self.task if isinstance(self.task, orbit.OrbitFlight) else None
+        do_orbit = command if command is not None and command.kind is NavCommandKind.ORBIT else None
+        return orbit.apply_orbit(task if self._task_mode is NavState.ORBIT else None, do_orbit, nav, self.params, ref)
 
     def orbit_status(self, ref: GeoRef) -> OrbitStatus | None:
         """orbit_status while the orbit flight task runs (ORBIT_EXECUTION_STATUS), else None."""
         task = self.task
-        return task.status(ref) if isinstance(task, tasks_orbit.OrbitTask) else None
+        return task.status(ref) if isinstance(task, orbit.OrbitTask) else None
 
-    def _make_takeoff(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> tasks.Task:
+    def _make_takeoff(self, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef) -> auto.Task:
         alt_up: float | None = None
         if command is not None and command.kind is NavCommandKind.TAKEOFF and isfinite(command.alt_amsl_m):
             alt_up = command.alt_amsl_m - ref.alt_amsl_m  # param7 is AMSL; the local origin is at ref altitude
-        return tasks.make_takeoff(nav, self.params, alt_up)
+        return auto.make_takeoff(nav, self.params, alt_up)
 
-    def _make_loiter(self, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
-                     takeoff_target: Vec3 | None) -> tasks.Task:
+    def _make_loiter(self, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef,
+                     takeoff_target: Vec3 | None) -> auto.Task:
         moves = (NavCommandKind.REPOSITION, NavCommandKind.CHANGE_ALTITUDE)
         if command is not None and command.kind in moves and nav.armed:
             target = _command_target(command, nav, ref)
@@ -274,13 +272,13 @@ class ModeExecutor:
             # navigator_main.cpp); a change of altitude keeps the current heading.
             keep = nav.yaw_rad if command.kind is NavCommandKind.CHANGE_ALTITUDE else math.nan
             yaw = command.yaw_rad if isfinite(command.yaw_rad) else keep
-            return tasks.make_reposition(nav, self.params, target, yaw, speed)
+            return auto.make_reposition(nav, self.params, target, yaw, speed)
         if takeoff_target is not None:
-            return tasks.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
-        return tasks.make_loiter(nav, self.params)
+            return auto.make_loiter(nav, self.params, hold_at_ned_m=takeoff_target)
+        return auto.make_loiter(nav, self.params)
 
 
-def _command_target(command: NavCommand, nav: tasks.NavInput, ref: GeoRef) -> Vec3:
+def _command_target(command: NavCommand, nav: auto.NavInput, ref: GeoRef) -> Vec3:
     """The reposition target in NED; NaN lat/lon/alt keep the current position's component."""
     x, y, z = nav.pos_ned_m
     if isfinite(command.lat_deg) and isfinite(command.lon_deg):

@@ -25,13 +25,13 @@ from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.control.qmath import constrain, isfinite
-from sitl_emu.flight_tasks.core import NavInput, SetpointType
 from sitl_emu.flight_tasks.manual import TASK_PERIOD_US, ManualAltitudeTask, ManualSettings, VerticalSmoothing
 from sitl_emu.flight_tasks.sticks import stick_expo
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.motion_planning.heading import HeadingSmoother
 from sitl_emu.motion_planning.smoothing import PositionSmoother
 from sitl_emu.navigator.commands import NavCommand
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, NAN3, OrbitStatus, TrajectorySetpoint, Vec3

@@ -14,7 +14,8 @@ import struct
 from enum import Enum
 from typing import Final
 
-from sitl_emu.flight_tasks.core import NavInput, SetpointType, Task, Waypoint
+from sitl_emu.flight_tasks.core import Task, Waypoint
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, Vec3

@@ -18,8 +18,8 @@ from typing import Final
 
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import constrain, isfinite, q_from_yaw, q_mul
-from sitl_emu.flight_tasks.core import NavInput
 from sitl_emu.flight_tasks.sticks import NAN, StickYaw, stick_expo
+from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import AttitudeSetpoint, ManualControlSetpoint, Vec4
 

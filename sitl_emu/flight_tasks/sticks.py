@@ -17,9 +17,9 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
+from px4common.manual_defaults import STICK_EXPO
 from sitl_emu.control.qmath import constrain, isfinite
 
-STICK_EXPO: Final = 0.6
 FLT_EPSILON: Final = 1.1920929e-07
 GRAVITY: Final = 9.80665
 NAN: Final = math.nan

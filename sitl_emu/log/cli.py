@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from sitl_emu.cli.options import UserError
+from px4common.cli_style import UserError
 from sitl_emu.log.summary import LogError, LogSummary, format_summary, read_ulog, summarise
 
 __all__ = ["log"]

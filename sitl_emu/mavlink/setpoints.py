@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.mavlink.telemetry.messages import rotate_body_to_ned
 from sitl_emu.px4 import MavFrame
 from sitl_emu.types import AttitudeSetpoint, OffboardControlMode, TrajectorySetpoint, Vec3, VehicleSnapshot
@@ -35,9 +36,6 @@ POS_MASK, VEL_MASK, ACC_MASK = 7, 56, 448
 # ATTITUDE_TARGET_TYPEMASK
 ROLL_RATE_IGNORE, PITCH_RATE_IGNORE, YAW_RATE_IGNORE_ATT = 1, 2, 4
 THRUST_BODY_SET, THROTTLE_IGNORE, ATTITUDE_IGNORE = 32, 64, 128
-
-EARTH_RADIUS_M = 6371000.0  # CONSTANTS_RADIUS_OF_EARTH (lib/geo)
-
 
 @dataclass(frozen=True, slots=True)
 class Decoded:
@@ -85,7 +83,8 @@ def decode_global_int(msg: dialect.MAVLink_set_position_target_global_int_messag
         z = _global_z(frame, float(msg.alt), snap)
         if z is None:
             return DROPPED
-        x, y = project(snap.ref_lat_deg, snap.ref_lon_deg, msg.lat_int * 1e-7, msg.lon_int * 1e-7)
+        ref = GeoRef(snap.ref_lat_deg, snap.ref_lon_deg, snap.ref_alt_amsl_m)  # PX4's MapProjection::project
+        x, y, _ = global_to_ned(ref, msg.lat_int * 1e-7, msg.lon_int * 1e-7, snap.ref_alt_amsl_m)
         pos_ned = _finite((x, y, z))
     vel = _masked((msg.vx, msg.vy, msg.vz), mask, 3)
     acc = _masked((msg.afx, msg.afy, msg.afz), mask, 6)
@@ -114,19 +113,6 @@ def decode_attitude_target(msg: dialect.MAVLink_set_attitude_target_message) -> 
                                 body_rates_rad_s=rates, thrust_body=thrust)
     mode = OffboardControlMode(attitude=bool(use_attitude), body_rate=bool(use_rates))
     return Decoded(mode=mode, attitude=setpoint)
-
-
-def project(ref_lat_deg: float, ref_lon_deg: float, lat_deg: float, lon_deg: float) -> tuple[float, float]:
-    """Azimuthal equidistant projection around the reference (PX4 lib/geo MapProjection::project), metres N/E."""
-    lat, lon = math.radians(lat_deg), math.radians(lon_deg)
-    rlat, rlon = math.radians(ref_lat_deg), math.radians(ref_lon_deg)
-    cos_dlon = math.cos(lon - rlon)
-    arg = max(-1.0, min(1.0, math.sin(rlat) * math.sin(lat) + math.cos(rlat) * math.cos(lat) * cos_dlon))
-    c = math.acos(arg)
-    k = 1.0 if abs(c) < 1e-12 else c / math.sin(c)
-    x = k * (math.cos(rlat) * math.sin(lat) - math.sin(rlat) * math.cos(lat) * cos_dlon) * EARTH_RADIUS_M
-    y = k * math.cos(lat) * math.sin(lon - rlon) * EARTH_RADIUS_M
-    return x, y
 
 
 def _trajectory(name: str, mask: int, pos: Vec3, vel: Vec3, acc: Vec3, yaw: float, yaw_rate: float) -> Decoded:

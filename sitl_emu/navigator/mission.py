@@ -23,8 +23,9 @@ import math
 from dataclasses import dataclass, field
 from enum import Enum
 
-from sitl_emu.flight_tasks.core import NavInput, SetpointType, wrap_pi
+from sitl_emu.motion_planning.heading import wrap_pi
 from sitl_emu.navigator.mission_items import Kind, NavItem
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.px4 import MavCmd, Severity
 from sitl_emu.types import NAN, Vec3
 

@@ -14,7 +14,7 @@
   reference) gives every listed parameter PX4's minimum, maximum and unit where PX4 states them, and a one-line
   description in our own words. A parameter only in PX4's list takes its range and unit from there (a bound PX4 does
   not state is the type's: an int32, or a finite float32). A defined one keeps the range and unit of its definition,
-  which must agree with PX4's where PX4 states them (tests/sitl_emu/test_params_meta.py); every listed parameter's
+  which must agree with PX4's where PX4 states them (tests/sitl_emu/params/test_meta.py); every listed parameter's
   description is the data file's.
 - The registry refuses a value outside the range (registry.py), as it does for the defined parameters; PX4 itself
   stores any value a client sends. No PX4 SITL default lies outside PX4's stated range (tested), so a client that

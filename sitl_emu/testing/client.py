@@ -3,7 +3,7 @@
 `FlightClient` behaves like an offboard companion: it talks first (so the vehicle's API link latches it), sends a
 HEARTBEAT every second, streams the current position setpoint at 20 Hz while one is set, and waits only through
 its clock. With `Sim.clock` (lockstep) a whole flight runs as fast as the CPU allows and is reproducible; with a
-`ScaledWallClock(speed)` the same script flies `sitl-emu serve --speed speed` in another process.
+`px4common.clock.ScaledClock(speed)` the same script flies `sitl-emu serve --speed speed` in another process.
 
 `fly_square()` is the reference flight of the tests and the benchmark: wait until healthy, arm, take off, OFFBOARD
 square (PX4's rule: setpoints stream before the switch, reference 4.2), land, wait for the auto-disarm.

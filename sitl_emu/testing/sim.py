@@ -38,7 +38,7 @@ from sitl_emu.runtime.swarm import DEFAULT_HOME, DEFAULT_SPACING_M, SwarmRunner,
 from sitl_emu.runtime.timeline import Timeline
 from sitl_emu.vehicle.vehicle import Vehicle
 
-__all__ = ["LockstepClock", "ScaledWallClock", "Sim", "VehiclePorts"]
+__all__ = ["LockstepClock", "Sim", "VehiclePorts"]  # a wall clock sped up: px4common.clock.ScaledClock
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,25 +63,6 @@ class LockstepClock:
     def sleep(self, seconds: float) -> None:
         if seconds > 0:
             self._sim.advance_to(self._sim.time_us + round(seconds * 1e6))
-
-
-class ScaledWallClock:
-    """Wall time x `speed`, for a client in another thread or process paired with a vehicle run at that speed.
-
-    joyfly.clock.ScaledClock is its twin on purpose: sitl_emu never imports joyfly, and joyfly imports sitl_emu only
-    to run the demo's emulator (ARCHITECTURE.md).
-    """
-
-    def __init__(self, speed: float = 1.0) -> None:
-        self.speed = float(speed)
-        self._t0 = time.monotonic()
-
-    def now(self) -> float:
-        return (time.monotonic() - self._t0) * self.speed
-
-    def sleep(self, seconds: float) -> None:
-        if seconds > 0:
-            time.sleep(seconds / self.speed)
 
 
 class Sim:

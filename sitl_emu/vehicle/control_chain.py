@@ -13,9 +13,10 @@ from typing import Final
 from sitl_emu.commander.commander import Commander
 from sitl_emu.control.cascade import MulticopterControl
 from sitl_emu.control.qmath import isfinite, norm, yaw_from_q
-from sitl_emu.flight_tasks.core import IDLE_ACC_Z_M_S2, NavInput, SetpointType
+from sitl_emu.flight_tasks.core import IDLE_ACC_Z_M_S2
 from sitl_emu.flight_tasks.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.geo import GeoRef
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.params.settings import cascade_settings
 from sitl_emu.physics import RigidBodyState

@@ -14,7 +14,6 @@ from collections.abc import Callable
 
 from sitl_emu.commander.commander import Commander
 from sitl_emu.control.qmath import isfinite
-from sitl_emu.flight_tasks.core import NavInput
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
 from sitl_emu.navigator.geofence import (
@@ -28,6 +27,7 @@ from sitl_emu.navigator.geofence import (
 from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
 from sitl_emu.navigator.rally import choose_destination
+from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import Vec3

@@ -28,10 +28,10 @@ from sitl_emu.commander.commands import handle_command
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
 from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
-from sitl_emu.flight_tasks.core import NavInput, SetpointType
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.mission_store import MissionStore
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig

@@ -16,13 +16,13 @@ from support.sdl_virtual import VirtualPad
 
 from joyfly.cli_calibrate import TerminalConsole
 from joyfly.cli_joystick import joystick
-from joyfly.clock import WallClock
 from joyfly.sticks.calibrate import Wizard
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sources import open_source
 from joyfly.sticks.user_profiles import load_user_profiles, profile_toml, write_user_profile
 from joyfly.types import Action
+from px4common.clock import WallClock
 
 # a stick with its axes in an odd order: throttle on 3 (centred), yaw 0, pitch 2 (forward = negative), roll 1
 #  (right = negative: reversed)

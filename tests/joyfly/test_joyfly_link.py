@@ -11,10 +11,10 @@ from pymavlink.dialects.v20 import common as mavlink2
 from support.joyfly_fakes import FakeVehicle, WallStepper
 from support.joyfly_sim import SimClock, memory_pair
 
-from joyfly.clock import WallClock
 from joyfly.link.transport import TransportError, UdpTransport, open_transport, parse_udp_url
-from joyfly.link.vehicle_link import VehicleLink, is_offboard, mode_name
+from joyfly.link.vehicle_link import VehicleLink, VehicleState
 from joyfly.sticks.setpoints import Setpoint
+from px4common.clock import WallClock
 
 
 def test_mavros_style_url_gives_bind_and_remote() -> None:
@@ -68,12 +68,12 @@ def test_udpin_waits_for_the_vehicle_before_sending() -> None:
         transport.close()
 
 
-def test_mode_names_follow_px4_custom_mode() -> None:
-    assert mode_name(6 << 16) == "OFFBOARD" and is_offboard(393216)
-    assert mode_name(50593792) == "AUTO.LOITER"
-    assert mode_name(84148224) == "AUTO.RTL"
-    assert mode_name(100925440) == "AUTO.LAND"
-    assert mode_name(99 << 16) == f"CMODE({99 << 16})"
+def test_the_vehicle_state_names_px4_custom_mode() -> None:
+    offboard = VehicleState(last_heartbeat_s=0.0, custom_mode=6 << 16)
+    assert offboard.mode == "OFFBOARD" and offboard.offboard
+    loiter = VehicleState(last_heartbeat_s=0.0, custom_mode=50593792)
+    assert loiter.mode == "AUTO.LOITER" and not loiter.offboard
+    assert VehicleState(custom_mode=6 << 16).mode == "-"  # no heartbeat yet
 
 
 def test_over_udp_link_finds_the_vehicle_and_tracks_its_state() -> None:

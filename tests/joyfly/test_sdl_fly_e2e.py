@@ -25,11 +25,11 @@ from support.calibration_user import CalibrationUser
 from support.ports import free_udp_port
 from support.sdl_virtual import RIGHT_X, RIGHT_Y, A, VirtualPad
 
-from joyfly.clock import WallClock
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
 from joyfly.sticks.calibrate import Wizard
 from joyfly.sticks.sources import open_source
 from joyfly.sticks.user_profiles import profile_toml, write_user_profile
+from px4common.clock import WallClock
 
 # the wizard's user: throttle on axis 3, yaw 0, pitch 2 (forward negative), roll 1 (right negative)
 GAMEPADISH = {"up": (3, -1.0, 0.0), "yaw": (0, 1.0, 0.0), "forward": (2, -1.0, 0.0), "right": (1, -1.0, 0.0)}

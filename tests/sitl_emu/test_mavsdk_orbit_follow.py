@@ -11,7 +11,9 @@ from typing import Any
 from support.mavsdk_waits import MAVSDK_SPEED, Session, connect
 from support.serve_process import load_mavsdk
 
-EARTH_M_PER_DEG = math.radians(1.0) * 6371000.0
+from sitl_emu.geo import EARTH_RADIUS_M
+
+EARTH_M_PER_DEG = math.radians(1.0) * EARTH_RADIUS_M
 
 
 def test_mavsdk_orbits_a_point_and_follows_a_target(mavsdk_port: int) -> None:

@@ -11,10 +11,11 @@ import time
 from collections.abc import Awaitable, Callable
 from typing import Any
 
+from sitl_emu.geo import EARTH_RADIUS_M
+
 MAVSDK_SPEED = 4.0  # the server's simulated seconds per wall second: MAVSDK retries commands after 0.5 s of wall time
 CALL_TIMEOUT_S = 20.0
 SESSION_CALL_TIMEOUT_S = 15.0  # no single call in a recorded Session may hang the test
-EARTH_RADIUS_M = 6371000.0
 
 
 async def call(awaitable: Awaitable[Any]) -> Any:

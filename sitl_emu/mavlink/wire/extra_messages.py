@@ -5,7 +5,7 @@ pymavlink bundles; these are the messages of the ground-station stream set (../s
 it lacks. Each is described here by its fields in XML order (name, MAVLink type, array length); from that we get what
 mavgen would: the wire order (fields sorted by type size, largest first, stable), the struct layout and the
 CRC_EXTRA seed (x25 checksum over "NAME " and each wire-ordered field's "type name " plus its array length).
-tests/sitl_emu/mavlink/test_extra_messages.py checks the seed algorithm against every pymavlink message and the
+tests/sitl_emu/mavlink/wire/test_extra_messages.py checks the seed algorithm against every pymavlink message and the
 seeds below against the published MAVLINK_MSG_ID_<NAME>_CRC values.
 
 `EXTRA.<name>_encode(...)` takes the fields in XML order (arrays as sequences) and returns a fastpack `Packed`, which

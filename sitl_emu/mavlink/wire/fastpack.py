@@ -14,8 +14,8 @@ objects; at ~700 messages per simulated second per vehicle that was most of the 
 The field order, struct layout and crc_extra come from the pymavlink message classes themselves, so the wire format is
 theirs. Each class gets two small functions generated from that metadata, mirroring pymavlink's own generated
 `pack()` expression term by term (arrays indexed element by element, char arrays passed whole), so bad values fail
-the same way (struct.error, IndexError...). tests/test_mavlink_fastpack.py checks the bytes against pymavlink for
-every message type the emulator sends.
+the same way (struct.error, IndexError...). tests/sitl_emu/mavlink/wire/test_fastpack.py checks the bytes against
+pymavlink for every message type the emulator sends.
 """
 
 from __future__ import annotations

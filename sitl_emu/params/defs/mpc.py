@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from px4common import manual_defaults as manual
 from sitl_emu.params.registry import ParamDef, integer, real
 
 _LIMITS: list[ParamDef] = [
     real("MPC_XY_VEL_MAX", 12.0, 0.0, 20.0, "m/s"),
-    real("MPC_Z_VEL_MAX_UP", 3.0, 0.5, 8.0, "m/s"),
-    real("MPC_Z_VEL_MAX_DN", 1.5, 0.5, 4.0, "m/s"),
+    real("MPC_Z_VEL_MAX_UP", manual.MPC_Z_VEL_MAX_UP, 0.5, 8.0, "m/s"),
+    real("MPC_Z_VEL_MAX_DN", manual.MPC_Z_VEL_MAX_DN, 0.5, 4.0, "m/s"),
     real("MPC_TILTMAX_AIR", 45.0, 20.0, 89.0, "deg"),
     real("MPC_TILTMAX_LND", 12.0, 5.0, 89.0, "deg"),
     real("MPC_THR_MIN", 0.12, 0.05, 0.5, "norm"),
@@ -18,7 +19,7 @@ _AUTO: list[ParamDef] = [
     real("MPC_XY_CRUISE", 5.0, 3.0, 20.0, "m/s"),
     real("MPC_Z_V_AUTO_UP", 3.0, 0.5, 8.0, "m/s"),
     real("MPC_Z_V_AUTO_DN", 1.5, 0.5, 4.0, "m/s"),
-    real("MPC_ACC_HOR", 3.0, 2.0, 15.0, "m/s^2"),
+    real("MPC_ACC_HOR", manual.MPC_ACC_HOR, 2.0, 15.0, "m/s^2"),
     real("MPC_JERK_AUTO", 4.0, 1.0, 80.0, "m/s^3"),
     real("MPC_YAWRAUTO_MAX", 60.0, 5.0, 360.0, "deg/s"),
     real("MPC_YAWRAUTO_ACC", 20.0, 5.0, 360.0, "deg/s^2"),
@@ -29,8 +30,8 @@ _AUTO: list[ParamDef] = [
 
 _MANUAL: list[ParamDef] = [
     real("MPC_ACC_HOR_MAX", 5.0, 2.0, 15.0, "m/s^2"),
-    real("MPC_JERK_MAX", 8.0, 0.5, 500.0, "m/s^3"),
-    real("MPC_VEL_MANUAL", 10.0, 3.0, 20.0, "m/s"),
+    real("MPC_JERK_MAX", manual.MPC_JERK_MAX, 0.5, 500.0, "m/s^3"),
+    real("MPC_VEL_MANUAL", manual.MPC_VEL_MANUAL, 3.0, 20.0, "m/s"),
     integer("MPC_POS_MODE", 4, 0, 4),
     real("MPC_ACC_UP_MAX", 4.0, 2.0, 15.0, "m/s^2"),
     real("MPC_ACC_DOWN_MAX", 3.0, 2.0, 15.0, "m/s^2"),

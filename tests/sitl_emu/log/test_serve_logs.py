@@ -16,9 +16,9 @@ from support import REPO_ROOT
 from support.log_flight import RecordingClient
 from support.ports import free_udp_ports
 
+from px4common.clock import ScaledClock
 from sitl_emu.mavlink.protocols.log import LIST_ALL
 from sitl_emu.px4 import MavCmd, MavResult
-from sitl_emu.testing.sim import ScaledWallClock
 
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")
 
@@ -32,7 +32,7 @@ def _serve(cwd: Path, *args: str) -> tuple[subprocess.Popen, RecordingClient]:
                              "--port", str(api), "--gcs-port", str(gcs), "--remote", f"127.0.0.1:{remote}", *args],
                             cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)})
-    client = RecordingClient(("127.0.0.1", api), ScaledWallClock(SPEED))
+    client = RecordingClient(("127.0.0.1", api), ScaledClock(SPEED))
     return proc, client
 
 

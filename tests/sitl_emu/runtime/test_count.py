@@ -16,9 +16,9 @@ import sys
 
 from support import REPO_ROOT
 
+from px4common.clock import ScaledClock
 from sitl_emu.px4 import MavCmd
 from sitl_emu.testing.client import FlightClient
-from sitl_emu.testing.sim import ScaledWallClock
 
 REPO = REPO_ROOT
 SPEED = 4.0
@@ -62,7 +62,7 @@ def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_ot
     gcs = _free_run(3, (api,))
     sink = _free_run(3, (api, gcs))
     proc = _serve_count(3, api, gcs, sink)
-    clock = ScaledWallClock(SPEED)
+    clock = ScaledClock(SPEED)
     clients = [FlightClient(("127.0.0.1", api + i), clock, target_sysid=i + 1) for i in range(3)]
     try:
         assert proc.stdout is not None

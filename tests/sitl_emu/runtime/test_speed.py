@@ -22,8 +22,9 @@ from pymavlink.dialects.v20 import development as dialect
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
+from px4common.clock import ScaledClock
 from sitl_emu.testing.client import FlightClient, fly_square
-from sitl_emu.testing.sim import ScaledWallClock, Sim
+from sitl_emu.testing.sim import Sim
 
 REPO = REPO_ROOT
 
@@ -54,7 +55,7 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
     try:
         assert proc.stdout is not None
         proc.stdout.readline()
-        client = FlightClient(("127.0.0.1", api), ScaledWallClock(20.0))
+        client = FlightClient(("127.0.0.1", api), ScaledClock(20.0))
         fast = fly_square(client)
         client.close()
     finally:

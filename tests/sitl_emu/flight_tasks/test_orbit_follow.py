@@ -9,12 +9,12 @@ import math
 
 import pytest
 
-from sitl_emu.flight_tasks.core import NavInput
 from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import STALE_US, TargetEstimator, TargetFix
 from sitl_emu.flight_tasks.orbit import FailedOrbitHold, OrbitSettings, OrbitTask, apply_orbit, sanitize
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
+from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import default_registry
 
 NAN = math.nan

@@ -10,7 +10,7 @@ import types
 import pytest
 from support.handler_ctx import FakeVehicle
 
-from sitl_emu.console import terminal as console_input
+from sitl_emu.console import terminal
 from sitl_emu.console.console import PROMPT, Console
 from sitl_emu.console.terminal import ReadlineInput, StreamInput, make_input
 from sitl_emu.px4 import Severity
@@ -210,9 +210,9 @@ class _FakeReadline(types.SimpleNamespace):
 
 def test_a_terminal_console_reads_through_readline(monkeypatch):
     fake = _FakeReadline()
-    monkeypatch.setattr(console_input, "_both_ttys", lambda: True)
-    monkeypatch.setattr(console_input, "_import_readline", lambda: fake)
-    monkeypatch.setattr(console_input, "is_foreground", lambda fd: True)
+    monkeypatch.setattr(terminal, "_both_ttys", lambda: True)
+    monkeypatch.setattr(terminal, "_import_readline", lambda: fake)
+    monkeypatch.setattr(terminal, "is_foreground", lambda fd: True)
     monkeypatch.setattr(sys.stdin, "fileno", lambda: 0, raising=False)
     reader = make_input(sys.stdin, sys.stdout, ["commander", "listener"], threading.Event())
     assert isinstance(reader, ReadlineInput) and reader.draws_prompt
@@ -232,14 +232,14 @@ def test_a_terminal_console_reads_through_readline(monkeypatch):
 
 
 def test_without_readline_the_terminal_is_read_line_by_line(monkeypatch):
-    monkeypatch.setattr(console_input, "_both_ttys", lambda: True)
+    monkeypatch.setattr(terminal, "_both_ttys", lambda: True)
     monkeypatch.setitem(sys.modules, "readline", None)  # import readline fails, as where it does not exist
     reader = make_input(sys.stdin, sys.stdout, ["ver"], threading.Event())
     assert isinstance(reader, StreamInput) and not reader.draws_prompt
 
 
 def test_other_streams_never_use_readline(monkeypatch):
-    monkeypatch.setattr(console_input, "_both_ttys", lambda: True)
+    monkeypatch.setattr(terminal, "_both_ttys", lambda: True)
     reader = make_input(io.StringIO("ver\n"), io.StringIO(), ["ver"], threading.Event())
     assert isinstance(reader, StreamInput)
     assert reader.read_line() == "ver" and reader.read_line() is None
@@ -248,9 +248,9 @@ def test_other_streams_never_use_readline(monkeypatch):
 @pytest.mark.parametrize("at_prompt", [True, False])
 def test_log_lines_go_above_the_readline_prompt(monkeypatch, at_prompt):
     fake = _FakeReadline()
-    monkeypatch.setattr(console_input, "_both_ttys", lambda: True)
-    monkeypatch.setattr(console_input, "_import_readline", lambda: fake)
-    monkeypatch.setattr(console_input, "is_foreground", lambda fd: True)
+    monkeypatch.setattr(terminal, "_both_ttys", lambda: True)
+    monkeypatch.setattr(terminal, "_import_readline", lambda: fake)
+    monkeypatch.setattr(terminal, "is_foreground", lambda fd: True)
     monkeypatch.setattr(sys.stdin, "fileno", lambda: 0, raising=False)
     out = io.StringIO()
     monkeypatch.setattr(sys, "stdout", out)

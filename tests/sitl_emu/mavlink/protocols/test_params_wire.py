@@ -27,7 +27,7 @@ from sitl_emu.params.catalog import EMULATOR_DEFAULTS
 from sitl_emu.params.registry import ParamType, float32, same_value
 from sitl_emu.vehicle.vehicle import Vehicle
 
-from ..test_params_registry import px4_list
+from ...params.test_registry import px4_list
 
 TYPE_NAMES = {MAV_PARAM_TYPE_INT32: "INT32", MAV_PARAM_TYPE_REAL32: "REAL32"}
 

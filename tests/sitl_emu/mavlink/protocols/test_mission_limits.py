@@ -2,7 +2,7 @@
 the largest mission PX4 stores (MAX_ITEMS, 10,000 items in mavlink_mission.cpp's dataman) uploaded item by item and
 one item past it refused with MAV_MISSION_NO_SPACE, the stored plan untouched; a client that vanishes after part of
 an upload leaves the previous plan whole (PX4 stores a plan only at the final item), and another link uploads after
-PX4's 5 s timeout. (Two links at once: test_mission_cases.py; in memory: test_mission_protocol.py.)
+PX4's 5 s timeout. (Two links at once: test_mission_cases.py; in memory: test_mission.py.)
 
 Run with -s to see the simulated and wall time of the 10,000-item upload.
 """

@@ -21,7 +21,7 @@ from support.fakes import Client, Harness
 from sitl_emu.mavlink.protocols.mission import MissionProtocol
 from sitl_emu.vehicle.vehicle import Vehicle
 
-CASES: dict[str, Any] = json.loads((Path(__file__).parents[2] / "reference" / "px4-mission" / "cases.json").read_text())
+CASES: dict[str, Any] = json.loads((Path(__file__).parents[3] / "reference" / "px4-mission" / "cases.json").read_text())
 PROTOCOL = ("MISSION_COUNT", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ITEM_INT", "MISSION_ITEM",
             "MISSION_ACK")
 ORDER = ("download.empty", "upload.valid", "download.valid", "bad.rtl_global_frame_zero_xy", "bad.count_zero",
