@@ -33,7 +33,7 @@ from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.mapping import open_sticks
-from joyfly.sticks.sdl_mappings import SdlMappings
+from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
 from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError

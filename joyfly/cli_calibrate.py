@@ -11,7 +11,7 @@ import click
 
 from joyfly.sticks.calibrate import Wizard
 from joyfly.sticks.js_events import JoystickError
-from joyfly.sticks.sdl_mappings import SdlMappings
+from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sources import open_source
 from joyfly.sticks.user_profiles import profile_dir, profile_toml, write_user_profile
 from px4common.clock import WallClock

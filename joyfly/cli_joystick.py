@@ -20,9 +20,9 @@ from joyfly.sticks.js_seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
 from joyfly.sticks.mapping import StickMapper
 from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
-from joyfly.sticks.sdl_list import sdl_lines
-from joyfly.sticks.sdl_mappings import SdlMappings
-from joyfly.sticks.sdl_source import SdlSource
+from joyfly.sticks.sdl.listing import sdl_lines
+from joyfly.sticks.sdl.mappings import SdlMappings
+from joyfly.sticks.sdl.source import SdlSource
 from joyfly.sticks.sources import open_source, pick_profile
 from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.sticks.virtual import TimedSource, record_to

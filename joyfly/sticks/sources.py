@@ -22,9 +22,9 @@ from typing import Any
 from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.js_seam import js_reader, open_js
 from joyfly.sticks.profiles import BUILTIN, ROLES, Profile, apply_overrides, load_profile
-from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
-from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings
-from joyfly.sticks.sdl_source import LIST_HINT, SDL_PREFIX, SdlSource, choose_device
+from joyfly.sticks.sdl.api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
+from joyfly.sticks.sdl.mappings import SdlMappings, apply_mappings
+from joyfly.sticks.sdl.source import LIST_HINT, SDL_PREFIX, SdlSource, choose_device
 from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.types import Clock, JoystickSource
 

@@ -17,7 +17,7 @@ from support import REPO_ROOT
 from support.sdl_virtual import RIGHT_Y, VirtualPad
 
 from joyfly.cli_joystick import joystick
-from joyfly.sticks.sdl_api import sdl_api
+from joyfly.sticks.sdl.api import sdl_api
 
 
 @pytest.fixture

@@ -13,9 +13,9 @@ from support.sdl_virtual import BACK, LEFT_Y, RIGHT_X, RIGHT_Y, START, A, Virtua
 
 from joyfly.sticks.joystick import JoystickError
 from joyfly.sticks.mapping import open_sticks
-from joyfly.sticks.sdl_api import SdlUnavailable, sdl_api
-from joyfly.sticks.sdl_mappings import SdlMappings
-from joyfly.sticks.sdl_source import SdlSource
+from joyfly.sticks.sdl.api import SdlUnavailable, sdl_api
+from joyfly.sticks.sdl.mappings import SdlMappings
+from joyfly.sticks.sdl.source import SdlSource
 from joyfly.sticks.sources import open_source
 from joyfly.types import Action
 

@@ -21,7 +21,7 @@ import time
 from collections.abc import Callable, Sequence
 
 from joyfly.sticks.js_events import DeviceVanishedError, JoystickError, NoDeviceError
-from joyfly.sticks.sdl_api import Hotplug, Opened, SdlApi, SdlDevice
+from joyfly.sticks.sdl.api import Hotplug, Opened, SdlApi, SdlDevice
 from joyfly.types import Clock, JoyState
 
 log = logging.getLogger(__name__)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
-from joyfly.sticks.sdl_api import MappingError
+from joyfly.sticks.sdl.api import MappingError
 
 ENV_VAR = "SDL_GAMECONTROLLERCONFIG"
 

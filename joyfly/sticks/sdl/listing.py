@@ -7,9 +7,9 @@ from collections.abc import Callable
 
 from joyfly.sticks.js_events import JoystickError
 from joyfly.sticks.profiles import load_profile
-from joyfly.sticks.sdl_api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
-from joyfly.sticks.sdl_mappings import SdlMappings, apply_mappings
-from joyfly.sticks.sdl_source import GAME_CONTROLLER_TAG
+from joyfly.sticks.sdl.api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
+from joyfly.sticks.sdl.mappings import SdlMappings, apply_mappings
+from joyfly.sticks.sdl.source import GAME_CONTROLLER_TAG
 from joyfly.sticks.sources import own_profile
 from joyfly.sticks.user_profiles import find_user_profile
 
