@@ -6,7 +6,7 @@ For each flip it takes the wall time just before the event and the wall time jus
 first SET_POSITION_TARGET_LOCAL_NED whose velocity feed-forward shows the new stick.
   js:  a FIFO joystick (the js API's records); the event is the write of the js_event to the FIFO.
   sdl: an SDL virtual game controller (read by SDL exactly like hardware); the event is SDL_JoystickSetVirtualAxis,
-       and joyfly's thread pumps SDL's events (joyfly/sticks/sdl_source.py).
+       and joyfly's thread pumps SDL's events (joyfly/sticks/sdl/source.py).
 
     .venv/bin/python bench/joyfly_latency.py [--events 300] [--only js|sdl]
 """

@@ -113,7 +113,7 @@ BUILTIN: tuple[Profile, ...] = (
     Profile("script", "joyfly virtual script joystick (values already in the flying convention)", ("joyfly script",),
             {role: AxisMap(i, deadzone=0.0) for i, role in enumerate(STICK_ROLES)},
             {**_buttons(arm=0, takeoff=1, land=2, ret=3, hold=4, offboard=5)}),
-    # SDL's standard game-controller layout (joyfly/sticks/sdl_api.py): axes 0 LX, 1 LY, 2 RX, 3 RY, 4 LT, 5 RT;
+    # SDL's standard game-controller layout (joyfly/sticks/sdl/api.py): axes 0 LX, 1 LY, 2 RX, 3 RY, 4 LT, 5 RT;
     # buttons 0 A, 1 B, 2 X, 3 Y, 4 Back, 5 Guide, 6 Start. Any pad SDL's database (or a mapping) knows flies with it.
     Profile("sdl-gamecontroller", "any game controller read through SDL, in SDL's standard layout",
             ("*(sdl game controller)",), _mode2(lx=0, ly=1, rx=2, ry=3),

@@ -1,5 +1,5 @@
 """The seam between joyfly and SDL2 (pysdl2 over the SDL 2.32 library from pysdl2-dll): every SDL call joyfly makes
-goes through `SdlApi`, so the SDL source (joyfly/sticks/sdl_source.py) can be driven by SDL's own virtual joysticks
+goes through `SdlApi`, so the SDL source (joyfly/sticks/sdl/source.py) can be driven by SDL's own virtual joysticks
 in tests, and a machine without a loadable SDL gets one sentence (`SdlUnavailable`) instead of a traceback.
 
 SDL runs headless here: only the joystick and game-controller subsystems are started (no video, no window), with

@@ -1,6 +1,6 @@
 """Joysticks and game controllers read through SDL2, as QGroundControl, MAVProxy and ROS 2's joy do: `--joy sdl`
 (the first game controller), `--joy sdl:N` (SDL's device index), `--joy sdl:NAME` (a case-insensitive part of the
-name). `SdlSource` meets joyfly.types.JoystickSource; the SDL calls go through joyfly/sticks/sdl_api.py.
+name). `SdlSource` meets joyfly.types.JoystickSource; the SDL calls go through joyfly/sticks/sdl/api.py.
 
 A game controller (SDL's database or a user mapping knows it) reads in SDL's standard layout, which the one
 built-in profile `sdl-gamecontroller` flies; its source name ends in GAME_CONTROLLER_TAG, so a --record recording
@@ -61,7 +61,7 @@ def choose_device(devices: Sequence[SdlDevice], spec: str) -> tuple[SdlDevice, s
 
 
 class SdlSource:
-    """One SDL device, read as a JoyState (see joyfly/sticks/sdl_api.py for the layout)."""
+    """One SDL device, read as a JoyState (see joyfly/sticks/sdl/api.py for the layout)."""
 
     def __init__(self, api: SdlApi, device: SdlDevice, clock: Clock, why: str = "",
                  sleep: Callable[[float], None] = time.sleep,
