@@ -6,7 +6,7 @@ For each flip it takes the wall time just before the event and the wall time jus
 first SET_POSITION_TARGET_LOCAL_NED whose velocity feed-forward shows the new stick.
   js:  a FIFO joystick (the js API's records); the event is the write of the js_event to the FIFO.
   sdl: an SDL virtual game controller (read by SDL exactly like hardware); the event is SDL_JoystickSetVirtualAxis,
-       and joyfly's thread pumps SDL's events (joyfly/sticks/sdl_source.py).
+       and joyfly's thread pumps SDL's events (joyfly/sticks/sdl/source.py).
 
     .venv/bin/python bench/joyfly_latency.py [--events 300] [--only js|sdl]
 """
@@ -31,9 +31,9 @@ from joyfly.demo import EmbeddedVehicle
 from joyfly.link.transport import UdpTransport
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
-from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.mapping import MappedSource, open_sticks
-from joyfly.sticks.sdl_api import sdl_api
+from joyfly.sticks.sdl.api import sdl_api
 from joyfly.sticks.setpoints import Setpoint
 from px4common.clock import WallClock
 

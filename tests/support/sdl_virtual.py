@@ -12,7 +12,7 @@ from __future__ import annotations
 import ctypes
 from typing import Any
 
-from joyfly.sticks.sdl_api import sdl_api
+from joyfly.sticks.sdl.api import sdl_api
 
 # SDL_GameControllerButton numbers of the standard layout
 A, B, X, Y, BACK, GUIDE, START = range(7)
