@@ -20,7 +20,6 @@ from flightview.options import view_options, view_settings
 from joyfly.cli.joystick import joystick
 from joyfly.config import BOUNDS, CONTROLS, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
-from joyfly.link.signing_key import SigningKeyError, read_signing_key
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
@@ -38,6 +37,7 @@ from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
 from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
 from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
+from px4common.signing_key import SigningKeyError, read_signing_key
 
 TOOL = "joyfly"
 D = FlyOptions()
