@@ -66,6 +66,9 @@ class AxisMap:
 
 @dataclass(frozen=True, slots=True)
 class Profile:
+    """A controller's layout: the device names (and SDL GUIDs) it fits, which axis flies which role, which button
+    does which action, and how long the arm button is held."""
+
     name: str
     description: str
     match: tuple[str, ...]  # fnmatch patterns on the lower-cased js device name
