@@ -74,7 +74,7 @@ class FlyOptions:
     sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl_mappings.py)
     mappings: tuple[str, ...] = ()  # SDL mapping lines from the config file's `mappings` list
     rumble: bool = True  # rumble pulses on a pad that has them (sticks/rumble.py); --no-rumble
-    signing_key: str | None = None  # MAVLink 2 signing key file (joyfly/link/signing.py)
+    signing_key: str | None = None  # MAVLink 2 signing key file (px4common/signing_key.py)
     setup_signing: bool = False  # give the vehicle the key with SETUP_SIGNING
 
     def session_settings(self, **extra: Any) -> SessionSettings:
