@@ -71,7 +71,7 @@ class FlyOptions:
     joy_timeout: float = 5.0  # s
     connect_timeout: float = 15.0  # s
     speed: float = 1.0  # the emulator's speed factor (sitl-emu serve --speed): joyfly's timing follows it
-    sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl_mappings.py)
+    sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl/mappings.py)
     mappings: tuple[str, ...] = ()  # SDL mapping lines from the config file's `mappings` list
     rumble: bool = True  # rumble pulses on a pad that has them (sticks/rumble.py); --no-rumble
     signing_key: str | None = None  # MAVLink 2 signing key file (px4common/signing_key.py)

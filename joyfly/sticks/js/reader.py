@@ -12,7 +12,7 @@
 Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (without raw:
 joyfly takes no file for a joystick), a directory, a character device that answers neither the js ioctls nor is a
 pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer. What a FIFO, a pty or a device sends
-is checked record by record (js_events.JsStreamCheck): the first one joydev never writes stops the reading for good
+is checked record by record (events.JsStreamCheck): the first one joydev never writes stops the reading for good
 (`gone`: before take-off the session ends with that sentence; in flight it is a lost joystick). For a FIFO the counts
 grow as events arrive and the name is the path.
 """

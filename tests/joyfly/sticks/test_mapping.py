@@ -39,7 +39,7 @@ def test_invert_and_scale():
 
 @dataclass(frozen=True)
 class Pad:
-    """A controller's hardware layout as reference/joystick.md 1C-2 describes it (independent of profiles.py)."""
+    """A controller's hardware layout as reference/joystick.md 1C-2 describes it (not read from profile.py)."""
 
     name: str  # the js name the kernel reports
     lx: int
