@@ -20,7 +20,7 @@ from typing import Final
 
 from sitl_emu.control.control_math import add_if_not_nan3, bodyz_to_attitude, constrain_xy, limit_tilt
 from sitl_emu.control.filters import LowPassDerivative
-from sitl_emu.control.qmath import constrain, emult, isfinite, norm, normalized, scale, sub
+from sitl_emu.control.qmath import at_least, at_most, constrain, emult, isfinite, norm, normalized, scale, sub
 from sitl_emu.types import TrajectorySetpoint, Vec3, Vec4
 
 G: Final = 9.80665  # CONSTANTS_ONE_G
@@ -222,7 +222,7 @@ class PositionControl:
         hover = self.hover_thrust
         thrust_ned_z = acc_sp[2] * (hover / G) - hover
         collective = thrust_ned_z / body_z[2]  # projected onto the body z axis
-        collective = -self._lim_thr_min if -self._lim_thr_min < collective else collective  # at least the minimum
+        collective = at_most(collective, -self._lim_thr_min)  # at least the minimum thrust (NED: upwards < 0)
         return scale(body_z, collective)
 
     def _saturate_thrust(self, thrust_sp: Vec3) -> Vec3:
@@ -231,10 +231,10 @@ class PositionControl:
         xy = hypot(t_x, t_y)
         thr_max_sq = self._lim_thr_max * self._lim_thr_max
         margin = self._settings.thr_xy_margin
-        allocated_xy = margin if margin < xy else xy  # the horizontal thrust kept, at most the margin
+        allocated_xy = at_most(xy, margin)  # the horizontal thrust kept, at most the margin
         t_z_max_sq = thr_max_sq - allocated_xy * allocated_xy
         t_z_lim = -sqrt(t_z_max_sq if t_z_max_sq > 0.0 else 0.0)
-        t_z = t_z_lim if t_z_lim > t_z else t_z  # the vertical thrust left beside it
+        t_z = at_least(t_z, t_z_lim)  # the vertical thrust left beside it
         xy_max_sq = thr_max_sq - t_z * t_z
         xy_max = sqrt(xy_max_sq if xy_max_sq > 0.0 else 0.0)  # the horizontal thrust left
         if xy > xy_max:

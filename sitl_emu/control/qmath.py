@@ -178,6 +178,16 @@ def all_finite3(v: Vec3) -> bool:
     return v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0 == 0.0
 
 
+def at_most(v: float, limit: float) -> float:
+    """min(v, limit) as PX4's math::min, a NaN `v` passing through (as in constrain below)."""
+    return limit if limit < v else v
+
+
+def at_least(v: float, limit: float) -> float:
+    """max(v, limit) as PX4's math::max, a NaN `v` passing through (as in constrain below)."""
+    return limit if limit > v else v
+
+
 def constrain(v: float, lo: float, hi: float) -> float:
     """Like PX4's math::constrain: NaN passes through."""
     return lo if v < lo else (hi if v > hi else v)
