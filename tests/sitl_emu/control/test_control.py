@@ -218,8 +218,8 @@ def test_rate_integrator_is_frozen_while_landed():
 def test_position_control_handles_acceleration_only_setpoints():
     pc = PositionControl()
     sp = TrajectorySetpoint(acceleration_ned_m_s2=(1.0, 0.0, 0.0), velocity_ned_m_s=(NAN, NAN, 0.0))
-    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, 0.004, 0)
-    assert not out.in_failsafe
+    assert input_valid(sp)
+    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, 0.004)
     assert out.thrust_ned[0] > 0.0 and out.thrust_ned[2] < 0.0
     assert math.degrees(math.atan2(out.thrust_ned[0], -out.thrust_ned[2])) == pytest.approx(
         math.degrees(math.atan(1.0 / 9.80665)), abs=0.1)
