@@ -12,7 +12,7 @@ Ground: z = 0 (the home altitude). While on the ground with the net vertical for
 still: no velocity, no rates, level attitude with its yaw kept. It leaves the ground as soon as thrust exceeds
 weight. A touchdown stops it in one step (no bounce), like SIH's ground handling.
 
-Plain floats are used throughout: for 3-vectors they are several times faster than numpy in CPython.
+Vectors are tuples of plain floats (ARCHITECTURE.md, On the tick path).
 """
 
 from __future__ import annotations
@@ -57,8 +57,7 @@ class RigidBodyState:
     specific_force_frd: Vec3 = (0.0, 0.0, -GRAVITY_M_S2)  # what an accelerometer reads
     on_ground: bool = True
 
-    # Written out (the same as the one @dataclass would generate), so that `make speedups` compiles it: mypyc leaves
-    # a generated __init__ to the dataclasses module, i.e. interpreted, and a state is built on every physics step.
+    # written out, the same as the generated one (ARCHITECTURE.md, On the tick path)
     def __init__(self, pos_ned_m: Vec3 = (0.0, 0.0, 0.0), vel_ned_m_s: Vec3 = (0.0, 0.0, 0.0),
                  q_wxyz: Vec4 = (1.0, 0.0, 0.0, 0.0), rates_frd_rad_s: Vec3 = (0.0, 0.0, 0.0),
                  motors: Vec4 = (0.0, 0.0, 0.0, 0.0), acc_ned_m_s2: Vec3 = (0.0, 0.0, 0.0),
@@ -73,7 +72,7 @@ class RigidBodyState:
         self.on_ground = on_ground
 
 
-# RigidBodyState's field names, for copying a state: a class compiled by `make speedups` (mypyc) has no __slots__.
+# RigidBodyState's field names, for copying a state (a compiled class has no __slots__: ARCHITECTURE.md)
 RIGID_BODY_FIELDS = ("pos_ned_m", "vel_ned_m_s", "q_wxyz", "rates_frd_rad_s", "motors", "acc_ned_m_s2",
                      "specific_force_frd", "on_ground")
 

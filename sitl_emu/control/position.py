@@ -48,8 +48,7 @@ class PositionControlSettings:
 
 @dataclass(slots=True)
 class PositionOutput:
-    """One position-control cycle's result. Built on every cycle, so its __init__ is written out: cheaper than a
-    NamedTuple's in CPython, and compiled by `make speedups` (mypyc leaves a generated __init__ interpreted)."""
+    """One position-control cycle's result (see ARCHITECTURE.md, On the tick path)."""
 
     thrust_ned: Vec3  # normalised thrust vector (z < 0 is up)
     q_sp: Vec4
