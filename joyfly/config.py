@@ -1,7 +1,8 @@
 """`joyfly fly` options: defaults, the TOML config file (`--config`), validation, and the session settings.
 
 A config file sets any option in a `[fly]` table (or at the top level), with the option's name as on the command
-line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile (joyfly/sticks/profiles.py).
+line (`max-speed` or `max_speed`); the `[profile]` table overrides the joystick profile
+(joyfly/sticks/profiles/profile.py).
 Command-line options win over the file, the file over the defaults::
 
     [fly]
@@ -35,7 +36,7 @@ from joyfly.session.core import SessionSettings
 from joyfly.session.fence_watch import FENCE_ACTIONS
 from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
-from joyfly.sticks.profiles import read_config
+from joyfly.sticks.profiles.profile import read_config
 from joyfly.sticks.setpoints import Limits
 from px4common.clock import SPEED_MAX, SPEED_MIN
 
@@ -73,7 +74,7 @@ class FlyOptions:
     sdl_mapping: str | None = None  # a gamecontrollerdb.txt or one SDL mapping line (sticks/sdl/mappings.py)
     mappings: tuple[str, ...] = ()  # SDL mapping lines from the config file's `mappings` list
     rumble: bool = True  # rumble pulses on a pad that has them (sticks/rumble.py); --no-rumble
-    signing_key: str | None = None  # MAVLink 2 signing key file (joyfly/link/signing_key.py)
+    signing_key: str | None = None  # MAVLink 2 signing key file (px4common/signing_key.py)
     setup_signing: bool = False  # give the vehicle the key with SETUP_SIGNING
 
     def session_settings(self, **extra: Any) -> SessionSettings:

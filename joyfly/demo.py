@@ -25,7 +25,7 @@ from joyfly.session.factory import make_session
 from joyfly.session.manual_session import MANUAL_CONTROLS
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.mapping import MappedSource
-from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.profiles.profile import load_profile
 from joyfly.sticks.virtual import ScriptSource
 from px4common.clock import ScaledClock
 

@@ -1,5 +1,5 @@
-"""joyfly's contracts between the joystick side (joystick.py, profiles.py, mapping.py) and the flight side
-(setpoints.py, link.py, flight.py). No I/O here.
+"""joyfly's contracts between the joystick side (sticks/: the sources, profiles/, mapping.py) and the flight side
+(sticks/setpoints.py, link/, session/). No I/O here.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ Ground: z = 0 (the home altitude). While on the ground with the net vertical for
 still: no velocity, no rates, level attitude with its yaw kept. It leaves the ground as soon as thrust exceeds
 weight. A touchdown stops it in one step (no bounce), like SIH's ground handling.
 
-Plain floats are used throughout: for 3-vectors they are several times faster than numpy in CPython.
+Vectors are tuples of plain floats (ARCHITECTURE.md, On the tick path).
 """
 
 from __future__ import annotations
@@ -22,7 +22,18 @@ from dataclasses import dataclass
 from math import cos, sin, sqrt
 from typing import Final
 
-from sitl_emu.control.qmath import constrain3, dcm_z, q_from_yaw, q_mul, rotate_world_to_body, yaw_from_q
+from sitl_emu.control.qmath import (
+    add,
+    constrain3,
+    dcm_z,
+    norm,
+    q_from_yaw,
+    q_mul,
+    rotate_world_to_body,
+    scale,
+    sub,
+    yaw_from_q,
+)
 from sitl_emu.types import Vec3, Vec4
 
 GRAVITY_M_S2: Final = 9.80665  # PX4 CONSTANTS_ONE_G
@@ -46,8 +57,7 @@ class RigidBodyState:
     specific_force_frd: Vec3 = (0.0, 0.0, -GRAVITY_M_S2)  # what an accelerometer reads
     on_ground: bool = True
 
-    # Written out (the same as the one @dataclass would generate), so that `make speedups` compiles it: mypyc leaves
-    # a generated __init__ to the dataclasses module, i.e. interpreted, and a state is built on every physics step.
+    # written out, the same as the generated one (ARCHITECTURE.md, On the tick path)
     def __init__(self, pos_ned_m: Vec3 = (0.0, 0.0, 0.0), vel_ned_m_s: Vec3 = (0.0, 0.0, 0.0),
                  q_wxyz: Vec4 = (1.0, 0.0, 0.0, 0.0), rates_frd_rad_s: Vec3 = (0.0, 0.0, 0.0),
                  motors: Vec4 = (0.0, 0.0, 0.0, 0.0), acc_ned_m_s2: Vec3 = (0.0, 0.0, 0.0),
@@ -62,7 +72,7 @@ class RigidBodyState:
         self.on_ground = on_ground
 
 
-# RigidBodyState's field names, for copying a state: a class compiled by `make speedups` (mypyc) has no __slots__.
+# RigidBodyState's field names, for copying a state (a compiled class has no __slots__: ARCHITECTURE.md)
 RIGID_BODY_FIELDS = ("pos_ned_m", "vel_ned_m_s", "q_wxyz", "rates_frd_rad_s", "motors", "acc_ned_m_s2",
                      "specific_force_frd", "on_ground")
 
@@ -104,9 +114,9 @@ def step(state: RigidBodyState, motor_cmd: Vec4, dt_s: float, cfg: SihConfig,
     if state.on_ground and acc[2] >= 0.0:
         return _grounded(state, u, (pos[0], pos[1], 0.0))
     # forward Euler on the velocity, trapezoidal position
-    new_vel = (vel[0] + acc[0] * dt_s, vel[1] + acc[1] * dt_s, vel[2] + acc[2] * dt_s)
-    new_pos = (pos[0] + 0.5 * (vel[0] + new_vel[0]) * dt_s, pos[1] + 0.5 * (vel[1] + new_vel[1]) * dt_s,
-               pos[2] + 0.5 * (vel[2] + new_vel[2]) * dt_s)
+    new_vel = add(vel, scale(acc, dt_s))
+    mean_vel = scale(add(vel, new_vel), 0.5)
+    new_pos = add(pos, scale(mean_vel, dt_s))
     if new_pos[2] >= 0.0:  # touchdown: stop in one step, never sink, never bounce
         return _grounded(state, u, (new_pos[0], new_pos[1], 0.0))
     specific_force = rotate_world_to_body(state.q_wxyz, (acc[0], acc[1], acc[2] - GRAVITY_M_S2))  # accelerometer
@@ -128,11 +138,9 @@ def _motor_lag(motors: Vec4, cmd: Vec4, dt_s: float, tau_s: float) -> Vec4:
 
 def _acceleration_ned(q: Vec4, vel: Vec3, thrust_n: float, cfg: SihConfig, wind: Vec3) -> Vec3:
     """sih.cpp generate_force_and_torques: thrust along body -z, linear drag on the air-relative velocity, gravity."""
-    body_z = dcm_z(q)
-    m, kdv = cfg.mass_kg, cfg.kdv
-    return ((-thrust_n * body_z[0] - kdv * (vel[0] - wind[0])) / m,
-            (-thrust_n * body_z[1] - kdv * (vel[1] - wind[1])) / m,
-            (-thrust_n * body_z[2] - kdv * (vel[2] - wind[2]) + m * GRAVITY_M_S2) / m)
+    m = cfg.mass_kg
+    f_x, f_y, f_z = sub(scale(dcm_z(q), -thrust_n), scale(sub(vel, wind), cfg.kdv))  # thrust and drag, N
+    return f_x / m, f_y / m, (f_z + m * GRAVITY_M_S2) / m
 
 
 def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:
@@ -145,13 +153,16 @@ def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:
     dp = (m_x + (iyy - izz) * q * r) / ixx
     dq = (m_y + (izz - ixx) * r * p) / iyy
     dr = (m_z + (ixx - iyy) * p * q) / izz
-    return constrain3((p + dp * dt_s, q + dq * dt_s, r + dr * dt_s), _RATE_MIN, _RATE_MAX)
+    return constrain3(add(rates, scale((dp, dq, dr), dt_s)), _RATE_MIN, _RATE_MAX)
 
 
 def _attitude_step(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:
-    """q <- q (x) exp(omega dt / 2), with the rates at the start of the step, normalised."""
+    """q <- q (x) exp(omega dt / 2), with the rates at the start of the step, normalised.
+
+    Normalised by multiplying with 1 / |q|, not with qmath.q_normalized (which divides by |q|): the last bit differs
+    and the golden flights (tools/golden_flights.py) keep SIH's arithmetic as it was recorded."""
     w_x, w_y, w_z = rates
-    n = sqrt(w_x * w_x + w_y * w_y + w_z * w_z)  # |omega|
+    n = norm(rates)  # |omega|
     if n < 1e-12:
         return q
     half = 0.5 * n * dt_s

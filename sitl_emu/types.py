@@ -37,9 +37,7 @@ class OffboardControlMode:
 class TrajectorySetpoint:
     """PX4's trajectory_setpoint in the local NED frame; NaN components are not controlled.
 
-    Made several times a tick (the flight tasks, the position controller's output), so not frozen and with its
-    __init__ written out, as commander/failsafe.Decision: `make speedups` compiles only a written-out __init__, and a
-    frozen one sets each field through object.__setattr__. Treat it as read-only: one setpoint is held and shared."""
+    Read-only by convention: one setpoint is held and shared (see ARCHITECTURE.md, On the tick path)."""
 
     position_ned_m: Vec3 = NAN3
     velocity_ned_m_s: Vec3 = NAN3
@@ -177,12 +175,8 @@ class FollowTargetSample:
 
 @dataclass(slots=True)
 class VehicleSnapshot:
-    """Everything telemetry needs, at one instant of simulated time. Read-only by convention: not frozen, because a
-    frozen dataclass's __init__ sets each of these ~34 fields through object.__setattr__, and `serve` builds a snapshot
-    on most ticks (frozen, that cost 5 % of a vehicle's instructions with its links). Its __init__ is written out
-    (the generated one's parameters, in the same order, with the same defaults; tests/sitl_emu/test_speedups.py checks),
-    because `make speedups` compiles only a written-out one: the generated one cost 20,000 instructions a snapshot
-    in the compiled build."""
+    """Everything telemetry needs, at one instant of simulated time (Vehicle.snapshot, cached until the next step
+    or input). Read-only by convention (see ARCHITECTURE.md, On the tick path)."""
 
     time_us: int
     # state machine

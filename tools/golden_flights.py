@@ -18,6 +18,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
 from sitl_emu.testing.harness import ClosedLoop, hover_loop
@@ -79,7 +80,7 @@ def _takeoff(v: Vehicle, run: Callable[..., None]) -> None:
 
 def flight_offboard_position(noise: bool) -> str:
     h = Hasher()
-    v = Vehicle(seed=3, position_noise_m=0.05 if noise else 0.0)
+    v = Vehicle(seed=3, estimate_noise=EstimateNoiseSettings(pos_white_m=0.05) if noise else None)
     run = _runner(v, h)
     _takeoff(v, run)
     pos = OffboardControlMode(position=True)

@@ -15,7 +15,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import common as mavlink2
 
-from joyfly.link.signing_key import keep_up, sign_with, wall_timestamp
+from joyfly.link.signing import keep_up, sign_with, wall_timestamp
 from joyfly.link.transport import Transport
 from joyfly.sticks.setpoints import FRAME_LOCAL_NED, Setpoint
 from joyfly.types import Clock
@@ -142,7 +142,7 @@ class VehicleLink:
 
     def use_signing(self, key: bytes, setup: bool = False) -> None:
         """Sign everything sent with `key` and take from the vehicle only what it signs with it, but its heartbeat
-        (joyfly/link/signing_key.py); `setup`: give the vehicle the key with SETUP_SIGNING, once it is found."""
+        (joyfly/link/signing.py); `setup`: give the vehicle the key with SETUP_SIGNING, once it is found."""
         sign_with(self._mav, key)
         self._signing = True
         self._key_to_give = key if setup else None

@@ -79,6 +79,8 @@ class Level(Enum):
 
 @dataclass(frozen=True, slots=True)
 class Note:
+    """One thing joyfly tells the pilot (the face prints it above the live view), stamped with the session's clock."""
+
     time_s: float
     level: Level
     text: str
@@ -86,6 +88,8 @@ class Note:
 
 @dataclass(frozen=True, slots=True)
 class FlightStats:
+    """What the closing summary says of the flight, counted as it goes."""
+
     distance_m: float = 0.0
     min_fence_margin_m: float = math.inf
     control_time_s: float = 0.0  # time in joyfly's mode: OFFBOARD, or POSCTL/ALTCTL with --control position/altitude

@@ -20,7 +20,7 @@ less a `buffer_m`, planning a deceleration of `brake_acc_m_s2` = MPC_ACC_HOR / 2
 of `reaction_s` (1.2 s: the stream period, PX4's loops, the telemetry's age, the jerk-limited start of braking and
 the vehicle lagging its velocity setpoint). That is conservative against real PX4: released at 6 m/s in POSCTL, it
 stops within 10.5 m (the reference trace p_fwd), where this rule plans for 19 m; a model of PX4's stick dynamics
-with the vehicle lagging twice as much as PX4 did still stops inside (tests/joyfly/test_manual_fence.py).
+with the vehicle lagging twice as much as PX4 did still stops inside (tests/joyfly/sticks/test_manual_fence.py).
 The stick component towards the side is then set so the vehicle's speed tracks that allowance (gain
 `track_gain_1_s`): it falls to 0 at the buffer and turns into a brake (a push inwards) when the vehicle is faster
 than allowed; it never pushes further out than the pilot does. The speed is the larger

@@ -18,8 +18,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from joyfly.sticks.js_events import AXIS_MAX, JoystickError
-from joyfly.sticks.profiles import AxisMap, Profile, rest_problems
+from joyfly.sticks.js.events import AXIS_MAX, JoystickError
+from joyfly.sticks.profiles.profile import AxisMap, Profile, rest_problems
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sources import open_source, pick_profile
 from joyfly.sticks.virtual import record_to

@@ -1,5 +1,5 @@
 """What `--joy` names, opened: SDL devices (`sdl`, `sdl:N`, `sdl:NAME`), `auto` (the default), or anything the js
-reader takes (joyfly/sticks/joystick.py: a js device, a FIFO, raw:, script:, replay:, a recording); and the profile
+reader takes (joyfly/sticks/js/reader.py: a js device, a FIFO, raw:, script:, replay:, a recording); and the profile
 a source flies with.
 
 `--joy auto` takes the first SDL game controller, else the first SDL joystick, else the first /dev/input/js* on
@@ -19,13 +19,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from joyfly.sticks.js_events import JoystickError
-from joyfly.sticks.js_seam import js_reader, open_js
-from joyfly.sticks.profiles import BUILTIN, ROLES, Profile, apply_overrides, load_profile
+from joyfly.sticks.js.events import JoystickError
+from joyfly.sticks.js.seam import js_reader, open_js
+from joyfly.sticks.profiles.profile import BUILTIN, ROLES, Profile, apply_overrides, load_profile
+from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl.mappings import SdlMappings, apply_mappings
 from joyfly.sticks.sdl.source import LIST_HINT, SDL_PREFIX, SdlSource, choose_device
-from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.types import Clock, JoystickSource
 
 AUTO = "auto"
@@ -115,7 +115,7 @@ def _described(table: Mapping[str, Any]) -> bool:
 
 def pick_profile(source: JoystickSource, name_or_auto: str | None, overrides: Mapping[str, Any] | None) -> Profile:
     """The profile `source` flies with: with --profile auto, the user's own profile for this device (written by
-    `joyfly joystick calibrate`, joyfly/sticks/user_profiles.py) first, then profiles.load_profile; a plain SDL
+    `joyfly joystick calibrate`, joyfly/sticks/profiles/user.py) first, then profiles.load_profile; a plain SDL
     joystick nothing describes is refused."""
     table = dict(overrides or {})
     name = (name_or_auto or AUTO).strip()

@@ -14,7 +14,7 @@ from typing import Any
 
 from joyfly.sticks.manual import Z_CENTRE, to_manual
 from joyfly.sticks.mapping import map_state
-from joyfly.sticks.profiles import Profile
+from joyfly.sticks.profiles.profile import Profile
 from joyfly.sticks.virtual import TimedSource
 from joyfly.types import JoyState
 

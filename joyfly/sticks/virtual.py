@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
-from joyfly.sticks.js_events import AXIS_MAX, JoystickError
+from joyfly.sticks.js.events import AXIS_MAX, JoystickError
 from joyfly.types import Clock, JoyState, JoystickSource
 
 SCRIPT_NAME = "joyfly script"

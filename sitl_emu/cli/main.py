@@ -18,6 +18,7 @@ import click
 from flightview.options import view_options, view_settings
 from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
 from px4common.clock import SPEED_MAX, SPEED_MIN
+from px4common.signing_key import SigningKeyError, read_signing_key
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli.options import (
     MAX_SYSID,
@@ -33,7 +34,7 @@ from sitl_emu.cli.options import (
     parse_home,
 )
 from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
-from sitl_emu.cli.signing_key import attach_signing, read_signing_key
+from sitl_emu.cli.signing_key import attach_signing
 from sitl_emu.console.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
@@ -276,7 +277,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
                             epoch_unix_us=int(time.time() * 1e6),
                             handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
         _sign(nodes, instance, key)
-    except (UsageProblem, PortInUseError) as err:
+    except (UsageProblem, PortInUseError, SigningKeyError) as err:
         raise UserError(str(err)) from None
     loggers = [] if no_log else attach_loggers(nodes, log_dir, instance)
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)

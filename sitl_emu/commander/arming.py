@@ -69,8 +69,7 @@ _REASONS: tuple[tuple[int, str], ...] = (
 class CheckInputs:
     """What the checks look at, at one instant.
 
-    Made every commander cycle, so not frozen and with its __init__ written out (the same as the generated one:
-    `make speedups` compiles only a written-out __init__, as for NavInput). Treat it as read-only."""
+    Made every commander cycle; read-only by convention (see ARCHITECTURE.md, On the tick path)."""
 
     estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
     home_valid: bool

@@ -28,8 +28,8 @@ from sitl_emu.px4 import NavState
 
 @dataclass(slots=True)
 class Decision:
-    """The mode in force and what to do (made every commander cycle, so not frozen and with its __init__ written
-    out, as arming.CheckInputs). Treat it as read-only."""
+    """The mode in force and what to do, every commander cycle; read-only by convention (see ARCHITECTURE.md, On
+    the tick path)."""
 
     nav_state: NavState
     failsafe: bool

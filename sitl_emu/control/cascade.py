@@ -3,7 +3,10 @@
 trajectory setpoint -> PositionControl (with TakeoffHandling, as MulticopterPositionControl.cpp wraps it)
 -> attitude setpoint -> AttitudeControl -> rate setpoint -> RateControl -> torque -> quad-X mixer -> motors 0..1.
 An offboard attitude/rate setpoint (SET_ATTITUDE_TARGET) bypasses position control (PX4 then skips the takeoff
-ramp: updateTakeoffState(..., skip_takeoff=true)). The estimate is the true state.
+ramp: updateTakeoffState(..., skip_takeoff=true)). As MulticopterPositionControl::Run, the cascade chooses the
+setpoint the position controller flies: the trajectory setpoint when it is valid (PositionControl's _inputValid),
+else the last valid one for 200 ms, else the failsafe setpoint "stop and wait" (zero velocity,
+MulticopterPositionControl::failsafe; the velocity estimate is always valid here).
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from typing import Final
 from sitl_emu.control.attitude import AttitudeControl, AttitudeControlSettings
 from sitl_emu.control.hover import HoverThrustEstimator, HoverThrustSettings
 from sitl_emu.control.mixer import mix
-from sitl_emu.control.position import PositionControl, PositionControlSettings, PositionOutput
+from sitl_emu.control.position import PositionControl, PositionControlSettings, PositionOutput, input_valid
 from sitl_emu.control.qmath import constrain, isfinite, q_normalized, yaw_from_q
 from sitl_emu.control.rate import RateControl, RateControlSettings
 from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState
@@ -27,6 +30,8 @@ ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 # mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
 # Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
 POSITION_PERIOD_US: Final = 8000
+INVALID_HOLD_US: Final = 200_000  # MulticopterPositionControl LOITER_TIME_BEFORE_DESCEND hysteresis
+FAILSAFE_SETPOINT: Final = TrajectorySetpoint(velocity_ned_m_s=(0.0, 0.0, 0.0))  # "Failsafe: stop and wait"
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,6 +121,8 @@ class MulticopterControl:
         self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
         self._thrust = 0.0
         self._in_failsafe = False
+        self._last_valid: TrajectorySetpoint | None = None
+        self._invalid_since_us: int | None = None
         self._pos_out: PositionOutput | None = None
         self._pos_last_us = 0
         self._tilt_limit = s.tilt_max_air_rad if flying else s.tilt_max_lnd_rad
@@ -202,11 +209,22 @@ class MulticopterControl:
             sp = IDLE_SETPOINT
             self.position.reset_integral()
         self._set_limits(flying, dt_s)
-        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw_from_q(state.q_wxyz), sp, dt_s, now_us)
-        self._in_failsafe = out.in_failsafe
+        sp, self._in_failsafe = self._select_setpoint(sp, now_us)
+        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw_from_q(state.q_wxyz), sp, dt_s)
         self._local_setpoint, self._local_out = None, out
         self._update_hover_thrust(state, out, landed, dt_s, now_us)
         return out
+
+    def _select_setpoint(self, sp: TrajectorySetpoint, now_us: int) -> tuple[TrajectorySetpoint, bool]:
+        """The setpoint to fly, and whether it is the failsafe's (module docstring)."""
+        if sp is self._last_valid or input_valid(sp):  # the last valid setpoint (immutable) is still valid
+            self._last_valid, self._invalid_since_us = sp, None
+            return sp, False
+        if self._invalid_since_us is None:
+            self._invalid_since_us = now_us
+        if self._last_valid is not None and now_us - self._invalid_since_us < INVALID_HOLD_US:
+            return self._last_valid, False
+        return FAILSAFE_SETPOINT, True
 
     def _set_limits(self, flying: bool, dt_s: float) -> None:
         """The position controller's limits for this cycle: the tilt limit slews (0.2 rad/s) from MPC_TILTMAX_LND to

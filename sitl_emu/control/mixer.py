@@ -76,8 +76,7 @@ def _desaturation_gain(vec: Vec4, u: Vec4, hi: float) -> float:
 
 def _widen_gain_range(v: float, x: float, hi: float, k_min: float, k_max: float) -> tuple[float, float]:
     """One actuator of computeDesaturationGain: (k_min, k_max) widened to the gain along v that brings x back into
-    0..hi. (One actuator at a time rather than a loop over the indices: `make speedups` keeps a Vec4 unboxed only
-    while its indices are constants.)"""
+    0..hi. One actuator at a time rather than a loop over the indices (see ARCHITECTURE.md, On the tick path)."""
     if abs(v) < 1.2e-7:  # FLT_EPSILON: this axis cannot move this actuator
         return k_min, k_max
     if x < 0.0:

@@ -3,8 +3,8 @@ PositionControl.cpp).
 
 Position P -> velocity PID -> acceleration -> thrust vector -> attitude setpoint, with PX4's rules:
 - validity (PositionControl.cpp _inputValid): every axis needs a position, velocity or acceleration setpoint, and x/y
-  come in pairs for each kind; an invalid setpoint keeps the last valid one for 200 ms, then the failsafe setpoint
-  "stop and wait" (zero velocity) of MulticopterPositionControl::failsafe;
+  come in pairs for each kind. What to fly instead of an invalid setpoint is the wrapper's choice (cascade.py, as
+  MulticopterPositionControl's): `update` is given a valid one;
 - the horizontal velocity limit keeps the position term first (ControlMath::constrainXY);
 - vertical anti-windup on thrust saturation, horizontal tracking anti-windup (Rundqwist), vertical integral <= g;
 - tilt limit (ControlMath::limitTilt), minimum thrust, and the horizontal margin MPC_THR_XY_MARG.
@@ -20,11 +20,10 @@ from typing import Final
 
 from sitl_emu.control.control_math import add_if_not_nan3, bodyz_to_attitude, constrain_xy, limit_tilt
 from sitl_emu.control.filters import LowPassDerivative
-from sitl_emu.control.qmath import constrain, emult, isfinite, norm, normalized, scale, sub
+from sitl_emu.control.qmath import at_least, at_most, constrain, emult, isfinite, norm, normalized, scale, sub
 from sitl_emu.types import TrajectorySetpoint, Vec3, Vec4
 
 G: Final = 9.80665  # CONSTANTS_ONE_G
-INVALID_HOLD_US: Final = 200_000  # MulticopterPositionControl LOITER_TIME_BEFORE_DESCEND hysteresis
 THR_MIN_FLOOR: Final = 10e-4  # PositionControl::setThrustLimits: enough thrust to infer an attitude from
 
 
@@ -49,28 +48,24 @@ class PositionControlSettings:
 
 @dataclass(slots=True)
 class PositionOutput:
-    """One position-control cycle's result. Built on every cycle, so its __init__ is written out: cheaper than a
-    NamedTuple's in CPython, and compiled by `make speedups` (mypyc leaves a generated __init__ interpreted)."""
+    """One position-control cycle's result (see ARCHITECTURE.md, On the tick path)."""
 
     thrust_ned: Vec3  # normalised thrust vector (z < 0 is up)
     q_sp: Vec4
     collective: float  # |thrust|, 0..1
     yaw_sp_rad: float
     yawspeed_sp_rad_s: float
-    in_failsafe: bool
     position_sp_ned_m: Vec3  # the position setpoint used
     velocity_sp_ned_m_s: Vec3  # incl. the P-correction
     acceleration_sp_ned_m_s2: Vec3
 
     def __init__(self, thrust_ned: Vec3, q_sp: Vec4, collective: float, yaw_sp_rad: float, yawspeed_sp_rad_s: float,
-                 in_failsafe: bool, position_sp_ned_m: Vec3, velocity_sp_ned_m_s: Vec3,
-                 acceleration_sp_ned_m_s2: Vec3) -> None:
+                 position_sp_ned_m: Vec3, velocity_sp_ned_m_s: Vec3, acceleration_sp_ned_m_s2: Vec3) -> None:
         self.thrust_ned = thrust_ned
         self.q_sp = q_sp
         self.collective = collective
         self.yaw_sp_rad = yaw_sp_rad
         self.yawspeed_sp_rad_s = yawspeed_sp_rad_s
-        self.in_failsafe = in_failsafe
         self.position_sp_ned_m = position_sp_ned_m
         self.velocity_sp_ned_m_s = velocity_sp_ned_m_s
         self.acceleration_sp_ned_m_s2 = acceleration_sp_ned_m_s2
@@ -91,15 +86,11 @@ def input_valid(sp: TrajectorySetpoint) -> bool:
     return in_pairs and (pos_x or vel_x or acc_x) and (isfinite(pos[2]) or isfinite(vel[2]) or isfinite(acc[2]))
 
 
-def failsafe_setpoint() -> TrajectorySetpoint:
-    """"Failsafe: stop and wait": zero velocity in all axes (the velocity estimate is always valid here)."""
-    return TrajectorySetpoint(velocity_ned_m_s=(0.0, 0.0, 0.0))
-
-
 class PositionControl:
-    """One instance per vehicle; `update` is pure apart from the integrator, filter and failsafe memory.
+    """One instance per vehicle; `update` is pure apart from the integrator and the filter.
 
-    As in PX4, the wrapper (cascade.py, MulticopterPositionControl's role) sets the limits before every update."""
+    As in PX4, the wrapper (cascade.py, MulticopterPositionControl's role) sets the limits before every update and
+    chooses the setpoint it flies (a valid one: input_valid)."""
 
     def __init__(self, settings: PositionControlSettings | None = None) -> None:
         self._deriv = LowPassDerivative(0.0)
@@ -110,8 +101,6 @@ class PositionControl:
         self.set_thrust_limits(s.thr_min, s.thr_max)
         self.set_tilt_limit(s.tilt_max_air_rad)
         self._vel_int: Vec3 = (0.0, 0.0, 0.0)
-        self._last_valid: TrajectorySetpoint | None = None
-        self._invalid_since_us: int | None = None
 
     @property
     def settings(self) -> PositionControlSettings:
@@ -136,8 +125,6 @@ class PositionControl:
     def reset(self) -> None:
         self.reset_integral()
         self._deriv.reset()
-        self._last_valid = None
-        self._invalid_since_us = None
 
     def reset_integral(self) -> None:
         self._vel_int = (0.0, 0.0, 0.0)
@@ -152,29 +139,15 @@ class PositionControl:
             self._vel_int = (i0, i1, i2 + ((acc_sp_z - G) * self.hover_thrust / hover_new + G - acc_sp_z))
             self.hover_thrust = hover_new
 
-    def select_setpoint(self, sp: TrajectorySetpoint, now_us: int) -> tuple[TrajectorySetpoint, bool]:
-        """The setpoint to fly: sp if valid, else the last valid one for 200 ms, else the failsafe setpoint."""
-        if sp is self._last_valid or input_valid(sp):  # the last valid setpoint (immutable) is still valid
-            self._last_valid, self._invalid_since_us = sp, None
-            return sp, False
-        if self._invalid_since_us is None:
-            self._invalid_since_us = now_us
-        if self._last_valid is not None and now_us - self._invalid_since_us < INVALID_HOLD_US:
-            return self._last_valid, False
-        return failsafe_setpoint(), True
-
-    def update(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, dt_s: float,
-               now_us: int) -> PositionOutput:
-        """One cycle (PositionControl::update and getAttitudeSetpoint)."""
+    def update(self, pos: Vec3, vel: Vec3, yaw_rad: float, sp: TrajectorySetpoint, dt_s: float) -> PositionOutput:
+        """One cycle (PositionControl::update and getAttitudeSetpoint) for a valid setpoint `sp` (input_valid)."""
         vel_dot = self._deriv.update(vel, dt_s)
-        sp, in_failsafe = self.select_setpoint(sp, now_us)
         vel_sp = self._position_control(pos, sp)
         acc_sp, thrust_sp = self._velocity_control(vel, vel_dot, vel_sp, sp.acceleration_ned_m_s2, dt_s)
         yaw_sp = sp.yaw_rad if isfinite(sp.yaw_rad) else yaw_rad  # no yaw setpoint: keep the heading
         yawspeed_sp = sp.yawspeed_rad_s if isfinite(sp.yawspeed_rad_s) else 0.0
         q_sp = bodyz_to_attitude(scale(thrust_sp, -1.0), yaw_sp)  # ControlMath::thrustToAttitude
-        return PositionOutput(thrust_sp, q_sp, norm(thrust_sp), yaw_sp, yawspeed_sp, in_failsafe, sp.position_ned_m,
-                              vel_sp, acc_sp)
+        return PositionOutput(thrust_sp, q_sp, norm(thrust_sp), yaw_sp, yawspeed_sp, sp.position_ned_m, vel_sp, acc_sp)
 
     def _position_control(self, pos: Vec3, sp: TrajectorySetpoint) -> Vec3:
         """PositionControl::_positionControl: P on the position error plus the velocity feed-forward, limited."""
@@ -222,7 +195,7 @@ class PositionControl:
         hover = self.hover_thrust
         thrust_ned_z = acc_sp[2] * (hover / G) - hover
         collective = thrust_ned_z / body_z[2]  # projected onto the body z axis
-        collective = -self._lim_thr_min if -self._lim_thr_min < collective else collective  # at least the minimum
+        collective = at_most(collective, -self._lim_thr_min)  # at least the minimum thrust (NED: upwards < 0)
         return scale(body_z, collective)
 
     def _saturate_thrust(self, thrust_sp: Vec3) -> Vec3:
@@ -231,10 +204,10 @@ class PositionControl:
         xy = hypot(t_x, t_y)
         thr_max_sq = self._lim_thr_max * self._lim_thr_max
         margin = self._settings.thr_xy_margin
-        allocated_xy = margin if margin < xy else xy  # the horizontal thrust kept, at most the margin
+        allocated_xy = at_most(xy, margin)  # the horizontal thrust kept, at most the margin
         t_z_max_sq = thr_max_sq - allocated_xy * allocated_xy
         t_z_lim = -sqrt(t_z_max_sq if t_z_max_sq > 0.0 else 0.0)
-        t_z = t_z_lim if t_z_lim > t_z else t_z  # the vertical thrust left beside it
+        t_z = at_least(t_z, t_z_lim)  # the vertical thrust left beside it
         xy_max_sq = thr_max_sq - t_z * t_z
         xy_max = sqrt(xy_max_sq if xy_max_sq > 0.0 else 0.0)  # the horizontal thrust left
         if xy > xy_max:

@@ -165,17 +165,26 @@ def normalized(a: Vec3) -> Vec3:
 
 
 def isfinite(x: float) -> bool:
-    """math.isfinite for a float. Written as arithmetic because `make speedups` (mypyc) has no primitive for
-    math.isfinite: a call would box the float into a Python object on every use. x - x is 0.0 for every finite x and
-    NaN for inf and NaN."""
+    """math.isfinite for a float, written as arithmetic (see ARCHITECTURE.md, On the tick path): x - x is 0.0 for
+    every finite x and NaN for inf and NaN."""
     return x - x == 0.0
 
 
 def all_finite3(v: Vec3) -> bool:
-    """Every component of v finite, in one expression (the vector form of isfinite above, for the same reason): each
+    """Every component of v finite, in one expression (the vector form of isfinite above): each
     finite component times 0.0 is +-0.0 and so is their sum (no overflow, unlike a plain sum), while an inf or NaN
     component makes its product NaN, and the sum with it."""
     return v[0] * 0.0 + v[1] * 0.0 + v[2] * 0.0 == 0.0
+
+
+def at_most(v: float, limit: float) -> float:
+    """min(v, limit) as PX4's math::min, a NaN `v` passing through (as in constrain below)."""
+    return limit if limit < v else v
+
+
+def at_least(v: float, limit: float) -> float:
+    """max(v, limit) as PX4's math::max, a NaN `v` passing through (as in constrain below)."""
+    return limit if limit > v else v
 
 
 def constrain(v: float, lo: float, hi: float) -> float:

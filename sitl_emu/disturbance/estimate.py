@@ -1,15 +1,24 @@
 """Estimator noise: what the controllers and LOCAL_POSITION_NED see is the truth plus white noise plus a bias that
-wanders (a random walk), on position, velocity and attitude.
+wanders (a random walk), on position, velocity and attitude. This is the vehicle's one noise model
+(`Vehicle(estimate_noise=...)`, `Sim(estimate_noise=...)`).
 
 Per axis and per tick: bias += walk * sqrt(dt) * N(0, 1); estimate = truth + bias + white * N(0, 1). Attitude noise
 is a small rotation (rotation vector in the body frame, rad) applied to the true attitude. Every level defaults to 0,
-and then the estimate is the truth, exactly (no draw is made).
+and then the estimate is the truth, exactly (no draw is made); a quantity whose two levels are 0 is the truth's.
+
+On the ground the noise is the same as in flight. PX4's EKF2 keeps fusing the GNSS position and velocity and the
+barometer while landed (its zero-velocity update, aid_sources/ZeroVelocityUpdate.cpp, acts only when nothing aids
+the vertical velocity; its fake-position fusion only without any position aiding), so its estimate is never pinned
+to the pad: PX4 SIH's LOCAL_POSITION_NED, recorded, wanders by centimetres and reads a few cm/s while the vehicle
+stands disarmed. The truth stays on the ground; the land detector and the commander read the noisy estimate, as
+PX4's do.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -34,6 +43,20 @@ class EstimateNoiseSettings:
         return any(v > 0.0 for v in (self.pos_white_m, self.pos_walk_m, self.vel_white_m_s, self.vel_walk_m_s,
                                      self.att_white_rad, self.att_walk_rad))
 
+    @classmethod
+    def from_mapping(cls, levels: Mapping[str, object]) -> EstimateNoiseSettings:
+        """From plain data (a campaign's `estimate_noise = { pos_white_m = 0.3 }`); ValueError in one sentence."""
+        names = [f.name for f in fields(cls)]
+        unknown = sorted(set(levels) - set(names))
+        if unknown:
+            raise ValueError(f"estimate_noise has no level {unknown[0]!r}; the levels are {', '.join(names)}.")
+        values: dict[str, float] = {}
+        for name, value in levels.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value < math.inf:
+                raise ValueError(f"estimate_noise {name} must be a number from 0 up, not {value!r}.")
+            values[name] = float(value)
+        return cls(**values)
+
 
 class _Channel:
     """One 3-axis quantity: white noise plus a random-walk bias."""
@@ -50,25 +73,30 @@ class _Channel:
         return self.bias
 
 
+def _channel(white: float, walk: float) -> _Channel | None:
+    return _Channel(white, walk) if white > 0.0 or walk > 0.0 else None
+
+
 class EstimateNoise:
-    """Turns the truth into the estimate, tick by tick (seeded)."""
+    """Turns the truth into the estimate, tick by tick (seeded), on the ground as in flight (module docstring)."""
 
     def __init__(self, settings: EstimateNoiseSettings, rng: np.random.Generator) -> None:
         self.settings = settings
         self._rng = rng
         s = settings
-        self._pos = _Channel(s.pos_white_m, s.pos_walk_m)
-        self._vel = _Channel(s.vel_white_m_s, s.vel_walk_m_s)
-        self._att = _Channel(s.att_white_rad, s.att_walk_rad)
+        self._pos = _channel(s.pos_white_m, s.pos_walk_m)
+        self._vel = _channel(s.vel_white_m_s, s.vel_walk_m_s)
+        self._att = _channel(s.att_white_rad, s.att_walk_rad)
 
     def apply(self, truth: RigidBodyState, dt_s: float) -> RigidBodyState:
         est = RigidBodyState(**{f: getattr(truth, f) for f in RIGID_BODY_FIELDS})
-        if truth.on_ground:  # resting: the estimator sees the ground's constraint, noise only while flying
-            return est
         rng = self._rng
-        est.pos_ned_m = _add(truth.pos_ned_m, self._pos.draw(rng, dt_s))
-        est.vel_ned_m_s = _add(truth.vel_ned_m_s, self._vel.draw(rng, dt_s))
-        est.q_wxyz = _rotated(truth.q_wxyz, self._att.draw(rng, dt_s))
+        if self._pos is not None:
+            est.pos_ned_m = _add(truth.pos_ned_m, self._pos.draw(rng, dt_s))
+        if self._vel is not None:
+            est.vel_ned_m_s = _add(truth.vel_ned_m_s, self._vel.draw(rng, dt_s))
+        if self._att is not None:
+            est.q_wxyz = _rotated(truth.q_wxyz, self._att.draw(rng, dt_s))
         return est
 
 

@@ -50,7 +50,8 @@ FlightTask = auto.Task | ManualAltitudeTask | orbit.FailedOrbitHold | FollowTarg
 
 @dataclass(slots=True)
 class ExecutorOutput:
-    """Built on every tick, so not frozen and with its __init__ written out (as NavInput). Treat it as read-only."""
+    """What the mode in force asks of the controllers this tick; read-only by convention (see ARCHITECTURE.md, On
+    the tick path)."""
 
     trajectory: TrajectorySetpoint | None
     attitude: AttitudeSetpoint | None

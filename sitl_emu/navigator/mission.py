@@ -265,9 +265,10 @@ class MissionNavigator:
         if math.isfinite(self._climb_up_m) and self._work is Work.DEFAULT:
             home_up = -nav.home_ned_m[2]
             self._say(f"Climb to {self._climb_up_m - home_up:.1f} meters above home")
-            climb = NavItem(item.seq, item.command, Kind.TAKEOFF if nav.landed else Kind.WAYPOINT,
-                            (nav.pos_ned_m[0], nav.pos_ned_m[1], -self._climb_up_m), self._climb_up_m - home_up,
-                            0.0, NAN, NAN, True, item.params)
+            climb = NavItem(seq=item.seq, command=item.command, kind=Kind.TAKEOFF if nav.landed else Kind.WAYPOINT,
+                            target_ned_m=(nav.pos_ned_m[0], nav.pos_ned_m[1], -self._climb_up_m),
+                            relative_alt_m=self._climb_up_m - home_up, hold_s=0.0, acceptance_m=NAN, yaw_rad=NAN,
+                            autocontinue=True, params=item.params)
             self._climb_up_m = NAN
             return climb, Work.CLIMB
         if item.kind is Kind.TAKEOFF and (self._work is Work.CLIMB or not nav.landed):
@@ -276,8 +277,9 @@ class MissionNavigator:
             dx, dy = item.target_ned_m[0] - nav.pos_ned_m[0], item.target_ned_m[1] - nav.pos_ned_m[1]
             if math.hypot(dx, dy) > s.acc_rad:
                 z = self.current.target_ned_m[2] if self.current is not None else nav.pos_ned_m[2]
-                move = NavItem(item.seq, item.command, Kind.WAYPOINT, (item.target_ned_m[0], item.target_ned_m[1], z),
-                               NAN, 0.0, NAN, NAN, True, item.params)
+                move = NavItem(seq=item.seq, command=item.command, kind=Kind.WAYPOINT,
+                               target_ned_m=(item.target_ned_m[0], item.target_ned_m[1], z), relative_alt_m=NAN,
+                               hold_s=0.0, acceptance_m=NAN, yaw_rad=NAN, autocontinue=True, params=item.params)
                 return move, Work.MOVE_TO_LAND
         return item, Work.DEFAULT
 
@@ -307,11 +309,8 @@ class MissionNavigator:
             self._roi = None
 
     def _apply_cruise(self) -> None:
-        for name in ("current", "next"):
-            sp = getattr(self, name)
-            if sp is not None:
-                setattr(self, name, Setpoint(sp.kind, sp.target_ned_m, sp.yaw_rad, sp.acceptance_m, self._cruise,
-                                             sp.loiter))
+        self.current = _with_cruise(self.current, self._cruise)
+        self.next = _with_cruise(self.next, self._cruise)
 
     def _end_of_mission(self, nav: NavInput, s: MissionSettings) -> None:
         """setEndOfMissionItems: idle on the ground, else loiter at the current setpoint (or here)."""
@@ -379,5 +378,14 @@ class MissionNavigator:
 
 def _replace_kind(item: NavItem, kind: Kind) -> NavItem:
     """The item flown as `kind` (a takeoff item as a waypoint: its yaw ignored, no hold)."""
-    return NavItem(item.seq, item.command, kind, item.target_ned_m, item.relative_alt_m, 0.0, item.acceptance_m, NAN,
-                   item.autocontinue, item.params)
+    return NavItem(seq=item.seq, command=item.command, kind=kind, target_ned_m=item.target_ned_m,
+                   relative_alt_m=item.relative_alt_m, hold_s=0.0, acceptance_m=item.acceptance_m, yaw_rad=NAN,
+                   autocontinue=item.autocontinue, params=item.params)
+
+
+def _with_cruise(sp: Setpoint | None, cruise_m_s: float) -> Setpoint | None:
+    """The setpoint flown at `cruise_m_s` (DO_CHANGE_SPEED), or None without one."""
+    if sp is None:
+        return None
+    return Setpoint(kind=sp.kind, target_ned_m=sp.target_ned_m, yaw_rad=sp.yaw_rad, acceptance_m=sp.acceptance_m,
+                    cruise_m_s=cruise_m_s, loiter=sp.loiter)

@@ -80,8 +80,9 @@ def nav_item(item: MissionItem, ref: GeoRef, home_alt_amsl_m: float) -> NavItem:
     yaw = math.radians(item.param4) if kind in (Kind.WAYPOINT, Kind.LOITER_TIME, Kind.LOITER_UNLIM) else NAN
     if math.isfinite(yaw):
         yaw = (yaw + math.pi) % math.tau - math.pi
-    return NavItem(item.seq, item.command, kind, target, rel, max(hold, 0.0) if math.isfinite(hold) else 0.0,
-                   acceptance, yaw, bool(item.autocontinue), params)
+    return NavItem(seq=item.seq, command=item.command, kind=kind, target_ned_m=target, relative_alt_m=rel,
+                   hold_s=max(hold, 0.0) if math.isfinite(hold) else 0.0, acceptance_m=acceptance, yaw_rad=yaw,
+                   autocontinue=bool(item.autocontinue), params=params)
 
 
 def nav_items(items: tuple[MissionItem, ...], ref: GeoRef, home_alt_amsl_m: float) -> tuple[NavItem, ...]:

@@ -37,11 +37,7 @@ class NavInput:
     `takeoff_state` is the control cascade's TakeoffHandling state: while it is before the ramp (disarmed, spoolup,
     ready for takeoff) the trajectory is held at the vehicle, as PX4's FlightModeManager does; the default FLIGHT
     disables that. `ref_alt_amsl_m` is the AMSL altitude of the local origin (only used for the RTL message, which
-    PX4 prints in AMSL).
-
-    Built on every tick, so not frozen and with its __init__ written out (the same as the generated one): a frozen
-    dataclass sets each field through object.__setattr__, and `make speedups` (mypyc) compiles only a written-out
-    __init__. Treat it as read-only.
+    PX4 prints in AMSL). Made every tick; read-only by convention (see ARCHITECTURE.md, On the tick path).
     """
 
     time_us: int

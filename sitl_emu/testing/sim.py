@@ -72,7 +72,8 @@ class Sim:
                  home: tuple[float, float, float] = DEFAULT_HOME, spacing_m: float = DEFAULT_SPACING_M,
                  api_remote: Address | None = None, gcs_remote: Address | None = None,
                  bind_host: str = "127.0.0.1", vehicle_options: Mapping[str, Any] | None = None,
-                 wind: WindSettings | None = None, estimate_noise: EstimateNoiseSettings | None = None,
+                 wind: WindSettings | None = None,
+                 estimate_noise: EstimateNoiseSettings | Mapping[str, float] | None = None,
                  log_dir: str | os.PathLike[str] | None = None) -> None:
         """`log_dir`: write a ULog per flight there (vehicle i > 0 in `<log_dir>-<i>`) and serve them over
         LOG_REQUEST_*, as `sitl-emu serve --log-dir` (sitl_emu/log/); `self.loggers` are the loggers."""
@@ -83,6 +84,8 @@ class Sim:
         self._vehicle_options = dict(vehicle_options or {})
         if wind is not None:  # sitl_emu/disturbance/wind.py: WindSettings(5.0, 270.0) or parse_wind("5@270,light")
             self._vehicle_options["wind"] = wind
+        if isinstance(estimate_noise, Mapping):  # plain data, as a campaign's options give: {"pos_white_m": 0.3}
+            estimate_noise = EstimateNoiseSettings.from_mapping(estimate_noise)
         if estimate_noise is not None:  # sitl_emu/disturbance/estimate.py: white noise and bias walk on the estimate
             self._vehicle_options["estimate_noise"] = estimate_noise
         settings = LinkSettings(bind_host, 0, api_remote or sink, 0, gcs_remote or sink)

@@ -44,7 +44,8 @@ from sitl_emu.types import CommandAck, Vec3, VehicleCommand
 
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
-WIND_STREAM, NOISE_STREAM = 1, 2  # Generator streams beside the vehicle's own: np.random.default_rng([seed, n])
+# The estimator noise draws from the seed's own stream, np.random.default_rng(seed); the wind from a second one
+WIND_STREAM = 1  # np.random.default_rng([seed, WIND_STREAM])
 
 
 @dataclass(frozen=True, slots=True)
@@ -82,7 +83,7 @@ class VehicleFaults:
         self.battery = BatterySimulator()
         self._settings, self._params_version = MonitorSettings.from_params(params), params.version
         self.wind = WindModel(wind, dt_s, np.random.default_rng([seed, WIND_STREAM])) if wind and wind.active else None
-        self.noise = (EstimateNoise(noise, np.random.default_rng([seed, NOISE_STREAM]))
+        self.noise = (EstimateNoise(noise, np.random.default_rng(seed))
                       if noise is not None and noise.active else None)
         self._gps_off_us: int | None = None
         self._fd_since_us: list[int | None] = [None, None]  # roll, pitch beyond their limit since
@@ -104,8 +105,9 @@ class VehicleFaults:
             return None
         return self.wind.sample(time_us, -state.pos_ned_m[2], self.settings.sih_wind_from)
 
-    def estimate(self, est: RigidBodyState, dt_s: float) -> RigidBodyState:
-        return est if self.noise is None else self.noise.apply(est, dt_s)
+    def estimate(self, truth: RigidBodyState, dt_s: float) -> RigidBodyState:
+        """The estimate of this tick: the truth itself without estimator noise (disturbance/estimate.py)."""
+        return truth if self.noise is None else self.noise.apply(truth, dt_s)
 
     @property
     def settings(self) -> MonitorSettings:

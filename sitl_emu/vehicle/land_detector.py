@@ -29,8 +29,8 @@ WIDEN_FACTOR: Final = 2.5  # thresholds widen once maybe landed
 
 @dataclass(slots=True)
 class LandDetectorInput:
-    """One detector cycle's input. Made every cycle, so not frozen and with its __init__ written out (as
-    LandDetectorState and arming.CheckInputs): treat both as read-only."""
+    """One detector cycle's input; read-only by convention, as LandDetectorState (see ARCHITECTURE.md, On the tick
+    path)."""
 
     time_us: int
     armed: bool

@@ -21,8 +21,6 @@ import itertools
 from collections import deque
 from typing import Final
 
-import numpy as np
-
 from sitl_emu.commander.commander import Commander
 from sitl_emu.commander.commands import handle_command
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
@@ -34,7 +32,7 @@ from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
-from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState, SihConfig
+from sitl_emu.physics import RigidBodyState, SihConfig
 from sitl_emu.physics import step as physics_step
 from sitl_emu.px4 import AUTO_MODES, LandedState, MavCmd, NavState, Severity
 from sitl_emu.types import (
@@ -68,20 +66,19 @@ class Vehicle:
 
     def __init__(self, *, params: ParamRegistry | None = None,
                  home: tuple[float, float, float] = (47.397742, 8.545594, 488.0), seed: int = 0, sysid: int = 1,
-                 ready_delay_s: float = 2.0, position_noise_m: float = 0.0, wind: WindSettings | None = None,
+                 ready_delay_s: float = 2.0, wind: WindSettings | None = None,
                  estimate_noise: EstimateNoiseSettings | None = None) -> None:
         """Boot disarmed in Hold on the ground at `home` (lat_deg, lon_deg, alt_amsl_m), the local frame's origin.
 
-        `ready_delay_s` is the simulated estimator warm-up before arming is possible; `position_noise_m` (default 0)
-        adds seeded Gaussian noise to the position estimate; `wind` (mean, turbulence, gusts) and `estimate_noise`
-        (white noise and bias walk on position, velocity, attitude) are off by default (faults.py).
+        `ready_delay_s` is the simulated estimator warm-up before arming is possible; `wind` (mean, turbulence, gusts)
+        and `estimate_noise` (seeded white noise and bias walk on position, velocity, attitude, on the ground as in
+        flight: disturbance/estimate.py) are off by default (faults.py).
         """
         self.params: ParamRegistry = params if params is not None else default_registry()
         self.sysid = sysid
         self._home_tuple = home
         self._seed = seed
         self._ready_delay_us = round(ready_delay_s * 1e6)
-        self._noise_m = position_noise_m
         self._wind_settings = wind
         self._estimate_noise = estimate_noise
         self._events: deque[VehicleEvent] = deque(maxlen=EVENT_HISTORY)
@@ -92,7 +89,6 @@ class Vehicle:
         self._snap: VehicleSnapshot | None = None
         self._time_us = 0
         self.ref = GeoRef(*self._home_tuple)
-        self._rng = np.random.default_rng(self._seed)
         self._state = RigidBodyState()
         self._estimate = self._state
         self._motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the mixer's output of the last tick
@@ -145,9 +141,7 @@ class Vehicle:
         motors = chain.control_update(self._estimate, out, motors_armed, c.landed, now, dt_s)
         motors = self._motor_commands = faults.motors(motors)
         self._state = physics_step(self._state, motors, dt_s, self._sih_config(), faults.wind_at(now, self._state))
-        self._estimate = self._state if self._noise_m <= 0.0 else self._with_noise(self._state)
-        if faults.noise is not None:
-            self._estimate = faults.estimate(self._estimate, dt_s)
+        self._estimate = faults.estimate(self._state, dt_s)
         detected = chain.land(self._estimate, c.armed, out, now)
         if detected is not None:
             c.on_land_detector(detected.landed, detected.maybe_landed)
@@ -178,14 +172,6 @@ class Vehicle:
         if self.params.version != self._sih_version:
             self._sih, self._sih_version = sih_config(self.params), self.params.version
         return self._sih
-
-    def _with_noise(self, truth: RigidBodyState) -> RigidBodyState:
-        """The estimate: the truth with seeded Gaussian noise on the position."""
-        n = self._rng.normal(0.0, self._noise_m, 3)
-        p = truth.pos_ned_m
-        est = RigidBodyState(**{f: getattr(truth, f) for f in RIGID_BODY_FIELDS})
-        est.pos_ned_m = (p[0] + float(n[0]), p[1] + float(n[1]), p[2] + float(n[2]))
-        return est
 
     # ---- inputs -------------------------------------------------------------------------------------------------
     def handle_command(self, cmd: VehicleCommand) -> CommandAck | None:

@@ -15,7 +15,7 @@ import joyfly.cli
 import joyfly.config
 import sitl_emu.cli.main
 import sitl_emu.cli.options
-from joyfly.sticks.profiles import read_config
+from joyfly.sticks.profiles.profile import read_config
 
 REPO = REPO_ROOT
 TOOLS = {"joyfly": joyfly.cli.main, "sitl-emu": sitl_emu.cli.main.main}

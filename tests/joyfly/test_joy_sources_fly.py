@@ -23,7 +23,7 @@ from support import REPO_ROOT
 from support.ports import free_udp_port
 
 from joyfly.demo import EmbeddedVehicle
-from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.virtual import JoyRecorder
 from joyfly.types import JoyState
 

@@ -26,7 +26,7 @@ from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
 from joyfly.link.transport import UdpTransport
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
-from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.mapping import open_sticks
 
 SPEED = 8.0

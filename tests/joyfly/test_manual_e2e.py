@@ -22,7 +22,7 @@ from pymavlink import mavutil
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
-from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 
 SPEED = 4.0
 AXIS_FULL = 32767

@@ -26,9 +26,9 @@ from support.ports import free_udp_port
 from support.sdl_virtual import RIGHT_X, RIGHT_Y, A, VirtualPad
 
 from joyfly.demo import EmbeddedVehicle, VehicleTimeClock
-from joyfly.sticks.calibrate import Wizard
+from joyfly.sticks.profiles.calibrate import Wizard
+from joyfly.sticks.profiles.user import profile_toml, write_user_profile
 from joyfly.sticks.sources import open_source
-from joyfly.sticks.user_profiles import profile_toml, write_user_profile
 from px4common.clock import WallClock
 
 # the wizard's user: throttle on axis 3, yaw 0, pitch 2 (forward negative), roll 1 (right negative)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any
 
-from joyfly.sticks.js_events import AXIS_MAX, JoystickError
+from joyfly.sticks.js.events import AXIS_MAX, JoystickError
 
 CONTROLLER_AXES = 6  # SDL_CONTROLLER_AXIS_MAX
 CONTROLLER_BUTTONS = 21  # SDL_CONTROLLER_BUTTON_MAX

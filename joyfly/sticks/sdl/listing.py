@@ -5,13 +5,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from joyfly.sticks.js_events import JoystickError
-from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.js.events import JoystickError
+from joyfly.sticks.profiles.profile import load_profile
+from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl.mappings import SdlMappings, apply_mappings
 from joyfly.sticks.sdl.source import GAME_CONTROLLER_TAG
 from joyfly.sticks.sources import own_profile
-from joyfly.sticks.user_profiles import find_user_profile
 
 
 def _profile_text(device: SdlDevice) -> str:

@@ -20,7 +20,7 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 
-from joyfly.sticks.js_events import DeviceVanishedError, JoystickError, NoDeviceError
+from joyfly.sticks.js.events import DeviceVanishedError, JoystickError, NoDeviceError
 from joyfly.sticks.sdl.api import Hotplug, Opened, SdlApi, SdlDevice
 from joyfly.types import Clock, JoyState
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from enum import Enum
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from sitl_emu.mavlink.protocols.mission_items import (
@@ -61,20 +62,24 @@ MAV_COMP_ID_MISSIONPLANNER = 190
 RETRY_US = 250_000  # MAVLINK_MISSION_RETRY_TIMEOUT_DEFAULT
 TIMEOUT_US = 5_000_000  # MAVLINK_MISSION_PROTOCOL_TIMEOUT_DEFAULT
 REPEAT_US = 1_000_000  # the slow rate limiter of MavlinkMissionManager::send
-IDLE, GETLIST, SENDLIST = "idle", "getlist", "sendlist"
+
+
+class TransferState(Enum):
+    """MavlinkMissionManager's _state: no transfer, receiving an upload, sending a download."""
+
+    IDLE = "idle"
+    GETLIST = "getlist"
+    SENDLIST = "sendlist"
 
 
 class MissionProtocol:
     """One instance per link; the plans and the upload lock live in the vehicle's MissionStore."""
 
-    MESSAGES: ClassVar[tuple[str, ...]] = (
-        "MISSION_REQUEST_LIST", "MISSION_COUNT", "MISSION_CLEAR_ALL", "MISSION_ITEM", "MISSION_ITEM_INT",
-        "MISSION_REQUEST", "MISSION_REQUEST_INT", "MISSION_ACK", "MISSION_SET_CURRENT",
-    )
+    # MESSAGES: the keys of _HANDLERS, at the end of the class (the handlers must be defined first)
     WATCHES_VEHICLE: ClassVar[bool] = True  # tick() reports the mission progress (context.vehicle_news)
 
     def __init__(self) -> None:
-        self._state = IDLE
+        self._state = TransferState.IDLE
         self._type = PLAN_MISSION
         self._partner = (0, 0)  # PX4 starts with partner 0/0: a stray item before any transfer is a "mismatch"
         self._seq = 0  # the next item to receive, or the next request expected
@@ -88,13 +93,6 @@ class MissionProtocol:
         self._seen_reached = -1
         self._reached_repeats = 0  # PX4 sends the last MISSION_ITEM_REACHED again with each 1 Hz report, 10 times
         self._next_repeat_us = 0
-        self._handlers: dict[str, Callable[[Any, LinkContext], None]] = {
-            "MISSION_REQUEST_LIST": self._on_request_list, "MISSION_COUNT": self._on_count,
-            "MISSION_CLEAR_ALL": self._on_clear_all, "MISSION_ITEM": self._on_item,
-            "MISSION_ITEM_INT": self._on_item, "MISSION_REQUEST": self._on_request,
-            "MISSION_REQUEST_INT": self._on_request, "MISSION_ACK": self._on_ack,
-            "MISSION_SET_CURRENT": self._on_set_current,
-        }
 
     def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None:
         if not _addressed_to_us(msg, ctx):
@@ -102,18 +100,18 @@ class MissionProtocol:
         kind = msg.get_type()
         if kind in ("MISSION_ITEM", "MISSION_ITEM_INT", "MISSION_REQUEST", "MISSION_REQUEST_INT"):
             self._int_mode = kind.endswith("_INT")  # PX4 follows the client's choice of message
-        self._handlers[kind](msg, ctx)
+        self._HANDLERS[kind](self, msg, ctx)
 
     def tick(self, ctx: LinkContext) -> bool:
         """Mission progress, retries and the protocol timeout (MavlinkMissionManager::send); False when no transfer
         is under way and no MISSION_ITEM_REACHED repeat is due (idle until news or a message)."""
         self._report_progress(ctx)
-        if self._state == IDLE:
+        if self._state is TransferState.IDLE:
             return self._reached_repeats > 0
         now = ctx.now_us
-        if now - self._sent_us > RETRY_US and self._state == GETLIST:
+        if now - self._sent_us > RETRY_US and self._state is TransferState.GETLIST:
             self._request(ctx, self._seq)
-        elif now - self._sent_us > RETRY_US and self._state == SENDLIST and self._seq == 0:
+        elif now - self._sent_us > RETRY_US and self._state is TransferState.SENDLIST and self._seq == 0:
             self._send_count(ctx, self._count)
         elif now - self._recv_us > TIMEOUT_US:
             _say(ctx, "Mission sync timeout")
@@ -147,10 +145,10 @@ class MissionProtocol:
     # ---- upload ---------------------------------------------------------------------------------------------------
     def _on_count(self, msg: Any, ctx: LinkContext) -> None:
         sender = _sender(msg)
-        if self._state == GETLIST:
+        if self._state is TransferState.GETLIST:
             self._count_while_receiving(msg, ctx, sender)
             return
-        if self._state == SENDLIST:
+        if self._state is TransferState.SENDLIST:
             _say(ctx, "WPM: IGN MISSION_COUNT: Busy")
             self._ack(ctx, MAV_MISSION_ERROR, sender, msg.mission_type)
             return
@@ -175,7 +173,7 @@ class MissionProtocol:
         if count == 0:
             store.clear(self._type)
             return MAV_MISSION_ACCEPTED
-        self._state, self._seq, self._count = GETLIST, 0, count
+        self._state, self._seq, self._count = TransferState.GETLIST, 0, count
         self._items, self._marked_current = [], -1
         return None
 
@@ -194,9 +192,9 @@ class MissionProtocol:
             _say(ctx, "REJ. MIS ITEM: partner id mismatch")
         elif msg.mission_type != self._type:
             self._ack(ctx, MAV_MISSION_ERROR)
-        elif self._state == IDLE:
+        elif self._state is TransferState.IDLE:
             self._item_while_idle(msg, ctx)
-        elif self._state == SENDLIST:
+        elif self._state is TransferState.SENDLIST:
             _say(ctx, "IGN MISSION_ITEM: Busy")
             self._ack(ctx, MAV_MISSION_ERROR)
         else:
@@ -230,7 +228,7 @@ class MissionProtocol:
             self._request(ctx, self._seq)
             return
         self._store_upload(ctx)
-        self._state = IDLE
+        self._state = TransferState.IDLE
         self._ack(ctx, MAV_MISSION_ACCEPTED)
         _store(ctx).unlock(self)
 
@@ -254,13 +252,14 @@ class MissionProtocol:
     # ---- download -------------------------------------------------------------------------------------------------
     def _on_request_list(self, msg: Any, ctx: LinkContext) -> None:
         sender = _sender(msg)
-        if self._state == SENDLIST and self._seq == self._count:
-            self._state = IDLE  # everything was sent: a new request may start even without the client's ACK
-        same = self._state == SENDLIST and self._type == msg.mission_type and sender == self._partner
-        if self._state != IDLE and not same:
+        if self._state is TransferState.SENDLIST and self._seq == self._count:
+            # everything was sent: a new request may start even without the client's ACK
+            self._state = TransferState.IDLE
+        same = self._state is TransferState.SENDLIST and self._type == msg.mission_type and sender == self._partner
+        if self._state is not TransferState.IDLE and not same:
             _say(ctx, "Mission download request ignored, already active", Severity.INFO)
             return
-        self._state, self._type, self._partner = SENDLIST, msg.mission_type, sender
+        self._state, self._type, self._partner = TransferState.SENDLIST, msg.mission_type, sender
         self._recv_us, self._seq = ctx.now_us, 0
         self._count = _store(ctx).count(self._type) if self._type in PLAN_TYPES else 0
         self._send_count(ctx, self._count)
@@ -272,9 +271,9 @@ class MissionProtocol:
     def _on_request(self, msg: Any, ctx: LinkContext) -> None:
         if _sender(msg) != self._partner:
             _say(ctx, "WPM: REJ. CMD: partner id mismatch")
-        elif self._state == GETLIST:
+        elif self._state is TransferState.GETLIST:
             _say(ctx, "WPM: REJ. CMD: Busy")
-        elif self._state == SENDLIST and msg.mission_type == self._type:
+        elif self._state is TransferState.SENDLIST and msg.mission_type == self._type:
             self._recv_us = ctx.now_us
             if msg.seq == self._seq and self._seq < self._count:
                 self._seq += 1
@@ -282,7 +281,7 @@ class MissionProtocol:
                 self._refuse_request(ctx)
                 return
             self._send_item(ctx, msg.seq)
-        # IDLE: silently ignored, as PX4 does ("some OSDs have buggy mission protocol implementations")
+        # TransferState.IDLE: silently ignored, as PX4 does ("some OSDs have buggy mission protocol implementations")
 
     def _send_item(self, ctx: LinkContext, seq: int) -> None:
         store = _store(ctx)
@@ -295,24 +294,24 @@ class MissionProtocol:
         ctx.send(item_message(ctx.mav, self._partner, plan.items[seq], current, self._type, self._int_mode))
 
     def _refuse_request(self, ctx: LinkContext) -> None:
-        self._state = IDLE
+        self._state = TransferState.IDLE
         self._ack(ctx, MAV_MISSION_ERROR)
         _say(ctx, "WPM: REJ. CMD: Req. WP was unexpected")
 
     def _on_ack(self, msg: Any, ctx: LinkContext) -> None:
         if _sender(msg) != self._partner:
             _say(ctx, "REJ. WP CMD: partner id mismatch")
-        elif self._state == SENDLIST and msg.mission_type == self._type:
-            self._state = IDLE  # the download is over, whatever the client says
-        elif self._state == GETLIST and msg.type == MAV_MISSION_UNSUPPORTED:
+        elif self._state is TransferState.SENDLIST and msg.mission_type == self._type:
+            self._state = TransferState.IDLE  # the download is over, whatever the client says
+        elif self._state is TransferState.GETLIST and msg.type == MAV_MISSION_UNSUPPORTED:
             self._int_mode = not self._int_mode  # the client cannot send this flavour: ask for the other
             self._request(ctx, self._seq)
-        elif self._state == GETLIST and msg.type == MAV_MISSION_OPERATION_CANCELLED:
+        elif self._state is TransferState.GETLIST and msg.type == MAV_MISSION_OPERATION_CANCELLED:
             self._end(ctx)
 
     # ---- clear, set current -----------------------------------------------------------------------------------------
     def _on_clear_all(self, msg: Any, ctx: LinkContext) -> None:
-        if self._state != IDLE:
+        if self._state is not TransferState.IDLE:
             _say(ctx, "WPM: IGN CLEAR CMD: Busy")
             return
         if msg.mission_type in PLAN_TYPES or msg.mission_type == PLAN_ALL:
@@ -320,7 +319,7 @@ class MissionProtocol:
         self._ack(ctx, MAV_MISSION_ACCEPTED, _sender(msg), msg.mission_type)
 
     def _on_set_current(self, msg: Any, ctx: LinkContext) -> None:
-        if self._state != IDLE:
+        if self._state is not TransferState.IDLE:
             _say(ctx, "WPM: IGN WP CURR CMD: Busy")
             return
         store = _store(ctx)
@@ -332,7 +331,7 @@ class MissionProtocol:
 
     # ---- helpers ----------------------------------------------------------------------------------------------------
     def _end(self, ctx: LinkContext) -> None:
-        self._state = IDLE
+        self._state = TransferState.IDLE
         _store(ctx).unlock(self)
 
     def _ack(self, ctx: LinkContext, result: int, target: tuple[int, int] | None = None,
@@ -340,6 +339,14 @@ class MissionProtocol:
         to = self._partner if target is None else target
         kind = self._type if mission_type is None else mission_type
         ctx.send(ctx.mav.mission_ack_encode(*to, result, kind))
+
+    # ---- dispatch ---------------------------------------------------------------------------------------------------
+    _HANDLERS: ClassVar[dict[str, Callable[[MissionProtocol, Any, LinkContext], None]]] = {
+        "MISSION_REQUEST_LIST": _on_request_list, "MISSION_COUNT": _on_count, "MISSION_CLEAR_ALL": _on_clear_all,
+        "MISSION_ITEM": _on_item, "MISSION_ITEM_INT": _on_item, "MISSION_REQUEST": _on_request,
+        "MISSION_REQUEST_INT": _on_request, "MISSION_ACK": _on_ack, "MISSION_SET_CURRENT": _on_set_current,
+    }
+    MESSAGES: ClassVar[tuple[str, ...]] = tuple(_HANDLERS)  # the endpoint routes these here
 
 
 def _store(ctx: LinkContext) -> MissionStore:

@@ -23,7 +23,7 @@ sim_s = 20.0
 wall_s = 60.0
 [fixed]
 params = {{ MPC_XY_CRUISE = 6.0 }}
-options = {{ bad_seeds = [2], behave = "raise", vehicle_options = {{ position_noise_m = 0.2 }} }}
+options = {{ bad_seeds = [2], behave = "raise", estimate_noise = {{ pos_white_m = 0.2 }} }}
 [grid]
 seed = [1, 2]
 [random]
@@ -47,7 +47,7 @@ def test_a_campaign_file_through_the_command_line_gives_the_table_the_summary_an
         rows = list(csv.DictReader(f))
     header = list(rows[0])
     assert header[:5] == ["case", "key", "seed", "faults", "param.MPC_XY_CRUISE"]
-    assert header[5:10] == ["param.SIH_WIND_N", "option.bad_seeds", "option.behave", "option.vehicle_options",
+    assert header[5:10] == ["param.SIH_WIND_N", "option.bad_seeds", "option.behave", "option.estimate_noise",
                             "passed"]
     assert header[10:] == ["status", "error", "metric.error_m", "metric.cruise", "metric.faults", "metric.sim_s",
                            "sim_s", "wall_s"]

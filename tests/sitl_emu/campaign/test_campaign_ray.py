@@ -35,7 +35,7 @@ def rows_of(path: Path) -> list[dict[str, str]]:
 
 
 def test_fifty_cases_give_the_same_rows_on_ray_as_on_the_process_pool(local_ray: None, tmp_path: Path) -> None:
-    cases = make_cases({"options.run_s": 0.25, "options.vehicle_options": {"position_noise_m": 0.3}},
+    cases = make_cases({"options.run_s": 0.25, "options.estimate_noise": {"pos_white_m": 0.3}},
                        {"params.MPC_XY_CRUISE": [4.0, 6.0]},
                        {"seed": {"integers": [0, 10**6]}, "params.SIH_WIND_N": {"uniform": [0.0, 10.0]}}, 25, 11)
     assert len(cases) == 50

@@ -15,7 +15,7 @@ from support import REPO_ROOT, campaign_scenarios
 from sitl_emu.campaign import CampaignError, Limits, make_cases, run_campaign
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()
-NOISY = {"options.vehicle_options": {"position_noise_m": 0.3}}  # Sim(vehicle_options=...): a seeded estimate
+NOISY = {"options.estimate_noise": {"pos_white_m": 0.3}}  # Sim(estimate_noise=...): a seeded estimate
 
 
 def rows_of(path: Path) -> list[dict[str, str]]:
@@ -39,7 +39,7 @@ def test_the_process_pool_gives_the_same_table_as_running_the_cases_one_by_one(t
     first = serial_rows[0]
     assert (first["seed"], first["param.MPC_XY_CRUISE"], first["faults"]) == ("3", "7.0", "gps_off@0.2")
     assert (first["metric.cruise"], first["metric.faults"], first["metric.sim_s"]) == ("7.0", "1.0", "0.5")
-    assert first["option.vehicle_options"] == '{"position_noise_m": 0.3}'
+    assert first["option.estimate_noise"] == '{"pos_white_m": 0.3}'
     assert first["sim_s"] == "0.5" and float(first["wall_s"]) > 0
     assert serial.total == pooled.total == 5 and serial.quantiles == pooled.quantiles
 
@@ -47,7 +47,7 @@ def test_the_process_pool_gives_the_same_table_as_running_the_cases_one_by_one(t
 def test_the_example_scenario_flies_pymavlink_the_same_in_the_pool_as_alone(tmp_path: Path) -> None:
     example = f"{REPO_ROOT / 'examples' / 'campaign_square.py'}:fly"
     options = {"options.side_m": 0.0, "options.alt_m": 1.5, "options.hold_s": 0.5, "options.max_error_m": 0.5,
-               "options.vehicle_options": {"position_noise_m": 0.1}}
+               "options.estimate_noise": {"pos_white_m": 0.1}}
     cases = make_cases(options, {"seed": [1, 2]})
     alone = run_campaign(example, cases, tmp_path / "alone.csv", engine="serial")
     pooled = run_campaign(example, cases, tmp_path / "pool.csv", engine="local", workers=2)

@@ -65,10 +65,12 @@ def _arm_answered(workdir: Path, key_args: tuple[str, ...], client_key: bytes | 
                   "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}", *key_args)
     client = _Client(client_port, api_port, client_key)
     try:
-        got = client.heartbeats_until(3.0, "SYS_STATUS")
+        got = client.heartbeats_until(30.0, "SYS_STATUS")  # serve is up (its start-up is slow on a busy machine)
         time.sleep(1.0)  # the estimator's warm-up: 2.5 simulated s
-        client.send(client.mav.command_long_encode(1, 1, MavCmd.COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))
-        got += client.heartbeats_until(2.0, "COMMAND_ACK")
+        deadline = time.monotonic() + 8.0  # ARM again each second until an ACK (or time is up: unanswered)
+        while time.monotonic() < deadline and not any(m.get_type() == "COMMAND_ACK" for m in got):
+            client.send(client.mav.command_long_encode(1, 1, MavCmd.COMPONENT_ARM_DISARM, 0, 1, 0, 0, 0, 0, 0, 0))
+            got += client.heartbeats_until(1.0, "COMMAND_ACK")
     finally:
         client.sock.close()
         proc.send_signal(signal.SIGTERM)

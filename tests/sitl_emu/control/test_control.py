@@ -218,8 +218,8 @@ def test_rate_integrator_is_frozen_while_landed():
 def test_position_control_handles_acceleration_only_setpoints():
     pc = PositionControl()
     sp = TrajectorySetpoint(acceleration_ned_m_s2=(1.0, 0.0, 0.0), velocity_ned_m_s=(NAN, NAN, 0.0))
-    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, 0.004, 0)
-    assert not out.in_failsafe
+    assert input_valid(sp)
+    out = pc.update((0.0, 0.0, -5.0), (0.0, 0.0, 0.0), 0.0, sp, 0.004)
     assert out.thrust_ned[0] > 0.0 and out.thrust_ned[2] < 0.0
     assert math.degrees(math.atan2(out.thrust_ned[0], -out.thrust_ned[2])) == pytest.approx(
         math.degrees(math.atan(1.0 / 9.80665)), abs=0.1)
@@ -349,3 +349,10 @@ def test_finiteness_helpers_agree_with_math_isfinite():
         for b in values:
             for c in values:
                 assert all_finite3((a, b, c)) == (math.isfinite(a) and math.isfinite(b) and math.isfinite(c))
+
+
+def test_at_most_and_at_least_limit_one_side_and_let_nan_through():
+    from sitl_emu.control.qmath import at_least, at_most
+
+    assert (at_most(2.0, 1.0), at_most(0.5, 1.0), at_least(-2.0, -1.0), at_least(3.0, -1.0)) == (1.0, 0.5, -1.0, 3.0)
+    assert math.isnan(at_most(math.nan, 1.0)) and math.isnan(at_least(math.nan, 1.0))  # PositionControl's NaN path

@@ -8,6 +8,7 @@ import math
 import pytest
 from support.fakes import HOME, Harness
 
+from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.geo import ned_to_global
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.vehicle.vehicle import Vehicle
@@ -17,7 +18,7 @@ HIL_STATE_QUATERNION = 115
 
 @pytest.fixture
 def h():
-    harness = Harness(Vehicle(home=HOME, position_noise_m=0.3, seed=5))
+    harness = Harness(Vehicle(home=HOME, estimate_noise=EstimateNoiseSettings(pos_white_m=0.3), seed=5))
     yield harness
     harness.close()
 

@@ -19,7 +19,7 @@ from sitl_emu.testing.sim import Sim
 
 def _fly(seed: int = 0, noise_m: float = 0.0, **params: float) -> tuple[object, list[tuple[float, ...]], float, Sim]:
     """Fly the reference square; returns the result, the vehicle's trace (every 0.5 s) and the wall time."""
-    sim = Sim(seed=seed, params=params, vehicle_options={"position_noise_m": noise_m})
+    sim = Sim(seed=seed, params=params, estimate_noise={"pos_white_m": noise_m})
     client = FlightClient(sim.ports(0).api, sim.clock)
     trace: list[tuple[float, ...]] = []
     original = sim.advance_to

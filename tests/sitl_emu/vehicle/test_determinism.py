@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from support.flights import scripted_flight as _script
 
+from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.vehicle.vehicle import Vehicle
 
 
@@ -12,8 +13,9 @@ def test_same_inputs_give_identical_runs() -> None:
 
 
 def test_noise_is_seeded() -> None:
-    a = _script(Vehicle(seed=1, position_noise_m=0.05))
-    b = _script(Vehicle(seed=1, position_noise_m=0.05))
-    c = _script(Vehicle(seed=2, position_noise_m=0.05))
+    noise = EstimateNoiseSettings(pos_white_m=0.05)
+    a = _script(Vehicle(seed=1, estimate_noise=noise))
+    b = _script(Vehicle(seed=1, estimate_noise=noise))
+    c = _script(Vehicle(seed=2, estimate_noise=noise))
     assert a == b
     assert a != c

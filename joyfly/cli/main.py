@@ -17,10 +17,9 @@ import click
 
 from flightview.launch import ViewOptions
 from flightview.options import view_options, view_settings
-from joyfly.cli_joystick import joystick
+from joyfly.cli.joystick import joystick
 from joyfly.config import BOUNDS, CONTROLS, ConfigError, FlyOptions, build_options, load_file
 from joyfly.dashboard import make_view
-from joyfly.link.signing_key import SigningKeyError, read_signing_key
 from joyfly.link.speedwatch import SpeedWatch
 from joyfly.link.transport import TransportError, open_transport
 from joyfly.link.vehicle_link import VehicleLink
@@ -31,13 +30,14 @@ from joyfly.session.factory import make_session
 from joyfly.session.fence_watch import FENCE_ACTIONS, FENCE_GRACE_S
 from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
-from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
 from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
 from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
+from px4common.signing_key import SigningKeyError, read_signing_key
 
 TOOL = "joyfly"
 D = FlyOptions()

@@ -1,4 +1,4 @@
-"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS (the record format: joyfly/sticks/js_events.py).
+"""The Linux joystick (js) API, read directly: no SDL, no evdev, no ROS (the record format: joyfly/sticks/js/events.py).
 
 `open_joystick(spec, clock)` returns a `JoystickSource` for what `--joy` names:
   - a js device: name and axis/button counts come from the JSIOCGNAME/JSIOCGAXES/JSIOCGBUTTONS ioctls; a read error
@@ -7,12 +7,12 @@
     writer connects and after it closes, `connected=False`; a new writer is picked up again;
   - a pseudo-terminal carrying js_event records (e.g. `socat` forwarding a remote joystick), read like a device;
   - a recording written by `--record` (its first line says so): replayed, as `replay:FILE` does;
-  - `raw:FILE`: a capture (`cat /dev/input/js0 > FILE`), checked and played by joyfly/sticks/raw_capture.py; or a
+  - `raw:FILE`: a capture (`cat /dev/input/js0 > FILE`), checked and played by joyfly/sticks/js/raw_capture.py; or a
     character device that is no joystick, read as one; `script:FILE`, `replay:FILE`: joyfly/sticks/virtual.py.
 Anything else is refused at open, before a vehicle is touched: a regular file that is no recording (without raw:
 joyfly takes no file for a joystick), a directory, a character device that answers neither the js ioctls nor is a
 pty (/dev/null, /dev/urandom, an evdev node). Only a FIFO waits for its writer. What a FIFO, a pty or a device sends
-is checked record by record (js_events.JsStreamCheck): the first one joydev never writes stops the reading for good
+is checked record by record (events.JsStreamCheck): the first one joydev never writes stops the reading for good
 (`gone`: before take-off the session ends with that sentence; in flight it is a lost joystick). For a FIFO the counts
 grow as events arrive and the name is the path.
 """
@@ -28,7 +28,7 @@ import select
 import stat
 from dataclasses import dataclass
 
-from joyfly.sticks.js_events import (
+from joyfly.sticks.js.events import (
     AXIS_MAX,
     EVENT_FORMAT,
     EVENT_SIZE,
@@ -48,7 +48,7 @@ from joyfly.sticks.js_events import (
     permission_error,
     vanished_error,
 )
-from joyfly.sticks.raw_capture import RawCapture
+from joyfly.sticks.js.raw_capture import RawCapture
 from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoyState, JoystickSource
 from px4common.clock import WallClock
@@ -143,7 +143,7 @@ def _is_joystick_or_pty(fd: int) -> bool:
 
 def refusal(fd: int, path: str, raw: bool = False) -> str | None:
     """Why the open file `fd` cannot be a joystick (one sentence), or None when it can; `raw` (the `raw:` spec) takes
-    the user's word for a character device (a regular file under raw: is a capture: joyfly/sticks/raw_capture.py)."""
+    the user's word for a character device (a regular file under raw: is a capture: joyfly/sticks/js/raw_capture.py)."""
     kind = _kind_of(fd)
     if kind == "directory":
         return f"{path} is a directory, not a joystick: pass {JOYSTICKS}."

@@ -15,8 +15,7 @@ from support.joyfly_sim import SimClock, memory_pair
 from joyfly.link.vehicle_link import VehicleLink
 from joyfly.session.core import Phase, SessionSettings
 from joyfly.session.flight_session import FlightSession
-from joyfly.sticks.joystick import open_joystick
-from joyfly.sticks.js_events import (
+from joyfly.sticks.js.events import (
     JS_EVENT_AXIS,
     JS_EVENT_BUTTON,
     JS_EVENT_INIT,
@@ -25,8 +24,9 @@ from joyfly.sticks.js_events import (
     pack_event,
     parse_events,
 )
+from joyfly.sticks.js.raw_capture import capture_steps
+from joyfly.sticks.js.reader import open_joystick
 from joyfly.sticks.mapping import open_sticks
-from joyfly.sticks.raw_capture import capture_steps
 
 AXES, BUTTONS = 4, 7  # the script profile's layout (joyfly script), so captures map without a --profile
 

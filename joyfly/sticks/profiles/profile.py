@@ -35,7 +35,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
-from joyfly.sticks.js_events import AXIS_MAX, JoystickError
+from joyfly.sticks.js.events import AXIS_MAX, JoystickError
 from joyfly.types import Action, JoyState
 
 if sys.version_info >= (3, 11):
@@ -66,6 +66,9 @@ class AxisMap:
 
 @dataclass(frozen=True, slots=True)
 class Profile:
+    """A controller's layout: the device names (and SDL GUIDs) it fits, which axis flies which role, which button
+    does which action, and how long the arm button is held."""
+
     name: str
     description: str
     match: tuple[str, ...]  # fnmatch patterns on the lower-cased js device name

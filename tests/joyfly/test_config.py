@@ -123,8 +123,8 @@ def test_position_and_altitude_control_stream_at_qgcs_25_hz_unless_told() -> Non
 
 
 def test_position_control_refuses_a_profile_without_a_throttle() -> None:
-    from joyfly.cli import throttle_problem
-    from joyfly.sticks.profiles import load_profile
+    from joyfly.cli.main import throttle_problem
+    from joyfly.sticks.profiles.profile import load_profile
 
     problem = throttle_problem("position", load_profile("generic", "some pad"))
     assert problem is not None and "maps no throttle" in problem and "[profile.up] index" in problem

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from support.joyfly_sim import SimClock
 
-from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.profiles.profile import load_profile
 from joyfly.sticks.takeoff_check import first_takeoff_throttle_s, takeoff_warning
 from joyfly.sticks.virtual import SCRIPT_NAME, ScriptSource
 

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import pytest
 
-from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.js.reader import JoystickError
 from joyfly.sticks.mapping import StickMapper, apply_deadzone, apply_expo, fired, map_state, open_sticks, shape_axis
-from joyfly.sticks.profiles import AxisMap, get_profile, load_profile
+from joyfly.sticks.profiles.profile import AxisMap, get_profile, load_profile
 from joyfly.types import Action, JoyState, StickCommand
 
 FULL = 32767
@@ -39,7 +39,7 @@ def test_invert_and_scale():
 
 @dataclass(frozen=True)
 class Pad:
-    """A controller's hardware layout as reference/joystick.md 1C-2 describes it (independent of profiles.py)."""
+    """A controller's hardware layout as reference/joystick.md 1C-2 describes it (not read from profile.py)."""
 
     name: str  # the js name the kernel reports
     lx: int

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 from support import REPO_ROOT
 
-from joyfly.sticks.joystick import JoystickError, open_joystick
+from joyfly.sticks.js.reader import JoystickError, open_joystick
 from joyfly.sticks.mapping import StickMapper
-from joyfly.sticks.profiles import load_profile
+from joyfly.sticks.profiles.profile import load_profile
 from joyfly.sticks.virtual import JoyRecorder, ReplaySource, ScriptSource, parse_script, record_to
 from joyfly.types import Action
 

@@ -14,13 +14,13 @@ from click.testing import CliRunner
 from support.calibration_user import CalibrationUser
 from support.sdl_virtual import VirtualPad
 
-from joyfly.cli_calibrate import TerminalConsole
-from joyfly.cli_joystick import joystick
-from joyfly.sticks.calibrate import Wizard
-from joyfly.sticks.joystick import JoystickError
+from joyfly.cli.calibrate import TerminalConsole
+from joyfly.cli.joystick import joystick
+from joyfly.sticks.js.reader import JoystickError
 from joyfly.sticks.mapping import open_sticks
+from joyfly.sticks.profiles.calibrate import Wizard
+from joyfly.sticks.profiles.user import load_user_profiles, profile_toml, write_user_profile
 from joyfly.sticks.sources import open_source
-from joyfly.sticks.user_profiles import load_user_profiles, profile_toml, write_user_profile
 from joyfly.types import Action
 from px4common.clock import WallClock
 

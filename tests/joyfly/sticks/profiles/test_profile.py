@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from joyfly.sticks.profiles import (
+from joyfly.sticks.profiles.profile import (
     ProfileError,
     get_profile,
     load_profile,

@@ -1,4 +1,4 @@
-"""The one platform seam of joyfly's joystick side: the Linux js reader (joyfly/sticks/joystick.py) needs `fcntl`
+"""The one platform seam of joyfly's joystick side: the Linux js reader (joyfly/sticks/js/reader.py) needs `fcntl`
 for the joystick ioctls, which Windows has not. Everything else that reads joysticks (SDL, `script:`, `replay:` and
 recordings) is portable, so joyfly imports the js reader only through here: where it cannot be imported, SDL and the
 virtual joysticks still work and a js path ends in one sentence.
@@ -9,11 +9,11 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.virtual import ReplaySource, ScriptSource, is_recording
 from joyfly.types import Clock, JoystickSource
 
-JS_MODULE = "joyfly.sticks.joystick"
+JS_MODULE = "joyfly.sticks.js.reader"
 
 
 class JsUnavailable(JoystickError):

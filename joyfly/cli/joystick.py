@@ -14,17 +14,17 @@ from typing import Any, TextIO
 
 import click
 
-from joyfly.cli_calibrate import calibrate
-from joyfly.sticks.js_events import JoystickError
-from joyfly.sticks.js_seam import js_reader_or_none
+from joyfly.cli.calibrate import calibrate
+from joyfly.sticks.js.events import JoystickError
+from joyfly.sticks.js.seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
 from joyfly.sticks.mapping import StickMapper
-from joyfly.sticks.profiles import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.profiles.profile import BUILTIN, Profile, load_profile, profile_names, read_config, rest_problems
+from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.listing import sdl_lines
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sdl.source import SdlSource
 from joyfly.sticks.sources import open_source, pick_profile
-from joyfly.sticks.user_profiles import find_user_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand

@@ -5,14 +5,14 @@ A file is not a joystick: joyfly refuses at open, before any MAVLink is sent, a 
 kernel's joydev writes (`JsStreamCheck`: random bytes fail on their first record with 252 chances in 256), and a
 file that holds no record or a piece of one. A capture ends at its last record: from then on the joystick is gone
 (`JoyState.connected` False), which a flight takes for a lost joystick (hold, then land after --joy-timeout). A live
-joystick is streamed through a FIFO or a pty instead (joyfly/sticks/joystick.py), which waits for its writer.
+joystick is streamed through a FIFO or a pty instead (joyfly/sticks/js/reader.py), which waits for its writer.
 """
 
 from __future__ import annotations
 
 import os
 
-from joyfly.sticks.js_events import (
+from joyfly.sticks.js.events import (
     EVENT_SIZE,
     TIME_WRAP_MS,
     JoystickError,

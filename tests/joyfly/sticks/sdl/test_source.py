@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from support.sdl_virtual import BACK, LEFT_Y, RIGHT_X, RIGHT_Y, START, A, VirtualPad, Y
 
-from joyfly.sticks.joystick import JoystickError
+from joyfly.sticks.js.reader import JoystickError
 from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sdl.api import SdlUnavailable, sdl_api
 from joyfly.sticks.sdl.mappings import SdlMappings

@@ -31,7 +31,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from joyfly.sticks.profiles import Profile, ProfileError, apply_overrides, read_config
+from joyfly.sticks.profiles.profile import Profile, ProfileError, apply_overrides, read_config
 from joyfly.types import Action
 
 ENV_DIR = "JOYFLY_PROFILES"

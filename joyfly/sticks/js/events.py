@@ -4,7 +4,7 @@ records (include/uapi/linux/joystick.h), the state they build, and the joystick 
 Axes run -32767..32767 (up on a stick is negative), buttons 1/0. On open, and again after the kernel's 64-event queue
 overflows, the driver re-sends the whole state as events flagged JS_EVENT_INIT (buttons first, then axes).
 `JsStreamCheck` tells js_event records from bytes that merely come in 8-byte pieces (drivers/input/joydev.c is what
-writes real ones). No I/O here: joyfly/sticks/joystick.py reads devices, joyfly/sticks/raw_capture.py captures.
+writes real ones). No I/O here: joyfly/sticks/js/reader.py reads devices, joyfly/sticks/js/raw_capture.py captures.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ QGroundControl's joystick calibration does, for any source (SDL game controllers
      reversed, and a throttle that rested at one end of its travel is a radio's (non-centring) throttle;
   3. the buttons for arm, take-off, land, return, hold and OFFBOARD (press one, or Enter to leave it unbound).
 
-The result is a Profile (joyfly/sticks/profiles.py) that `user_profiles.profile_toml` writes. The wizard talks
+The result is a Profile (joyfly/sticks/profiles/profile.py) that `user.profile_toml` writes. The wizard talks
 through a `Console` (say a prompt; has Enter been pressed?), so a test drives it with a virtual joystick.
 """
 
@@ -17,8 +17,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
-from joyfly.sticks.js_events import AXIS_MAX, JoystickError
-from joyfly.sticks.profiles import AxisMap, Profile
+from joyfly.sticks.js.events import AXIS_MAX, JoystickError
+from joyfly.sticks.profiles.profile import AxisMap, Profile
 from joyfly.types import Action, JoyState, JoystickSource
 
 CENTRE_S = 1.0  # hands off for this long: rest values and noise

@@ -1,5 +1,5 @@
-"""`joyfly joystick calibrate`: the calibration wizard (joyfly/sticks/calibrate.py) on a terminal; writes the
-profile where joyfly looks profiles up (joyfly/sticks/user_profiles.py), shows it, and from then on `joyfly fly`
+"""`joyfly joystick calibrate`: the calibration wizard (joyfly/sticks/profiles/calibrate.py) on a terminal; writes the
+profile where joyfly looks profiles up (joyfly/sticks/profiles/user.py), shows it, and from then on `joyfly fly`
 flies that device with it (with --profile auto)."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ import threading
 
 import click
 
-from joyfly.sticks.calibrate import Wizard
-from joyfly.sticks.js_events import JoystickError
+from joyfly.sticks.js.events import JoystickError
+from joyfly.sticks.profiles.calibrate import Wizard
+from joyfly.sticks.profiles.user import profile_dir, profile_toml, write_user_profile
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sources import open_source
-from joyfly.sticks.user_profiles import profile_dir, profile_toml, write_user_profile
 from px4common.clock import WallClock
 
 

@@ -6,43 +6,17 @@ it sends with the same key, and takes from the vehicle only what is signed with 
 that a vehicle without the key is still found, and `--setup-signing` can give it the key with SETUP_SIGNING, as
 QGroundControl does: PX4 accepts it from any link while it has no key, and signed with the current key after).
 
-The key file holds the 32 bytes as 64 hexadecimal digits or raw (PX4's own 40-byte mavlink-signing-key.bin too); the
-same files `sitl-emu serve --signing-key` reads (sitl_emu/cli/signing_key.py: joyfly does not import sitl_emu, and
-tests/joyfly/test_signing_key.py checks the two readers agree).
+The key file is read by px4common/signing_key.py, as `sitl-emu serve --signing-key` reads it.
 """
 
 from __future__ import annotations
 
-import string
 import time
-from pathlib import Path
 from typing import Any
 
-KEY_LEN = 32
-PX4_KEY_FILE_LEN = 40  # key, then the 8-byte timestamp
 EPOCH_2015_UNIX_US = 1_420_070_400_000_000  # signing timestamps count 10 us from 2015-01-01
 HEARTBEAT_ID = 0
 LINK_ID = 0
-
-
-class SigningKeyError(Exception):
-    """The key file cannot be used; the message is one sentence."""
-
-
-def read_signing_key(path: str | Path) -> bytes:
-    """The 32-byte key in `path`."""
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as err:
-        raise SigningKeyError(f"--signing-key {path}: cannot read it ({err.strerror or err}).") from None
-    text = data.strip()
-    if len(text) == 2 * KEY_LEN and all(chr(c) in string.hexdigits for c in text):
-        return bytes.fromhex(text.decode("ascii"))
-    if len(data) in (KEY_LEN, PX4_KEY_FILE_LEN):
-        return data[:KEY_LEN]
-    raise SigningKeyError(f"--signing-key {path}: not a MAVLink signing key; the file must hold 32 bytes, as 64 "
-                          f"hexadecimal digits or raw (e.g. `openssl rand -hex 32 > {path.name}`).")
 
 
 def wall_timestamp() -> int:

@@ -1,4 +1,4 @@
-"""The js reader behind its platform seam (joyfly/sticks/js_seam.py): where it cannot be imported (Windows has no
+"""The js reader behind its platform seam (joyfly/sticks/js/seam.py): where it cannot be imported (Windows has no
 fcntl), joyfly still imports, SDL and the virtual joysticks still work, and a js path is one sentence; where it can,
 everything goes to it as before."""
 
@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 from support import REPO_ROOT
 
-from joyfly.sticks.js_events import JoystickError
-from joyfly.sticks.js_seam import JS_MODULE, JsUnavailable, js_reader, js_reader_or_none, open_js
+from joyfly.sticks.js.events import JoystickError
+from joyfly.sticks.js.seam import JS_MODULE, JsUnavailable, js_reader, js_reader_or_none, open_js
 from joyfly.sticks.virtual import ScriptSource
 
 MISSING = "joyfly.sticks.no_js_api_here"

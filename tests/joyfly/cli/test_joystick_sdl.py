@@ -16,7 +16,7 @@ from click.testing import CliRunner
 from support import REPO_ROOT
 from support.sdl_virtual import RIGHT_Y, VirtualPad
 
-from joyfly.cli_joystick import joystick
+from joyfly.cli.joystick import joystick
 from joyfly.sticks.sdl.api import sdl_api
 
 

@@ -9,8 +9,8 @@ import tty
 
 import pytest
 
-from joyfly.sticks import joystick
-from joyfly.sticks.joystick import (
+from joyfly.sticks.js import reader
+from joyfly.sticks.js.reader import (
     EVENT_SIZE,
     JS_EVENT_AXIS,
     JS_EVENT_BUTTON,
@@ -163,24 +163,24 @@ def test_device_read_error_disconnects_then_reopens(pty_device, monkeypatch):
     def unplugged(fd, n):
         raise OSError(errno.ENODEV, "No such device")
 
-    monkeypatch.setattr(joystick.os, "read", unplugged)
+    monkeypatch.setattr(reader.os, "read", unplugged)
     os.write(master, pack_event(JS_EVENT_AXIS, 0, 7))
     state = src.poll(0.5)
     assert state.connected is False
     assert str(src.last_error).startswith(f"The joystick {path} vanished")
 
-    monkeypatch.setattr(joystick.os, "read", real_read)
+    monkeypatch.setattr(reader.os, "read", real_read)
     real_open = os.open
 
     def gone(p, flags):
         raise FileNotFoundError(errno.ENOENT, "No such file")
 
-    monkeypatch.setattr(joystick.os, "open", gone)
+    monkeypatch.setattr(reader.os, "open", gone)
     clock.sleep(0.5)
     assert src.poll(0.1).connected is False  # the node is gone: still "vanished", not "no such device"
     assert isinstance(src.last_error, DeviceVanishedError)
 
-    monkeypatch.setattr(joystick.os, "open", real_open)
+    monkeypatch.setattr(reader.os, "open", real_open)
     state = src.poll(0.1)  # retries at most every 0.5 s
     assert state.connected is False
     clock.sleep(0.5)
@@ -206,7 +206,7 @@ def test_permission_denied_says_how_to_fix(tmp_path, monkeypatch):
     def denied(path, flags):
         raise PermissionError(errno.EACCES, "Permission denied")
 
-    monkeypatch.setattr(joystick.os, "open", denied)
+    monkeypatch.setattr(reader.os, "open", denied)
     with pytest.raises(JoystickError) as info:
         open_joystick("/dev/input/js0", FakeClock())
     message = str(info.value)
@@ -280,14 +280,14 @@ def test_raw_vouches_for_a_character_device_without_js_ioctls():
 
 
 def test_a_device_answering_the_js_ioctls_is_a_joystick(monkeypatch):
-    real_ioctl = joystick.fcntl.ioctl
+    real_ioctl = reader.fcntl.ioctl
 
     def js_driver(fd, request, arg):
-        if request == joystick.JSIOCGVERSION:
+        if request == reader.JSIOCGVERSION:
             return b"\x00\x01\x02\x00"  # joydev answers JS_VERSION 0x020100
         return real_ioctl(fd, request, arg)
 
-    monkeypatch.setattr(joystick.fcntl, "ioctl", js_driver)
+    monkeypatch.setattr(reader.fcntl, "ioctl", js_driver)
     src = open_joystick("/dev/null", FakeClock())
     assert src.kind == "device"
     src.close()
@@ -318,7 +318,7 @@ def test_a_device_replaced_by_something_else_is_not_reopened(pty_device, tmp_pat
     def unplugged(fd, n):
         raise OSError(errno.ENODEV, "No such device")
 
-    monkeypatch.setattr(joystick.os, "read", unplugged)
+    monkeypatch.setattr(reader.os, "read", unplugged)
     assert src.poll(0.1).connected is False
     monkeypatch.undo()
     clock.sleep(1.0)

@@ -8,9 +8,9 @@ import threading
 
 from click.testing import CliRunner
 
-from joyfly.cli_joystick import LiveView, joystick
-from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
-from joyfly.sticks.profiles import get_profile
+from joyfly.cli.joystick import LiveView, joystick
+from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+from joyfly.sticks.profiles.profile import get_profile
 from joyfly.types import JoyState, StickCommand
 
 SCRIPT = "0 forward=0.5\n0.05 arm=1\n+0.1 arm=0\n+0.05 end\n"
