@@ -24,7 +24,8 @@ earlier request); a burst that finds the file shorter than when it was opened en
 sending empty packets).
 
 The root: FtpProtocol.root, or `fs/` in the working directory the emulator started in (created on the first
-request), as PX4 SITL serves its working directory. `FtpProtocol.with_root(path)` is the class to list for a node.
+request), as PX4 SITL serves its working directory; FtpProtocol.mounts add PX4 SITL's read-only log/, etc/ and
+parameter file to it (ftp_sandbox.py). `FtpProtocol.with_root(path, mounts)` is the class to list for a node.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ import errno
 import io
 import os
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import TYPE_CHECKING, ClassVar, cast
@@ -169,15 +170,17 @@ class FtpProtocol:
 
     MESSAGES: ClassVar[tuple[str, ...]] = ("FILE_TRANSFER_PROTOCOL",)
     root: ClassVar[str | os.PathLike[str] | None] = None  # None: ./fs of the working directory
+    mounts: ClassVar[Mapping[str, str | os.PathLike[str]]] = {}  # read-only top-level names (ftp_sandbox.py)
 
     @classmethod
-    def with_root(cls, root: str | os.PathLike[str]) -> type[FtpProtocol]:
-        """This protocol serving `root` (a handler class, for a node's handler list)."""
-        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), {"root": root}))
+    def with_root(cls, root: str | os.PathLike[str] | None,
+                  mounts: Mapping[str, str | os.PathLike[str]] | None = None) -> type[FtpProtocol]:
+        """This protocol serving `root` with `mounts` (a handler class, for a node's handler list)."""
+        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), {"root": root, "mounts": dict(mounts or {})}))
 
     def __init__(self) -> None:
         root = self.root if self.root is not None else os.path.join(os.getcwd(), "fs")
-        self.sandbox = Sandbox(root)
+        self.sandbox = Sandbox(root, self.mounts)
         self._file: io.FileIO | None = None
         self._file_size = 0  # of the file last opened (PX4 keeps it after the session ends)
         self._burst: _Burst | None = None
@@ -259,7 +262,7 @@ class FtpProtocol:
     def _open(self, p: Payload, flags: int) -> None:
         if self._file is not None:
             raise FtpNak(Err.NO_SESSIONS_AVAILABLE)
-        path = self.sandbox.target(p.path())
+        path = self.sandbox.target(p.path(), write=flags != os.O_RDONLY)
         try:
             size = os.stat(path).st_size
         except OSError:
@@ -303,8 +306,9 @@ class FtpProtocol:
     # --- paths ---------------------------------------------------------------------------------------------------
     def _list(self, p: Payload) -> None:
         path = self.sandbox.target(p.path())
+        mounted = self.sandbox.mount_entries() if self.sandbox.is_root(path) else None
         try:
-            data, ended = listing(path, p.offset, MAX_DATA)
+            data, ended = listing(path, p.offset, MAX_DATA, mounted)
         except OSError as err:
             raise FtpNak(Err.FILE_NOT_FOUND) from err  # PX4: opendir() failed
         if not data and ended and p.offset != 0:
@@ -330,7 +334,7 @@ class FtpProtocol:
         p.size = 0
 
     def _truncate(self, p: Payload) -> None:
-        path = self.sandbox.target(p.path())
+        path = self.sandbox.target(p.path(), write=True)
         p.size = 0
         os.truncate(path, p.offset)
 
