@@ -34,7 +34,7 @@ def handler_classes(directory: str | os.PathLike[str],
     mounts: dict[str, str | os.PathLike[str]] = {"log": directory}
     if params_file is not None:
         mounts[Path(params_file).name] = params_file
-    ftp = FtpProtocol.with_root(FtpProtocol.root, {**FtpProtocol.mounts, **mounts})
+    ftp = FtpProtocol.with_root(FtpProtocol.root, {**FtpProtocol.mounts, **mounts}, metadata=FtpProtocol.metadata)
     replaced: dict[type, type] = {LogProtocol: serving, FtpProtocol: ftp}
     return [replaced.get(cls, cls) for cls in load_handler_classes()]
 

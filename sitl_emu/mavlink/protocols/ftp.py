@@ -24,8 +24,9 @@ earlier request); a burst that finds the file shorter than when it was opened en
 sending empty packets).
 
 The root: FtpProtocol.root, or `fs/` in the working directory the emulator started in (created on the first
-request), as PX4 SITL serves its working directory; FtpProtocol.mounts add PX4 SITL's read-only log/, etc/ and
-parameter file to it (ftp_sandbox.py). `FtpProtocol.with_root(path, mounts)` is the class to list for a node.
+request), as PX4 SITL serves its working directory; FtpProtocol.mounts add PX4 SITL's read-only log/ and parameter
+file to it (ftp_sandbox.py), and etc/ holds the component metadata (component_metadata.py) unless with_root() was
+given a root of its own. `FtpProtocol.with_root(path, mounts)` is the class to list for a node.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import TYPE_CHECKING, ClassVar, cast
 
+from sitl_emu.mavlink.protocols.component_metadata import etc_directory
 from sitl_emu.mavlink.protocols.ftp_sandbox import PathRefused, Sandbox, c_string, crc32_file, listing
 
 if TYPE_CHECKING:
@@ -53,8 +55,7 @@ SESSION_IDLE_US = 10_000_000
 BURST_CHUNK_BYTES = 35_000  # "perform transfers in 35K chunks"
 # PX4 fills its 1500-byte UDP budget each 1.5 ms loop pass (5 packets); per 4 ms tick that is about 12
 BURST_PACKETS_PER_TICK = 12
-_HEADER = struct.Struct("<HBBBBBBI")
-_U32 = struct.Struct("<I")
+_HEADER, _U32 = struct.Struct("<HBBBBBBI"), struct.Struct("<I")
 
 
 class Op(IntEnum):
@@ -95,8 +96,7 @@ class Err(IntEnum):
 class FtpNak(Exception):
     def __init__(self, code: Err, err_no: int = 0) -> None:
         super().__init__(code.name)
-        self.code = code
-        self.err_no = err_no
+        self.code, self.err_no = code, err_no
 
 
 def nak_for(err: OSError) -> FtpNak:
@@ -171,16 +171,19 @@ class FtpProtocol:
     MESSAGES: ClassVar[tuple[str, ...]] = ("FILE_TRANSFER_PROTOCOL",)
     root: ClassVar[str | os.PathLike[str] | None] = None  # None: ./fs of the working directory
     mounts: ClassVar[Mapping[str, str | os.PathLike[str]]] = {}  # read-only top-level names (ftp_sandbox.py)
+    metadata: ClassVar[bool] = True  # etc/: PX4's ROMFS extras, the component metadata
 
     @classmethod
-    def with_root(cls, root: str | os.PathLike[str] | None,
-                  mounts: Mapping[str, str | os.PathLike[str]] | None = None) -> type[FtpProtocol]:
-        """This protocol serving `root` with `mounts` (a handler class, for a node's handler list)."""
-        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), {"root": root, "mounts": dict(mounts or {})}))
+    def with_root(cls, root: str | os.PathLike[str] | None, mounts: Mapping[str, str | os.PathLike[str]] | None = None,
+                  metadata: bool = False) -> type[FtpProtocol]:
+        """This protocol serving `root` with `mounts` (and etc/ if `metadata`): a class for a node's handler list."""
+        attrs = {"root": root, "mounts": dict(mounts or {}), "metadata": metadata}
+        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), attrs))
 
     def __init__(self) -> None:
         root = self.root if self.root is not None else os.path.join(os.getcwd(), "fs")
-        self.sandbox = Sandbox(root, self.mounts)
+        etc = {"etc": etc_directory()} if self.metadata else {}
+        self.sandbox = Sandbox(root, {**etc, **self.mounts})
         self._file: io.FileIO | None = None
         self._file_size = 0  # of the file last opened (PX4 keeps it after the session ends)
         self._burst: _Burst | None = None

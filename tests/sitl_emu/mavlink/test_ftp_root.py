@@ -35,12 +35,12 @@ def world(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
     harness.close()
 
 
-def test_root_lists_log_and_the_parameter_file_beside_the_clients_files(world):
+def test_root_lists_etc_log_and_the_parameter_file_beside_the_clients_files(world):
     ftp, tmp = world
-    assert ftp.list_dir(b"/") == [b"S", b"S", b"Dlog", b"Fparameters.params\t23"]
+    assert ftp.list_dir(b"/") == [b"S", b"S", b"Detc", b"Dlog", b"Fparameters.params\t23"]
     ftp.write_file(b"/mine.txt", b"hello")
     assert (tmp / "fs" / "mine.txt").read_bytes() == b"hello"
-    assert ftp.list_dir(b"/") == [b"S", b"S", b"Dlog", b"Fmine.txt\t5", b"Fparameters.params\t23"]
+    assert ftp.list_dir(b"/") == [b"S", b"S", b"Detc", b"Dlog", b"Fmine.txt\t5", b"Fparameters.params\t23"]
 
 
 def test_logs_are_listed_and_downloaded_under_log(world):
@@ -49,6 +49,14 @@ def test_logs_are_listed_and_downloaded_under_log(world):
     assert ftp.list_dir(b"/log/2026-01-02") == [b"S", b"S", b"F10_00_00.ulg\t604"]
     assert ftp.read_file(b"/log/2026-01-02/10_00_00.ulg") == b"ULog" + bytes(600)
     assert ftp.read_file(b"/parameters.params") == b"1 1 MPC_XY_VEL_MAX 9 9\n"
+
+
+def test_etc_extras_holds_the_component_metadata(world):
+    ftp, _tmp = world
+    assert ftp.list_dir(b"/etc") == [b"S", b"S", b"Dextras"]
+    names = sorted(e.split(b"\t")[0] for e in ftp.list_dir(b"/etc/extras") if e != b"S")
+    assert names == [b"Fall_events.json.xz", b"Fcomponent_general.json.xz", b"Fparameters.json.xz"]
+    assert ftp.nak(Op.REMOVE_FILE, b"/etc/extras/parameters.json.xz\0") == (Err.FILE_PROTECTED, 0)
 
 
 def test_mounts_are_read_only(world):
@@ -78,6 +86,6 @@ def test_a_mount_that_does_not_exist_yet_is_not_listed(tmp_path, monkeypatch):
                if c.__name__ == FtpProtocol.__name__]
     harness = Harness(FakeVehicle(), handler_classes=classes)
     try:
-        assert FtpClient(harness).list_dir(b"/") == [b"S", b"S"]
+        assert FtpClient(harness).list_dir(b"/") == [b"S", b"S", b"Detc"]  # the metadata is always there
     finally:
         harness.close()
