@@ -127,3 +127,36 @@ def test_a_request_for_a_missing_event_gets_response_event_error(h):
     assert first_error == {"target_system": 255, "target_component": 190, "sequence": FIRST_SEQUENCE - 5,
                            "sequence_oldest_available": FIRST_SEQUENCE, "reason": 0}
     assert replies[5][1]["sequence"] == FIRST_SEQUENCE
+
+
+@pytest.mark.parametrize("definition", [d for d in DEFINITIONS if not d.arguments], ids=lambda d: d.name)
+def test_an_event_without_arguments_says_what_its_statustext_says(definition):
+    from sitl_emu.events.catalogue import to_px4_event
+    from sitl_emu.px4 import Severity
+    from sitl_emu.types import VehicleEvent
+
+    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", definition.message))
+    assert event is not None and event.id == definition.id and event.time_ms == 2000
+    assert EventsDecoder(events_metadata()).decode(event.id, event.arguments) == (definition.name, definition.message)
+    assert to_px4_event(VehicleEvent(1, 0, Severity.INFO, "commander", definition.message, is_event=False)) is None
+
+
+def _fly(h, seconds):
+    for _ in range(round(seconds)):  # QGC's heartbeat each second: the STATUSTEXTs go out too
+        h.gcs.heartbeat()
+        h.run(1.0)
+
+
+def test_a_flight_sends_takeoff_landing_and_the_disarm_by_landing(h):
+    h.run(2.5)
+    _command(h, MavCmd.COMPONENT_ARM_DISARM, 1)
+    _command(h, MavCmd.NAV_TAKEOFF)
+    _fly(h, 6.0)
+    _command(h, MavCmd.NAV_LAND)
+    _fly(h, 12.0)
+    decoder = EventsDecoder(events_metadata())
+    messages = [decoder.decode(e["id"], e["arguments"])[1] for e in _events(h.gcs)]
+    assert messages == ["Armed by external command", "Takeoff detected", "Landing at current position",
+                        "Landing detected", "Disarmed by landing"]
+    texts = [m.text.rstrip("\t") for m in h.gcs.of_type("STATUSTEXT") if m.text.endswith("\t")]
+    assert [t for t in texts if t in messages] == messages  # each beside its tab-terminated STATUSTEXT
