@@ -7,9 +7,11 @@
   log_levels, the 40 argument bytes). Before the first one, CURRENT_EVENT_SEQUENCE with the RESET flag tells a
   client where the sequence starts.
 - CURRENT_EVENT_SEQUENCE (the newest sequence; flags RESET while the buffer is empty) every 3 s
-  (current_sequence_interval) and when a ground station connects (on_gcs_connected), so a client notices what it
-  missed and asks for it.
-- REQUEST_EVENT (first..last sequence, to our sysid/compid) is answered from the buffer: EVENT for each sequence it
+  (current_sequence_interval), so a client notices what it missed and asks for it. (SendProtocol also has an
+  on_gcs_connected() that sends it at once; nothing in PX4's mavlink module calls it, and PX4 SIH's GCS link shows
+  the plain 3 s rhythm, ../shared/reference/px4-gcs-streams.json.)
+- REQUEST_EVENT (first..last sequence) is answered from the buffer, whatever its target (mavlink_receiver.cpp hands
+  every one to handle_request_event): EVENT for each sequence it
   still holds, RESPONSE_EVENT_ERROR (reason UNAVAILABLE, with the oldest sequence after it still available) for each
   it does not; a range longer than the buffer gets one error for its start and only its newest 20 are looked up.
 A reboot of the vehicle starts the sequence and the buffer again. Each link keeps its own copy of the buffer; both
@@ -32,7 +34,6 @@ if TYPE_CHECKING:
 INITIAL_EVENT_SEQUENCE = 65535 - 10
 BUFFER_CAPACITY = 20
 CURRENT_SEQUENCE_INTERVAL_US = 3_000_000
-GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected
 MAV_EVENT_CURRENT_SEQUENCE_FLAGS_RESET = 1
 MAV_EVENT_ERROR_REASON_UNAVAILABLE = 0
 MAV_COMP_ID_ALL = 0
@@ -72,15 +73,12 @@ class EventsProtocol:
         self._sent_any = False
         self._last_current_sequence_us = 0
         self._last_now_us = 0
-        self._gcs_connected = False
 
     def handle(self, msg: MAVLink_message, ctx: LinkContext) -> None:
         frame = bytes(getattr(msg, "data", b""))
         if len(frame) < 2:
             return
         request = decode(REQUEST_EVENT_ID, payload_of_unknown(frame))
-        if request["target_system"] != ctx.sysid or request["target_component"] != ctx.compid:
-            return
         self._answer(request["first_sequence"], request["last_sequence"], source_of_unknown(frame), ctx)
 
     def _answer(self, first: int, last: int, requester: tuple[int, int], ctx: LinkContext) -> None:
@@ -114,11 +112,8 @@ class EventsProtocol:
             event = to_px4_event(vehicle_event)
             if event is not None:
                 self._publish(event, ctx)
-        gcs_now = self._gcs_seen(ctx)
-        if (gcs_now and not self._gcs_connected) or now_us - self._last_current_sequence_us > \
-                CURRENT_SEQUENCE_INTERVAL_US:
+        if now_us - self._last_current_sequence_us > CURRENT_SEQUENCE_INTERVAL_US:
             self._send_current_sequence(ctx)
-        self._gcs_connected = gcs_now
         return True
 
     def _publish(self, event: Px4Event, ctx: LinkContext) -> None:
@@ -136,8 +131,3 @@ class EventsProtocol:
         self._last_current_sequence_us = ctx.now_us
         flags = MAV_EVENT_CURRENT_SEQUENCE_FLAGS_RESET if reset or not self.buffer.events else 0
         ctx.send(EXTRA.current_event_sequence_encode(self.buffer.latest_sequence, flags))
-
-    @staticmethod
-    def _gcs_seen(ctx: LinkContext) -> bool:
-        last = getattr(ctx, "last_gcs_heartbeat_us", None)
-        return last is not None and ctx.now_us - last <= GCS_TIMEOUT_US
