@@ -5,7 +5,8 @@ the emulator's commander and navigator say the text (a VehicleEvent with is_even
 the event PX4 sends with it: its name, message, argument types and levels as PX4's source states them, and the
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
-navigator/rtl_direct.cpp (rtl_land_at_destination, rtl_completed_loiter).
+navigator/rtl_direct.cpp (rtl_land_at_destination, rtl_completed_loiter), commander/failsafe/framework.cpp
+(failsafe_rc_override: a pilot's takeover).
 
 A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action,
 the RTL start and the take-off texts); its STATUSTEXT goes out as before.
@@ -113,6 +114,8 @@ ENTRIES: tuple[_Entry, ...] = (
     _Entry(EventDefinition("mission_finished", "Mission finished, landed"), _exact("Mission finished, landed")),
     _Entry(EventDefinition("mission_finished_loiter", "Mission finished, loitering"),
            _exact("Mission finished, loitering")),
+    _Entry(EventDefinition("failsafe_rc_override", "Pilot took over using sticks"),
+           _exact("Pilot took over using sticks")),
     _Entry(EventDefinition("rtl_land_at_destination", "RTL: land at destination"), _exact("RTL: land at destination")),
     _Entry(EventDefinition("rtl_completed_loiter", "RTL: completed, loitering"), _exact("RTL: completed, loitering")),
 )
