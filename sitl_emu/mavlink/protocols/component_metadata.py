@@ -9,7 +9,8 @@
   and the events (COMP_METADATA_TYPE_EVENTS, 4), served from PX4's ROMFS extras: etc/extras/parameters.json.xz and
   etc/extras/all_events.json.xz. Each CRC is MAVLink's CRC32 as PX4's generators compute it (the reflected table
   of 0xEDB88320, starting at 0, no final inversion: ftp_sandbox's crc32part) over the uncompressed JSON; each file
-  is xz-compressed as PX4's build does (python's lzma, preset 9).
+  is xz-compressed as PX4's build does with python's lzma, at preset 1 rather than PX4's 9 (the same container a
+  client decompresses, about 10 % larger, made in milliseconds instead of a 0.6 s, 670 MB compression at start).
 - parameters.json (PX4's Tools/px4params/jsonout.py layout: version, uid, scope, parameters [{name, type, default,
   group, shortDesc, units, min, max, volatile}]) lists the emulator's own parameter catalogue (every listed
   parameter with its type, default, stated range, unit and description), so it never disagrees with PARAM_VALUE.
@@ -44,6 +45,7 @@ EVENTS_FILE = "all_events.json.xz"
 COMP_METADATA_TYPE_PARAMETER = 1
 COMP_METADATA_TYPE_EVENTS = 4
 MSG_COMPONENT_METADATA = 397
+XZ_PRESET = 1
 
 
 def uri(name: str) -> str:
@@ -60,7 +62,7 @@ def _dumps(doc: dict[str, Any]) -> bytes:
 
 
 def _xz(data: bytes) -> bytes:
-    return lzma.compress(data, preset=9)
+    return lzma.compress(data, preset=XZ_PRESET)
 
 
 def _bound(value: float) -> float | None:
