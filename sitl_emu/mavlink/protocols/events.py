@@ -79,6 +79,10 @@ class EventsProtocol:
         if len(frame) < 2:
             return
         request = decode(REQUEST_EVENT_ID, payload_of_unknown(frame))
+        # pymavlink does not know this message's target fields; with them the link forwards it as PX4's
+        # forward_message does (a request for this vehicle stays here, a broadcast one goes on)
+        for field in ("target_system", "target_component"):
+            setattr(msg, field, request[field])
         self._answer(request["first_sequence"], request["last_sequence"], source_of_unknown(frame), ctx)
 
     def _answer(self, first: int, last: int, requester: tuple[int, int], ctx: LinkContext) -> None:

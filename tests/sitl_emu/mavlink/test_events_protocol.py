@@ -159,3 +159,14 @@ def test_a_flight_sends_takeoff_landing_and_the_disarm_by_landing(h):
                         "Landing detected", "Disarmed by landing"]
     texts = [m.text.rstrip("\t") for m in h.gcs.of_type("STATUSTEXT") if m.text.endswith("\t")]
     assert [t for t in texts if t in messages] == messages  # each beside its tab-terminated STATUSTEXT
+
+
+def test_a_request_for_this_vehicle_is_not_forwarded_to_the_other_link(h):
+    h.api.heartbeat()  # the API link has heard a component: broadcasts reach it
+    h.run(0.05)
+    EventReceiver(h.gcs).request(FIRST_SEQUENCE)
+    h.run(0.05)
+    EventReceiver(h.gcs, target=(0, 0)).request(FIRST_SEQUENCE)
+    h.run(0.05)
+    forwarded = [x[1] for x in map(extra_of, h.api.received) if x and x[0] == 412]
+    assert [(r["target_system"], r["target_component"]) for r in forwarded] == [(0, 0)]
