@@ -5,11 +5,11 @@ the emulator's commander and navigator say the text (a VehicleEvent with is_even
 the event PX4 sends with it: its name, message, argument types and levels as PX4's source states them, and the
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
-navigator/rtl_direct.cpp (rtl_land_at_destination, rtl_completed_loiter), commander/failsafe/framework.cpp
-(failsafe_rc_override: a pilot's takeover).
+navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter),
+commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover).
 
-A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action,
-the RTL start and the take-off texts); its STATUSTEXT goes out as before.
+A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action;
+the take-off texts); its STATUSTEXT goes out as before.
 """
 
 from __future__ import annotations
@@ -71,6 +71,10 @@ def _reason(m: re.Match[str]) -> Values | None:
     return None if value is None else (value,)
 
 
+def _integers(m: re.Match[str]) -> Values:
+    return tuple(int(g) for g in m.groups())
+
+
 _NAV_BY_UI_NAME = {name: nav for nav, name in UI_NAMES.items()}
 
 
@@ -114,6 +118,9 @@ ENTRIES: tuple[_Entry, ...] = (
     _Entry(EventDefinition("mission_finished", "Mission finished, landed"), _exact("Mission finished, landed")),
     _Entry(EventDefinition("mission_finished_loiter", "Mission finished, loitering"),
            _exact("Mission finished, loitering")),
+    _Entry(EventDefinition("vrtl_return_at", "RTL: start return at {1m_v} ({2m_v} above destination)",
+                           ("int32_t", "int32_t")),
+           re.compile(r"RTL: start return at (-?\d+) m \((-?\d+) m above destination\)"), _integers),
     _Entry(EventDefinition("failsafe_rc_override", "Pilot took over using sticks"),
            _exact("Pilot took over using sticks")),
     _Entry(EventDefinition("rtl_land_at_destination", "RTL: land at destination"), _exact("RTL: land at destination")),

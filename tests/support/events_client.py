@@ -5,6 +5,7 @@ and sub id in the metadata, unpack its arguments, fill the message), written sma
 
 from __future__ import annotations
 
+import re
 import struct
 from typing import Any
 
@@ -58,10 +59,17 @@ class EventsDecoder:
             offset += struct.calcsize(code)
             shown.append(enum["entries"].get(str(value), {}).get("description", f"(unknown: {value})") if enum
                          else value)
-        message = event["message"]
-        for i, value in enumerate(shown, 1):
-            message = message.replace("{" + str(i) + "}", str(value))
-        return event["name"], message
+        return event["name"], _ARGUMENT.sub(lambda m: _shown(m, shown), event["message"])
+
+
+# libevents' argument syntax: {N[:.DIGITS][UNIT]}, UNIT one of m, m_v (vertical metres: shown as m), m/s, m^2, C
+_ARGUMENT = re.compile(r"\{(\d+)(?::(?:\.(\d+))?)?(m|m_v|m/s|m\^2|C)?\}")
+
+
+def _shown(m: re.Match[str], values: list[Any]) -> str:
+    value = values[int(m.group(1)) - 1]
+    text = f"{value:.{m.group(2)}f}" if m.group(2) is not None else str(value)
+    return text + ("" if m.group(3) is None else " " + ("m" if m.group(3) == "m_v" else m.group(3)))
 
 
 class EventReceiver:

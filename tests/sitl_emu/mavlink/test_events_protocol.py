@@ -170,3 +170,14 @@ def test_a_request_for_this_vehicle_is_not_forwarded_to_the_other_link(h):
     h.run(0.05)
     forwarded = [x[1] for x in map(extra_of, h.api.received) if x and x[0] == 412]
     assert [(r["target_system"], r["target_component"]) for r in forwarded] == [(0, 0)]
+
+
+def test_rtl_start_carries_both_altitudes_as_px4s_vrtl_return_at():
+    from sitl_emu.events.catalogue import to_px4_event
+    from sitl_emu.px4 import Severity
+    from sitl_emu.types import VehicleEvent
+
+    text = "RTL: start return at 519 m (31 m above destination)"
+    event = to_px4_event(VehicleEvent(1, 0, Severity.INFO, "navigator", text))
+    assert event is not None and event.id == event_id("vrtl_return_at")
+    assert EventsDecoder(events_metadata()).decode(event.id, event.arguments) == ("vrtl_return_at", text)
