@@ -6,10 +6,12 @@ the event PX4 sends with it: its name, message, argument types and levels as PX4
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
 navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter),
-commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover).
+commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover), navigator/takeoff.cpp
+(navigator_takeoff_default_alt, whose altitude is read back from the text's one decimal;
+navigator_takeoff_already_higher).
 
-A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action;
-the take-off texts); its STATUSTEXT goes out as before.
+A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action);
+its STATUSTEXT goes out as before.
 """
 
 from __future__ import annotations
@@ -121,6 +123,10 @@ ENTRIES: tuple[_Entry, ...] = (
     _Entry(EventDefinition("vrtl_return_at", "RTL: start return at {1m_v} ({2m_v} above destination)",
                            ("int32_t", "int32_t")),
            re.compile(r"RTL: start return at (-?\d+) m \((-?\d+) m above destination\)"), _integers),
+    _Entry(EventDefinition("navigator_takeoff_default_alt", "Using default takeoff altitude: {1:.2m}", ("float",)),
+           re.compile(r"Using default takeoff altitude: (-?[\d.]+) m"), lambda m: (float(m.group(1)),)),
+    _Entry(EventDefinition("navigator_takeoff_already_higher", "Already higher than takeoff altitude (not descending)",
+                           external=Log.ERROR, internal=Log.INFO), _exact("Already higher than takeoff altitude")),
     _Entry(EventDefinition("failsafe_rc_override", "Pilot took over using sticks"),
            _exact("Pilot took over using sticks")),
     _Entry(EventDefinition("rtl_land_at_destination", "RTL: land at destination"), _exact("RTL: land at destination")),

@@ -4,11 +4,13 @@ metadata (tests/support/events_client.py)."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from support.events_client import EventReceiver, EventsDecoder, extra_of
 from support.fakes import Harness
 
-from sitl_emu.events.catalogue import DEFINITIONS
+from sitl_emu.events.catalogue import DEFINITIONS, ENTRIES
 from sitl_emu.events.library import event_id, hash_32_fnv1a, sub_id
 from sitl_emu.events.metadata import events_metadata
 from sitl_emu.mavlink.protocols.events import EventsProtocol
@@ -128,16 +130,18 @@ def test_a_request_for_a_missing_event_gets_response_event_error(h):
     assert replies[5][1]["sequence"] == FIRST_SEQUENCE
 
 
-@pytest.mark.parametrize("definition", [d for d in DEFINITIONS if not d.arguments], ids=lambda d: d.name)
-def test_an_event_without_arguments_says_what_its_statustext_says(definition):
+@pytest.mark.parametrize("entry", [e for e in ENTRIES if not e.definition.arguments], ids=lambda e: e.definition.name)
+def test_an_event_without_arguments_goes_with_its_statustext(entry):
     from sitl_emu.events.catalogue import to_px4_event
     from sitl_emu.px4 import Severity
     from sitl_emu.types import VehicleEvent
 
-    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", definition.message))
+    text = re.sub(r"\\(.)", r"\1", entry.text.pattern)  # the exact text the entry matches
+    definition = entry.definition
+    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", text))
     assert event is not None and event.id == definition.id and event.time_ms == 2000
     assert EventsDecoder(events_metadata()).decode(event.id, event.arguments) == (definition.name, definition.message)
-    assert to_px4_event(VehicleEvent(1, 0, Severity.INFO, "commander", definition.message, is_event=False)) is None
+    assert to_px4_event(VehicleEvent(1, 0, Severity.INFO, "commander", text, is_event=False)) is None
 
 
 def _fly(h, seconds):
@@ -155,8 +159,9 @@ def test_a_flight_sends_takeoff_landing_and_the_disarm_by_landing(h):
     _fly(h, 12.0)
     decoder = EventsDecoder(events_metadata())
     messages = [decoder.decode(e["id"], e["arguments"])[1] for e in _events(h.gcs)]
-    assert messages == ["Armed by external command", "Takeoff detected", "Landing at current position",
-                        "Landing detected", "Disarmed by landing"]
+    assert messages == ["Armed by external command", "Using default takeoff altitude: 2.50 m", "Takeoff detected",
+                        "Landing at current position", "Landing detected", "Disarmed by landing"]
+    messages.remove("Using default takeoff altitude: 2.50 m")  # PX4's text says 2.5 m, the event {1:.2m}
     texts = [m.text.rstrip("\t") for m in h.gcs.of_type("STATUSTEXT") if m.text.endswith("\t")]
     assert [t for t in texts if t in messages] == messages  # each beside its tab-terminated STATUSTEXT
 
