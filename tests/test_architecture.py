@@ -29,7 +29,7 @@ def sources(*parts: str) -> list[Path]:
 
 CORE = sources("sitl_emu/control", "sitl_emu/vehicle", "sitl_emu/commander", "sitl_emu/navigator",
                "sitl_emu/flight_tasks", "sitl_emu/motion_planning", "sitl_emu/params", "sitl_emu/physics.py",
-               "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py", "sitl_emu/disturbance")
+               "sitl_emu/px4.py", "sitl_emu/types.py", "sitl_emu/geo.py", "sitl_emu/disturbance", "sitl_emu/events")
 CORE_MAY_NOT = ("pymavlink", "sitl_emu.mavlink", "sitl_emu.runtime", "sitl_emu.testing", "sitl_emu.cli",
                 "sitl_emu.console", "time", "socket", "threading", "random")
 

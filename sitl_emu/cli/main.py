@@ -124,6 +124,14 @@ def build_params(params_file: Path | None, assignments: tuple[str, ...]) -> Para
     return registry
 
 
+def param_file_path(params_file: Path | None, instance: int, first: int) -> Path:
+    """Vehicle `instance`'s parameter file (stored_params' rule): what its FTP root shows beside log/."""
+    from sitl_emu.params.store import DEFAULT_FILE, instance_path
+
+    base = params_file if params_file is not None else Path(DEFAULT_FILE)
+    return instance_path(base, instance, first if params_file is not None else 0)
+
+
 def stored_params(params_file: Path | None, instance: int, first: int,
                   reset: bool) -> tuple[ParamRegistry, ParamStore, str | None]:
     """Vehicle `instance`'s registry with its saved values, its ParamStore, and a warning sentence (or None).
@@ -134,11 +142,11 @@ def stored_params(params_file: Path | None, instance: int, first: int,
     A bad --params FILE is the user's mistake (UsageProblem, as before); a bad default file is a warning.
     """
     from sitl_emu.params import default_registry
-    from sitl_emu.params.store import DEFAULT_FILE, ParamStore, instance_path
+    from sitl_emu.params.store import DEFAULT_FILE, ParamStore
 
     registry = default_registry()
     base = params_file if params_file is not None else Path(DEFAULT_FILE)
-    store = ParamStore(registry, instance_path(base, instance, first if params_file is not None else 0), instance + 1)
+    store = ParamStore(registry, param_file_path(params_file, instance, first), instance + 1)
     if reset:
         return registry, store, None
     if params_file is None:
@@ -275,7 +283,8 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
 
         nodes = build_nodes(count, settings, vehicle, first_instance=instance, home=home_lla,
                             epoch_unix_us=int(time.time() * 1e6),
-                            handlers_for=None if no_log else handlers_by_instance(log_dir, instance))
+                            handlers_for=None if no_log else handlers_by_instance(
+                                log_dir, instance, lambda i: param_file_path(params_file, i, instance)))
         _sign(nodes, instance, key)
     except (UsageProblem, PortInUseError, SigningKeyError) as err:
         raise UserError(str(err)) from None

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from sitl_emu.log.flight_log import FlightLogger
 from sitl_emu.mavlink.endpoint import load_handler_classes
+from sitl_emu.mavlink.protocols.ftp import FtpProtocol
 from sitl_emu.mavlink.protocols.log import DirectoryLogSource, LogProtocol
 from sitl_emu.runtime.node import VehicleNode
 
@@ -25,10 +26,17 @@ def instance_log_dir(base: str | os.PathLike[str], instance: int, first: int = 0
     return path if instance == first else path.with_name(f"{path.name}-{instance}")
 
 
-def handler_classes(directory: str | os.PathLike[str]) -> Sequence[type]:
-    """A node's protocol handlers, its log protocol serving `directory`."""
+def handler_classes(directory: str | os.PathLike[str],
+                    params_file: str | os.PathLike[str] | None = None) -> Sequence[type]:
+    """A node's protocol handlers: its log protocol serving `directory`, and its FTP root showing `directory` as
+    log/ and `params_file` (if any) under its name, read-only, as PX4 SITL's working directory holds them."""
     serving = LogProtocol.with_source(DirectoryLogSource(directory))
-    return [serving if cls is LogProtocol else cls for cls in load_handler_classes()]
+    mounts: dict[str, str | os.PathLike[str]] = {"log": directory}
+    if params_file is not None:
+        mounts[Path(params_file).name] = params_file
+    ftp = FtpProtocol.with_root(FtpProtocol.root, {**FtpProtocol.mounts, **mounts}, metadata=FtpProtocol.metadata)
+    replaced: dict[type, type] = {LogProtocol: serving, FtpProtocol: ftp}
+    return [replaced.get(cls, cls) for cls in load_handler_classes()]
 
 
 def attach_logger(node: VehicleNode, directory: str | os.PathLike[str]) -> FlightLogger:
@@ -38,9 +46,12 @@ def attach_logger(node: VehicleNode, directory: str | os.PathLike[str]) -> Fligh
     return logger
 
 
-def handlers_by_instance(base: str | os.PathLike[str], first: int = 0) -> Callable[[int], Sequence[type]]:
-    """build_nodes' `handlers_for`: each instance's handlers serve that instance's log directory."""
-    return lambda instance: handler_classes(instance_log_dir(base, instance, first))
+def handlers_by_instance(base: str | os.PathLike[str], first: int = 0,
+                         params_file: Callable[[int], Path] | None = None) -> Callable[[int], Sequence[type]]:
+    """build_nodes' `handlers_for`: each instance's handlers serve that instance's log directory (and parameter
+    file, `params_file(instance)`)."""
+    return lambda instance: handler_classes(instance_log_dir(base, instance, first),
+                                            None if params_file is None else params_file(instance))
 
 
 def attach_loggers(nodes: Sequence[VehicleNode], base: str | os.PathLike[str], first: int = 0) -> list[FlightLogger]:

@@ -44,6 +44,7 @@ HANDLER_CLASSES: tuple[tuple[str, str], ...] = (
     ("sitl_emu.mavlink.protocols.shell", "ShellBridge"),
     ("sitl_emu.mavlink.protocols.ftp", "FtpProtocol"),
     ("sitl_emu.mavlink.protocols.log", "LogProtocol"),
+    ("sitl_emu.mavlink.protocols.events", "EventsProtocol"),
 )
 
 

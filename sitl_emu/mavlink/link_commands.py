@@ -11,6 +11,7 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from sitl_emu.mavlink.protocols.component_metadata import MSG_COMPONENT_METADATA, component_metadata_message
 from sitl_emu.mavlink.telemetry.modes import available_modes
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.types import VehicleCommand
@@ -70,6 +71,8 @@ class CommandHandler:
                 return self._get_interval(_msg_id(cmd.param(2)), ctx)
             if msg_id == MSG_AVAILABLE_MODES:
                 return self._send_all(available_modes(ctx, cmd.param(2)), ctx)
+            if msg_id == MSG_COMPONENT_METADATA:
+                return self._send_all([component_metadata_message(ctx.now_us // 1000)], ctx)
             return self._request(msg_id, ctx)
         return self._request(LEGACY_REQUESTS[cmd.command], ctx)
 

@@ -24,7 +24,9 @@ earlier request); a burst that finds the file shorter than when it was opened en
 sending empty packets).
 
 The root: FtpProtocol.root, or `fs/` in the working directory the emulator started in (created on the first
-request), as PX4 SITL serves its working directory. `FtpProtocol.with_root(path)` is the class to list for a node.
+request), as PX4 SITL serves its working directory; FtpProtocol.mounts add PX4 SITL's read-only log/ and parameter
+file to it (ftp_sandbox.py), and etc/ holds the component metadata (component_metadata.py) unless with_root() was
+given a root of its own. `FtpProtocol.with_root(path, mounts)` is the class to list for a node.
 """
 
 from __future__ import annotations
@@ -33,11 +35,12 @@ import errno
 import io
 import os
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import TYPE_CHECKING, ClassVar, cast
 
+from sitl_emu.mavlink.protocols.component_metadata import etc_directory
 from sitl_emu.mavlink.protocols.ftp_sandbox import PathRefused, Sandbox, c_string, crc32_file, listing
 
 if TYPE_CHECKING:
@@ -52,8 +55,7 @@ SESSION_IDLE_US = 10_000_000
 BURST_CHUNK_BYTES = 35_000  # "perform transfers in 35K chunks"
 # PX4 fills its 1500-byte UDP budget each 1.5 ms loop pass (5 packets); per 4 ms tick that is about 12
 BURST_PACKETS_PER_TICK = 12
-_HEADER = struct.Struct("<HBBBBBBI")
-_U32 = struct.Struct("<I")
+_HEADER, _U32 = struct.Struct("<HBBBBBBI"), struct.Struct("<I")
 
 
 class Op(IntEnum):
@@ -94,8 +96,7 @@ class Err(IntEnum):
 class FtpNak(Exception):
     def __init__(self, code: Err, err_no: int = 0) -> None:
         super().__init__(code.name)
-        self.code = code
-        self.err_no = err_no
+        self.code, self.err_no = code, err_no
 
 
 def nak_for(err: OSError) -> FtpNak:
@@ -169,15 +170,20 @@ class FtpProtocol:
 
     MESSAGES: ClassVar[tuple[str, ...]] = ("FILE_TRANSFER_PROTOCOL",)
     root: ClassVar[str | os.PathLike[str] | None] = None  # None: ./fs of the working directory
+    mounts: ClassVar[Mapping[str, str | os.PathLike[str]]] = {}  # read-only top-level names (ftp_sandbox.py)
+    metadata: ClassVar[bool] = True  # etc/: PX4's ROMFS extras, the component metadata
 
     @classmethod
-    def with_root(cls, root: str | os.PathLike[str]) -> type[FtpProtocol]:
-        """This protocol serving `root` (a handler class, for a node's handler list)."""
-        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), {"root": root}))
+    def with_root(cls, root: str | os.PathLike[str] | None, mounts: Mapping[str, str | os.PathLike[str]] | None = None,
+                  metadata: bool = False) -> type[FtpProtocol]:
+        """This protocol serving `root` with `mounts` (and etc/ if `metadata`): a class for a node's handler list."""
+        attrs = {"root": root, "mounts": dict(mounts or {}), "metadata": metadata}
+        return cast("type[FtpProtocol]", type(cls.__name__, (cls,), attrs))
 
     def __init__(self) -> None:
         root = self.root if self.root is not None else os.path.join(os.getcwd(), "fs")
-        self.sandbox = Sandbox(root)
+        etc = {"etc": etc_directory()} if self.metadata else {}
+        self.sandbox = Sandbox(root, {**etc, **self.mounts})
         self._file: io.FileIO | None = None
         self._file_size = 0  # of the file last opened (PX4 keeps it after the session ends)
         self._burst: _Burst | None = None
@@ -259,7 +265,7 @@ class FtpProtocol:
     def _open(self, p: Payload, flags: int) -> None:
         if self._file is not None:
             raise FtpNak(Err.NO_SESSIONS_AVAILABLE)
-        path = self.sandbox.target(p.path())
+        path = self.sandbox.target(p.path(), write=flags != os.O_RDONLY)
         try:
             size = os.stat(path).st_size
         except OSError:
@@ -303,8 +309,9 @@ class FtpProtocol:
     # --- paths ---------------------------------------------------------------------------------------------------
     def _list(self, p: Payload) -> None:
         path = self.sandbox.target(p.path())
+        mounted = self.sandbox.mount_entries() if self.sandbox.is_root(path) else None
         try:
-            data, ended = listing(path, p.offset, MAX_DATA)
+            data, ended = listing(path, p.offset, MAX_DATA, mounted)
         except OSError as err:
             raise FtpNak(Err.FILE_NOT_FOUND) from err  # PX4: opendir() failed
         if not data and ended and p.offset != 0:
@@ -330,7 +337,7 @@ class FtpProtocol:
         p.size = 0
 
     def _truncate(self, p: Payload) -> None:
-        path = self.sandbox.target(p.path())
+        path = self.sandbox.target(p.path(), write=True)
         p.size = 0
         os.truncate(path, p.offset)
 

@@ -14,6 +14,13 @@ does the same, strictly, for every operation:
 A refused path raises PathRefused; the protocol answers it with PX4's FileProtected. Clients have no opcode that
 creates a symbolic link, so a link can only be put into the root by whoever runs the emulator.
 
+Mounts: PX4 SITL's root is its working directory, which holds log/ (the logger's files), etc/ (ROMFS, with the
+component metadata under etc/extras) and the parameter file. The emulator keeps its writable root apart and shows
+those as read-only mounts, each a top-level name standing for a host directory or file: "/log/..." names a path
+under the mounted log directory (contained in it as strictly as the root), the root's listing shows each mount that
+exists (a directory as D, a file as F with its size), and any write, create, remove, rename or mkdir at or under a
+mount is refused (PathRefused: FileProtected, as PX4 answers a write to its read-only storage).
+
 Also here: PX4's directory listing format and its CRC32 (crc32part: the CRC-32 table without the initial and
 final inversion, src/lib/crc/crc.c; MAVSDK's core/crc32.cpp computes the same).
 """
@@ -22,7 +29,7 @@ from __future__ import annotations
 
 import os
 import zlib
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 
 DIRENT_FILE = b"F"  # F<name>\t<size>\0
 DIRENT_DIR = b"D"  # D<name>\0
@@ -35,11 +42,14 @@ class PathRefused(Exception):
 
 
 class Sandbox:
-    """Paths under `root` (created on first use, then resolved once: the root may itself be reached through a link)."""
+    """Paths under `root` (created on first use, then resolved once: the root may itself be reached through a link),
+    and the read-only `mounts` (top-level name -> host directory or file)."""
 
-    def __init__(self, root: str | os.PathLike[str]) -> None:
+    def __init__(self, root: str | os.PathLike[str],
+                 mounts: Mapping[str, str | os.PathLike[str]] | None = None) -> None:
         self._root_given = os.fsencode(root)
         self._root: bytes | None = None
+        self.mounts = {os.fsencode(name): os.fsencode(path) for name, path in (mounts or {}).items()}
 
     @property
     def root(self) -> bytes:
@@ -48,23 +58,45 @@ class Sandbox:
             self._root = os.path.realpath(self._root_given)
         return self._root
 
-    def target(self, raw: bytes) -> bytes:
-        """The object the path names, every link followed: for open, read, list, truncate, CRC."""
-        return self._contained(os.path.realpath(os.path.join(self.root, *_parts(raw))))
+    def target(self, raw: bytes, write: bool = False) -> bytes:
+        """The object the path names, every link followed: for open, read, list, truncate, CRC (`write`: for a
+        change, refused under a mount)."""
+        parts = _parts(raw)
+        if parts and parts[0] in self.mounts:
+            if write:
+                raise PathRefused("a read-only mount")
+            base = os.path.realpath(self.mounts[parts[0]])
+            return _contained(os.path.realpath(os.path.join(base, *parts[1:])), base)
+        return _contained(os.path.realpath(os.path.join(self.root, *parts)), self.root)
 
     def entry(self, raw: bytes) -> bytes:
         """The directory entry the path names, its parent resolved and its own name kept: remove, rename, mkdir."""
         parts = _parts(raw)
         if not parts:
             return self.root
-        parent = self._contained(os.path.realpath(os.path.join(self.root, *parts[:-1])))
+        if parts[0] in self.mounts:
+            raise PathRefused("a read-only mount")
+        parent = _contained(os.path.realpath(os.path.join(self.root, *parts[:-1])), self.root)
         return os.path.join(parent, parts[-1])
 
-    def _contained(self, resolved: bytes) -> bytes:
-        root = self.root
-        if resolved != root and not resolved.startswith(root.rstrip(b"/") + b"/"):
-            raise PathRefused("path leaves the root")
-        return resolved
+    def is_root(self, path: bytes) -> bool:
+        return path == self.root
+
+    def mount_entries(self) -> dict[bytes, bytes]:
+        """The root listing's entries for the mounts that exist: name -> entry (without its NUL)."""
+        out: dict[bytes, bytes] = {}
+        for name, path in self.mounts.items():
+            if os.path.isdir(path):
+                out[name] = DIRENT_DIR + name
+            elif os.path.isfile(path):
+                out[name] = DIRENT_FILE + name + b"\t%d" % os.stat(path).st_size
+        return out
+
+
+def _contained(resolved: bytes, base: bytes) -> bytes:
+    if resolved != base and not resolved.startswith(base.rstrip(b"/") + b"/"):
+        raise PathRefused("path leaves the root")
+    return resolved
 
 
 def _parts(raw: bytes) -> list[bytes]:
@@ -80,17 +112,23 @@ def c_string(data: bytes) -> bytes:
     return data if end < 0 else data[:end]
 
 
-def directory_entries(path: bytes) -> Iterator[bytes]:
+def directory_entries(path: bytes, mounted: Mapping[bytes, bytes] | None = None) -> Iterator[bytes]:
     """PX4's listing entries in readdir order ("." and ".." first), each without its trailing NUL.
 
     Raises OSError if `path` is not a readable directory. Sizes are stat() sizes of regular files; anything that
     is neither a regular file nor a directory (a symbolic link included: PX4 looks at d_type) is a skip entry.
+    `mounted` (the root's mounts: name -> entry) are listed among the names, in place of an entry of the same name.
     """
+    mounted = mounted or {}
     with os.scandir(path) as it:
-        names = sorted(it, key=lambda e: e.name)
+        found: list[tuple[bytes, os.DirEntry[bytes] | bytes]] = [(e.name, e) for e in it if e.name not in mounted]
+    found.extend(mounted.items())
     yield DIRENT_SKIP
     yield DIRENT_SKIP
-    for entry in names:
+    for _, entry in sorted(found, key=lambda item: item[0]):
+        if isinstance(entry, bytes):
+            yield entry
+            continue
         try:
             if entry.is_file(follow_symlinks=False):
                 yield DIRENT_FILE + entry.name + b"\t%d" % entry.stat(follow_symlinks=False).st_size
@@ -102,13 +140,14 @@ def directory_entries(path: bytes) -> Iterator[bytes]:
             yield DIRENT_SKIP
 
 
-def listing(path: bytes, offset: int, max_bytes: int) -> tuple[bytes, bool]:
+def listing(path: bytes, offset: int, max_bytes: int,
+            mounted: Mapping[bytes, bytes] | None = None) -> tuple[bytes, bool]:
     """(the packed entries from index `offset` that fit in `max_bytes`, whether the listing reached the end).
 
     Each entry takes its bytes plus a NUL; PX4 stops at the first entry that does not fit.
     """
     out = bytearray()
-    for index, entry in enumerate(directory_entries(path)):
+    for index, entry in enumerate(directory_entries(path, mounted)):
         if index < offset:
             continue
         if len(out) + len(entry) + 1 > max_bytes:

@@ -12,10 +12,10 @@ seeds below against the published MAVLINK_MSG_ID_<NAME>_CRC values.
 Endpoint.send() frames as any other. A pymavlink client parses these as MAVLink_unknown ("UNKNOWN_290"), exactly as
 it parses them from PX4.
 
-Not here on purpose: CURRENT_EVENT_SEQUENCE (#411). PX4 streams it because it speaks the events protocol
-(EVENT / REQUEST_EVENT / RESPONSE_EVENT_ERROR); the emulator does not. A ground station that sees the sequence
-announced treats the vehicle as events-capable, waits for the arming-check events and hides PX4's tab-terminated
-STATUSTEXTs (QGroundControl does), so announcing it without the protocol would lose the texts.
+Also here: the events protocol (EVENT, CURRENT_EVENT_SEQUENCE, REQUEST_EVENT, RESPONSE_EVENT_ERROR: the emulator
+speaks it, sitl_emu/mavlink/protocols/events.py) and component metadata (COMPONENT_METADATA and the older
+COMPONENT_INFORMATION), which pymavlink 2.4 lacks too; a REQUEST_EVENT arrives as pymavlink's MAVLink_unknown
+("UNKNOWN_412"), whose payload `payload_of_unknown` cuts out for `decode`.
 """
 
 from __future__ import annotations
@@ -102,6 +102,23 @@ _DEFINITIONS: dict[str, tuple[int, tuple[Field, ...]]] = {
         ("mission_end", "int32_t", 0), ("commanded_action", "int32_t", 0))),
     "ESTIMATOR_SENSOR_FUSION_STATUS": (514, (
         ("intended", "uint8_t", 9), ("active", "uint8_t", 9), ("test_ratio", "float", 9))),
+    "COMPONENT_INFORMATION": (395, (
+        ("time_boot_ms", "uint32_t", 0), ("general_metadata_file_crc", "uint32_t", 0),
+        ("general_metadata_uri", "char", 100), ("peripherals_metadata_file_crc", "uint32_t", 0),
+        ("peripherals_metadata_uri", "char", 100))),
+    "COMPONENT_METADATA": (397, (
+        ("time_boot_ms", "uint32_t", 0), ("file_crc", "uint32_t", 0), ("uri", "char", 100))),
+    "EVENT": (410, (
+        ("destination_component", "uint8_t", 0), ("destination_system", "uint8_t", 0), ("id", "uint32_t", 0),
+        ("event_time_boot_ms", "uint32_t", 0), ("sequence", "uint16_t", 0), ("log_levels", "uint8_t", 0),
+        ("arguments", "uint8_t", 40))),
+    "CURRENT_EVENT_SEQUENCE": (411, (("sequence", "uint16_t", 0), ("flags", "uint8_t", 0))),
+    "REQUEST_EVENT": (412, (
+        ("target_system", "uint8_t", 0), ("target_component", "uint8_t", 0), ("first_sequence", "uint16_t", 0),
+        ("last_sequence", "uint16_t", 0))),
+    "RESPONSE_EVENT_ERROR": (413, (
+        ("target_system", "uint8_t", 0), ("target_component", "uint8_t", 0), ("sequence", "uint16_t", 0),
+        ("sequence_oldest_available", "uint16_t", 0), ("reason", "uint8_t", 0))),
 }
 
 SPECS: dict[str, MessageSpec] = {name: make_spec(msg_id, name, fields)
@@ -125,6 +142,19 @@ def decode(msg_id: int, payload: bytes) -> dict[str, Any]:
         taken, values = values[:count], values[count:]
         out[fname] = taken if length and ftype != "char" else taken[0]
     return out
+
+
+def payload_of_unknown(frame: bytes) -> bytes:
+    """The payload of a whole frame as pymavlink's MAVLink_unknown keeps it (`.data`): after the 10-byte MAVLink 2
+    header or the 6-byte MAVLink 1 header, as long as the length byte says."""
+    header = 10 if frame[:1] == b"\xfd" else 6
+    return bytes(frame[header:header + frame[1]])
+
+
+def source_of_unknown(frame: bytes) -> tuple[int, int]:
+    """(sysid, compid) from a whole frame's header (pymavlink leaves an unknown message's source unset)."""
+    at = 5 if frame[:1] == b"\xfd" else 3
+    return frame[at], frame[at + 1]
 
 
 class ExtraEncoder:

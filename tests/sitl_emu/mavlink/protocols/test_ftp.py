@@ -309,6 +309,6 @@ def test_a_sim_vehicle_serves_ftp_and_the_empty_log_list_on_both_links(tmp_path,
                 conn.close()
             reply = Payload.unpack(bytes(got["FILE_TRANSFER_PROTOCOL"].payload))
             assert (reply.seq, reply.opcode) == (8, Op.ACK)
-            assert bytes(reply.data[:reply.size]) == b"S\0S\0Fparams.txt\t16\0"
+            assert bytes(reply.data[:reply.size]) == b"S\0S\0Detc\0Fparams.txt\t16\0"  # etc/: PX4 SITL's ROMFS extras
             entry = got["LOG_ENTRY"]
             assert (entry.id, entry.num_logs, entry.last_log_num, entry.time_utc, entry.size) == (0, 0, 0, 0, 0)

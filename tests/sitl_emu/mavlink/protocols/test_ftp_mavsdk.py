@@ -74,7 +74,8 @@ async def _check_ftp(ftp: Any, root: Path, tmp_path: Path) -> None:
 
     listed = await _call(ftp.list_directory("/"))
     kinds = {e.name: (e.entry_type, e.size_bytes) for e in listed.entries}
-    assert kinds == {"sub": (FilesystemEntry.EntryType.DIRECTORY, 0),
+    assert kinds == {"etc": (FilesystemEntry.EntryType.DIRECTORY, 0),  # PX4 SITL's ROMFS extras: the metadata
+                     "sub": (FilesystemEntry.EntryType.DIRECTORY, 0),
                      "hello.txt": (FilesystemEntry.EntryType.FILE, 24),
                      "big.bin": (FilesystemEntry.EntryType.FILE, 80_000)}
     for use_burst in (True, False):

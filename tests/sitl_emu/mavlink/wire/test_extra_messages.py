@@ -18,7 +18,9 @@ from sitl_emu.mavlink.wire import fastpack
 
 # (CRC_EXTRA, payload length) of the C headers generated from mavlink/mavlink's XML
 PUBLISHED = {"LINK_NODE_STATUS": (117, 36), "ESC_INFO": (251, 46), "ESC_STATUS": (10, 57),
-             "TIME_ESTIMATE_TO_TARGET": (232, 20), "ESTIMATOR_SENSOR_FUSION_STATUS": (197, 54)}
+             "TIME_ESTIMATE_TO_TARGET": (232, 20), "ESTIMATOR_SENSOR_FUSION_STATUS": (197, 54),
+             "COMPONENT_INFORMATION": (0, 212), "COMPONENT_METADATA": (182, 108), "EVENT": (160, 53),
+             "CURRENT_EVENT_SEQUENCE": (106, 3), "REQUEST_EVENT": (33, 6), "RESPONSE_EVENT_ERROR": (77, 7)}
 
 
 def _xml_fields(cls: Any) -> list[xm.Field]:
