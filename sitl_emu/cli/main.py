@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from flightview.options import view_options, view_settings
+from flightview.options import view_options
 from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
 from px4common.clock import SPEED_MAX, SPEED_MIN
 from px4common.signing_key import SigningKeyError, read_signing_key
@@ -35,6 +35,7 @@ from sitl_emu.cli.options import (
 )
 from sitl_emu.cli.signals import EARLY, ShutdownSignals, owning_signals
 from sitl_emu.cli.signing_key import attach_signing
+from sitl_emu.cli.view_setup import check_view, start_view
 from sitl_emu.console.console import attach_console
 from sitl_emu.log.cli import log as log_command
 from sitl_emu.log.serving import DEFAULT_LOG_DIR, attach_loggers, handlers_by_instance
@@ -44,7 +45,6 @@ from sitl_emu.runtime.runner import RealTimeRunner
 from sitl_emu.runtime.swarm import DEFAULT_HOME, SwarmRunner, build_nodes
 
 if TYPE_CHECKING:  # imported where used, so that `--help` stays quick
-    from flightview.launch import ViewHandle
     from sitl_emu.console.console import Console
     from sitl_emu.disturbance.wind import WindSettings
     from sitl_emu.params import ParamRegistry
@@ -252,7 +252,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
           signing_key: Path | None, signals: ShutdownSignals, **view: Any) -> None:
     """Run one emulated PX4 quadrotor (or --count of them) with its API and GCS MAVLink links."""
     try:
-        _check_view(view)
+        check_view(view)
         check_host(bind_host, "--bind")
         settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
                                 parse_address(gcs_remote, "--gcs-remote"))
@@ -296,7 +296,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
-    live = None if runner.stopped else _start_view(vehicles, nodes, view, runner)
+    live = None if runner.stopped else start_view(vehicles, nodes, view, runner)
     console = None if runner.stopped else attach_console(vehicles, runner, not no_console)
     try:
         _run_until_signalled(runner, console, signals)
@@ -306,42 +306,6 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
         for logger in loggers:
             logger.close()  # a flight cut short keeps its log up to here
     _close_all(nodes, stores)
-
-
-def _check_view(view: dict[str, Any]) -> None:
-    """--view without the extra, on a port in use, or an unwritable --record-view: one sentence, before any port
-    opens."""
-    options = view_settings(**view)
-    if options.wanted:
-        from flightview.launch import check_view
-        from flightview.server import ViewError
-
-        try:
-            check_view(options)
-        except ViewError as err:
-            raise UsageProblem(str(err)) from None
-
-
-def _start_view(vehicles: list[Vehicle], nodes: list[VehicleNode], view: dict[str, Any],
-                runner: RealTimeRunner) -> ViewHandle | None:
-    """--view / --record-view: the live view fed by a runner hook (sitl_emu/view.py), or None; one sentence on a
-    problem (the nodes are closed first)."""
-    options = view_settings(**view)
-    if not options.wanted:
-        return None
-    from flightview.launch import open_view
-    from flightview.server import ViewError
-    from sitl_emu.view import ServeView
-
-    try:
-        handle = open_view("sitl-emu", ServeView.keys(vehicles), options, lambda line: click.echo(f"{TOOL}: {line}"))
-    except ViewError as err:
-        for node in nodes:
-            node.close()
-        raise UserError(str(err)) from None
-    assert handle is not None
-    runner.hooks.append(ServeView(handle, vehicles))
-    return handle
 
 
 def _sign(nodes: list[VehicleNode], instance: int, key: bytes | None) -> None:
