@@ -78,16 +78,6 @@ class NodeServices(NodeView, Protocol):
     def forward(self, msg: MAVLink_message, origin: Endpoint, target_system: int, target_component: int) -> None: ...
 
 
-class _LinkWriter:
-    """pymavlink's MAVLink.send() writes to a file; this file is the UDP link."""
-
-    def __init__(self, link: UdpLink) -> None:
-        self._link = link
-
-    def write(self, buf: bytes | bytearray) -> None:
-        self._link.send(bytes(buf))
-
-
 class Endpoint:
     """A link endpoint; also the context (sitl_emu/mavlink/context.py) handed to its parts and protocol handlers:
     a LinkContext for the handlers, an EndpointContext for its receiver, command handler and telemetry."""
@@ -102,10 +92,8 @@ class Endpoint:
         self.node = node
         self.sysid = node.sysid
         self.compid = COMPID
-        # pymavlink's encoder: handlers build messages with it; its `seq` is this link's sequence number, which
-        # send() continues (one sequence per link, whichever way a message was built)
-        self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
-        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/wire/fastpack.py): same calls, cheaper messages
+        self.encoder = ENCODER  # builds what this link sends (sitl_emu/mavlink/wire/fastpack.py)
+        self.seq = 0  # this link's sequence number: one sequence per link, as PX4's Mavlink instance
         self.signing = node.signing  # the vehicle's MAVLink 2 signing, shared by its links (mavlink/signing.py)
         self._parser = _new_parser()
         self.stats = EndpointStats()
@@ -140,12 +128,11 @@ class Endpoint:
 
     def send(self, msg: OutMessage) -> None:
         """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
-        mav = self.mav
         try:
             if self.signing.key is None:
-                data = frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent)
+                data = frame_message(msg, self.seq, self.sysid, COMPID)
             else:  # with a key, PX4 signs everything it sends
-                data = self.signing.sign(frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent, IFLAG_SIGNED),
+                data = self.signing.sign(frame_message(msg, self.seq, self.sysid, COMPID, IFLAG_SIGNED),
                                          self.link_id, self.node.epoch_unix_us + self._now_us)
         except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
             self.stats.tx_pack_errors += 1
@@ -153,7 +140,7 @@ class Endpoint:
                 log.error("%s link: cannot send %s: %s", self.link_name, msg.get_type(), err)
             return
         self.link.send(data)
-        mav.seq = (mav.seq + 1) % 256
+        self.seq = (self.seq + 1) % 256
         stats = self.stats
         stats.tx_messages += 1
         stats.tx_bytes += len(data)

@@ -166,7 +166,7 @@ class VehicleNode:
         """COMMAND_ACK on every link where the commanding component has been heard (mavlink_main.cpp ~l.2996)."""
         for ep in self.endpoints:
             if (target_system, target_component) in ep.seen_components:
-                ep.send(ep.mav.command_ack_encode(command, result, 0, 0, target_system, target_component))
+                ep.send(ep.encoder.command_ack_encode(command, result, 0, 0, target_system, target_component))
 
     def close(self) -> None:
         for ep in self.endpoints:

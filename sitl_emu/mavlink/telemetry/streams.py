@@ -86,8 +86,8 @@ ON_DEMAND_STREAMS: dict[int, tm.Builder] = {
 STREAMS: dict[int, tm.Builder] = {**BUILDERS, **ON_DEMAND_STREAMS}
 # messages PX4 sends only on request (REQUEST_MESSAGE), not as periodic streams
 ON_REQUEST: dict[int, tm.Builder] = {
-    148: lambda ctx, snap: autopilot_version(ctx.mav, ctx.sysid),
-    300: lambda ctx, snap: protocol_version(ctx.mav),
+    148: lambda ctx, snap: autopilot_version(ctx.encoder, ctx.sysid),
+    300: lambda ctx, snap: protocol_version(),
 }
 
 # Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
