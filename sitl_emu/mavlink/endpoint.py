@@ -21,7 +21,7 @@ from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.signing import ARMED_TEXT, MavlinkSigning, SetupResult
-from sitl_emu.mavlink.telemetry.streams import StreamMode, Streams
+from sitl_emu.mavlink.telemetry.streams import SharedBuilds, StreamMode, Streams
 from sitl_emu.mavlink.wire.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, KEY_LEN, is_signed
 from sitl_emu.px4 import Severity
@@ -85,7 +85,9 @@ class Endpoint:
     GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
 
     def __init__(self, name: str, link: UdpLink, node: NodeServices, mode: StreamMode,
-                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0, link_id: int = 0) -> None:
+                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0, link_id: int = 0,
+                 shared: SharedBuilds | None = None) -> None:
+        """`shared`: what the vehicle's links build once for all of them in a tick (telemetry/streams.py)."""
         self.link_name = name
         self.link_id = link_id  # PX4's mavlink instance number: the link id of what it signs
         self.link = link
@@ -97,7 +99,7 @@ class Endpoint:
         self.signing = node.signing  # the vehicle's MAVLink 2 signing, shared by its links (mavlink/signing.py)
         self._parser = _new_parser()
         self.stats = EndpointStats()
-        self.streams = Streams(mode, stream_delay_us)
+        self.streams = Streams(mode, stream_delay_us, shared)
         self.receiver = Receiver(CommandHandler(self.streams))
         self.seen_components: set[tuple[int, int]] = set()
         self.last_gcs_heartbeat_us: int | None = None

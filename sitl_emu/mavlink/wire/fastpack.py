@@ -67,17 +67,19 @@ class MessageSpec:
 
 
 class Packed:
-    """A message as the fast encoder returns it: its spec and its field values in wire order (arrays flattened).
+    """A message as the encoder returns it: its spec and its field values in wire order (arrays flattened).
 
-    Endpoint.send() frames it directly. It also packs like a pymavlink message, so a plain pymavlink
-    `MAVLink.send()` (test contexts) can send it too.
+    Endpoint.send() frames it directly; the first framing keeps the packed payload (`body`, trailing zeros cut), so
+    a message both links send is packed once (telemetry/streams.py SharedBuilds). It also packs like a pymavlink
+    message, so a plain pymavlink `MAVLink.send()` can send it too.
     """
 
-    __slots__ = ("spec", "values")
+    __slots__ = ("body", "spec", "values")
 
     def __init__(self, spec: MessageSpec, values: tuple[Any, ...]) -> None:
         self.spec = spec
         self.values = values
+        self.body: bytes | None = None
 
     def get_type(self) -> str:
         return self.spec.name
@@ -92,8 +94,10 @@ def frame_message(msg: Packed, seq: int, sysid: int, compid: int, incompat_flags
     """The MAVLink 2 frame of a Packed, exactly as pymavlink's MAVLink_message._pack builds it, without a signature
     block (a struct.error etc. for a value out of range)."""
     spec = msg.spec
-    payload = spec.pack(*msg.values)
-    body = payload.rstrip(b"\0") or payload[:1]
+    body = msg.body
+    if body is None:
+        payload = spec.pack(*msg.values)
+        body = msg.body = payload.rstrip(b"\0") or payload[:1]
     msg_id = spec.msg_id
     head = _HEADER.pack(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
     return MAGIC_V2 + head + _CRC.pack(x25_crc(head + spec.crc_extra, 0xFFFF))
