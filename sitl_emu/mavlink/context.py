@@ -1,13 +1,14 @@
 """The contracts inside a link: what an endpoint offers the protocol handlers and its own parts.
 
-An endpoint (one UDP link: API or GCS, sitl_emu/mavlink/endpoint.py) owns a pymavlink encoder, the latched peer and
-the stream scheduler. For each received message whose type a handler lists in MESSAGES, it calls
-handler.handle(msg, ctx); once per main-loop iteration it calls handler.tick(ctx) so handlers can stream (parameter
-lists, shell output). Handlers never touch sockets or clocks: they read ctx.now_us and call ctx.send().
+An endpoint (one UDP link: API or GCS, sitl_emu/mavlink/endpoint.py) owns its sequence number, the latched peer and
+the stream scheduler; all it sends is built with the one encoder (ctx.encoder: wire/fastpack.py). For each received
+message whose type a handler lists in MESSAGES, it calls handler.handle(msg, ctx); once per main-loop iteration it
+calls handler.tick(ctx) so handlers can stream (parameter lists, shell output). Handlers never touch sockets or
+clocks: they read ctx.now_us and call ctx.send().
 
 - LinkContext: what a plugged-in protocol handler (params, mission, shell) may use.
 - EndpointContext: LinkContext plus what the endpoint's own parts use (receiver, command handler, telemetry
-  builders): the fast encoder, the node's snapshot and ACK routing, the GCS heartbeat bookkeeping.
+  builders): the node's snapshot and ACK routing, the GCS heartbeat bookkeeping.
 Tests implement LinkContext in memory (tests/handler_ctx.py); Endpoint implements both.
 """
 
@@ -19,7 +20,7 @@ from typing import TYPE_CHECKING, ClassVar, Protocol
 if TYPE_CHECKING:
     from typing import TypeAlias
 
-    from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
+    from pymavlink.dialects.v20.development import MAVLink_message
 
     from sitl_emu.mavlink.wire.encoding import MessageEncoder
     from sitl_emu.mavlink.wire.fastpack import Packed
@@ -40,8 +41,8 @@ if TYPE_CHECKING:
     )
     from sitl_emu.vehicle.vehicle import Vehicle
 
-    # What a link sends: a pymavlink message (built with ctx.mav) or a fast-encoder one (ctx.encoder, fastpack.py)
-    OutMessage: TypeAlias = MAVLink_message | Packed
+    # What a link sends: a message built with ctx.encoder (wire/fastpack.py)
+    OutMessage: TypeAlias = Packed
 
 
 @dataclass(slots=True)
@@ -120,10 +121,14 @@ if TYPE_CHECKING:
 
 
 class LinkContext(Protocol):
-    mav: MAVLink  # encoder with this vehicle's sysid/compid: ctx.mav.param_value_encode(...)
     link_name: str  # "api" or "gcs"
     sysid: int
     compid: int
+
+    @property
+    def encoder(self) -> MessageEncoder:
+        """Builds what the link sends, with pymavlink's calls: ctx.send(ctx.encoder.param_value_encode(...))."""
+        ...
 
     @property
     def vehicle(self) -> LinkVehicle: ...
@@ -157,11 +162,6 @@ class NodeView(Protocol):
 
 
 class EndpointContext(LinkContext, Protocol):
-    @property
-    def encoder(self) -> MessageEncoder:
-        """fastpack.ENCODER: the same calls as ctx.mav, cheaper messages (the telemetry streams)."""
-        ...
-
     last_gcs_heartbeat_us: int | None  # the receiver sets it on a GCS heartbeat
     stats: EndpointStats  # this link's counters (LINK_NODE_STATUS)
 

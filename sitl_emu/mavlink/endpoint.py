@@ -21,7 +21,7 @@ from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.signing import ARMED_TEXT, MavlinkSigning, SetupResult
-from sitl_emu.mavlink.telemetry.streams import StreamMode, Streams
+from sitl_emu.mavlink.telemetry.streams import SharedBuilds, StreamMode, Streams
 from sitl_emu.mavlink.wire.fastpack import ENCODER, frame_message
 from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, KEY_LEN, is_signed
 from sitl_emu.px4 import Severity
@@ -79,16 +79,6 @@ class NodeServices(NodeView, Protocol):
     def forward(self, msg: MAVLink_message, origin: Endpoint, target_system: int, target_component: int) -> None: ...
 
 
-class _LinkWriter:
-    """pymavlink's MAVLink.send() writes to a file; this file is the UDP link."""
-
-    def __init__(self, link: UdpLink) -> None:
-        self._link = link
-
-    def write(self, buf: bytes | bytearray) -> None:
-        self._link.send(bytes(buf))
-
-
 class Endpoint:
     """A link endpoint; also the context (sitl_emu/mavlink/context.py) handed to its parts and protocol handlers:
     a LinkContext for the handlers, an EndpointContext for its receiver, command handler and telemetry."""
@@ -96,21 +86,21 @@ class Endpoint:
     GCS_TIMEOUT_US = 2_500_000  # is_gcs_connected(): GCS heartbeat within 2.5 s (mavlink_main.h)
 
     def __init__(self, name: str, link: UdpLink, node: NodeServices, mode: StreamMode,
-                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0, link_id: int = 0) -> None:
+                 handler_classes: Sequence[type] = (), stream_delay_us: int = 0, link_id: int = 0,
+                 shared: SharedBuilds | None = None) -> None:
+        """`shared`: what the vehicle's links build once for all of them in a tick (telemetry/streams.py)."""
         self.link_name = name
         self.link_id = link_id  # PX4's mavlink instance number: the link id of what it signs
         self.link = link
         self.node = node
         self.sysid = node.sysid
         self.compid = COMPID
-        # pymavlink's encoder: handlers build messages with it; its `seq` is this link's sequence number, which
-        # send() continues (one sequence per link, whichever way a message was built)
-        self.mav = dialect.MAVLink(_LinkWriter(link), srcSystem=self.sysid, srcComponent=COMPID)
-        self.encoder = ENCODER  # the fast encoder (sitl_emu/mavlink/wire/fastpack.py): same calls, cheaper messages
+        self.encoder = ENCODER  # builds what this link sends (sitl_emu/mavlink/wire/fastpack.py)
+        self.seq = 0  # this link's sequence number: one sequence per link, as PX4's Mavlink instance
         self.signing = node.signing  # the vehicle's MAVLink 2 signing, shared by its links (mavlink/signing.py)
         self._parser = _new_parser()
         self.stats = EndpointStats()
-        self.streams = Streams(mode, stream_delay_us)
+        self.streams = Streams(mode, stream_delay_us, shared)
         self.receiver = Receiver(CommandHandler(self.streams))
         self.seen_components: set[tuple[int, int]] = set()
         self.last_gcs_heartbeat_us: int | None = None
@@ -141,12 +131,11 @@ class Endpoint:
 
     def send(self, msg: OutMessage) -> None:
         """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
-        mav = self.mav
         try:
             if self.signing.key is None:
-                data = frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent)
+                data = frame_message(msg, self.seq, self.sysid, COMPID)
             else:  # with a key, PX4 signs everything it sends
-                data = self.signing.sign(frame_message(msg, mav.seq, mav.srcSystem, mav.srcComponent, IFLAG_SIGNED),
+                data = self.signing.sign(frame_message(msg, self.seq, self.sysid, COMPID, IFLAG_SIGNED),
                                          self.link_id, self.node.epoch_unix_us + self._now_us)
         except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
             self.stats.tx_pack_errors += 1
@@ -154,7 +143,7 @@ class Endpoint:
                 log.error("%s link: cannot send %s: %s", self.link_name, msg.get_type(), err)
             return
         self.link.send(data)
-        mav.seq = (mav.seq + 1) % 256
+        self.seq = (self.seq + 1) % 256
         stats = self.stats
         stats.tx_messages += 1
         stats.tx_bytes += len(data)

@@ -51,7 +51,7 @@ class CommandHandler:
         """Mavlink-module commands are answered here (ACK on this link); the rest go to the vehicle."""
         if cmd.command in MAVLINK_MODULE_COMMANDS:
             result = self._mavlink_command(cmd, ctx)
-            ctx.send(ctx.mav.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
+            ctx.send(ctx.encoder.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
             return result
         ack = ctx.vehicle.handle_command(cmd)
         ctx.node.invalidate_snapshot()
@@ -91,7 +91,7 @@ class CommandHandler:
     def _get_interval(self, msg_id: int | None, ctx: EndpointContext) -> int:
         if msg_id is None:
             return MavResult.FAILED
-        ctx.send(ctx.mav.message_interval_encode(msg_id, self._streams.get_interval(msg_id)))
+        ctx.send(ctx.encoder.message_interval_encode(msg_id, self._streams.get_interval(msg_id)))
         return MavResult.ACCEPTED
 
     def _request(self, msg_id: int | None, ctx: EndpointContext) -> int:

@@ -82,13 +82,13 @@ class Receiver:
     def _ping(msg: dialect.MAVLink_ping_message, ctx: EndpointContext) -> None:
         """Echo pings addressed to everyone (target 0/0), back to the sender (reference 1.9)."""
         if msg.target_system == 0 and msg.target_component == 0:
-            ctx.send(ctx.mav.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(), msg.get_srcComponent()))
+            ctx.send(ctx.encoder.ping_encode(msg.time_usec, msg.seq, msg.get_srcSystem(), msg.get_srcComponent()))
 
     @staticmethod
     def _timesync(msg: dialect.MAVLink_timesync_message, ctx: EndpointContext) -> None:
         """mavlink_timesync.cpp: answer requests (tc1 == 0) with our boot time in ns."""
         if msg.tc1 == 0:
-            ctx.send(ctx.mav.timesync_encode(ctx.now_us * 1000, msg.ts1))
+            ctx.send(ctx.encoder.timesync_encode(ctx.now_us * 1000, msg.ts1))
 
     # --- commands ----------------------------------------------------------------------------------------------
     def _command_long(self, msg: dialect.MAVLink_command_long_message, ctx: EndpointContext) -> None:
@@ -207,7 +207,7 @@ def _command(msg: _CommandMessage, params: tuple[float, ...]) -> VehicleCommand:
 
 
 def _ack_here(ctx: EndpointContext, cmd: VehicleCommand, result: int) -> None:
-    ctx.send(ctx.mav.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
+    ctx.send(ctx.encoder.command_ack_encode(cmd.command, result, 0, 0, cmd.source_system, cmd.source_component))
 
 
 def _is_int32_max(value: float) -> bool:

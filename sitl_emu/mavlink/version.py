@@ -1,7 +1,8 @@
 """AUTOPILOT_VERSION and PROTOCOL_VERSION as PX4 v1.15 SITL sends them.
 
 Sources: mavlink_main.cpp send_autopilot_capabilities (~l.1263) and send_protocol_version (~l.1348); reference 9c.2,
-11.5. pymavlink's dialects lack PROTOCOL_VERSION (#300), so its message class is defined here from common.xml.
+11.5. pymavlink's dialects lack PROTOCOL_VERSION (#300), so its message class is defined here from common.xml: fastpack
+builds the message from that metadata as from pymavlink's own classes, and test clients parse it with the class.
 """
 
 from __future__ import annotations
@@ -11,8 +12,13 @@ from typing import TYPE_CHECKING
 
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.mavlink.wire.fastpack import spec_for_class
+
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.development import MAVLink, MAVLink_autopilot_version_message
+    from pymavlink.dialects.v20.development import MAVLink
+
+    from sitl_emu.mavlink.wire.encoding import MessageEncoder
+    from sitl_emu.mavlink.wire.fastpack import Packed
 
 # MAV_PROTOCOL_CAPABILITY: MISSION_FLOAT|PARAM_FLOAT|MISSION_INT|COMMAND_INT|PARAM_ENCODE_BYTEWISE|FTP|
 # SET_ATTITUDE_TARGET|SET_POSITION_TARGET_LOCAL_NED|FLIGHT_TERMINATION|MAVLINK2|MISSION_FENCE|MISSION_RALLY
@@ -31,9 +37,9 @@ def sw_version(major: int, minor: int, patch: int, fw_type: int = FIRMWARE_TYPE_
 FLIGHT_SW_VERSION = sw_version(*FIRMWARE_VERSION)
 
 
-def autopilot_version(mav: MAVLink, sysid: int) -> MAVLink_autopilot_version_message:
+def autopilot_version(encoder: MessageEncoder, sysid: int) -> Packed:
     custom = list(GIT_HASH)
-    return mav.autopilot_version_encode(
+    return encoder.autopilot_version_encode(
         CAPABILITIES, FLIGHT_SW_VERSION, FLIGHT_SW_VERSION, 0, 0, custom, custom, [0] * 8, 0, 0,
         UID_BASE + sysid - 1, [0] * 18)
 
@@ -78,7 +84,9 @@ class ProtocolVersionMessage(dialect.MAVLink_message):
         return self._pack(mav, self.crc_extra, payload, force_mavlink1=force_mavlink1)
 
 
-def protocol_version(mav: MAVLink) -> ProtocolVersionMessage:
+def protocol_version() -> Packed:
     """PX4: {version 200, min_version 100, max_version 203} (MAVLink 2.0, supports 1.0-2.03)."""
-    del mav
-    return ProtocolVersionMessage(200, 100, 203, [0] * 8, list(GIT_HASH))
+    return _PROTOCOL_VERSION.encode(200, 100, 203, [0] * 8, list(GIT_HASH))
+
+
+_PROTOCOL_VERSION = spec_for_class(ProtocolVersionMessage)

@@ -18,7 +18,7 @@ from sitl_emu.mavlink.context import LinkVehicle
 from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
 from sitl_emu.mavlink.link import Address, UdpLink
 from sitl_emu.mavlink.signing import MavlinkSigning
-from sitl_emu.mavlink.telemetry.streams import StreamMode
+from sitl_emu.mavlink.telemetry.streams import SharedBuilds, StreamMode
 from sitl_emu.runtime.timeline import TickVehicle
 from sitl_emu.types import VehicleSnapshot
 
@@ -81,9 +81,11 @@ class VehicleNode:
             raise
         # one signing key for the vehicle's links (mavlink/signing.py); `serve` gives it its key file
         self.signing = MavlinkSigning()
-        # link ids are PX4 SITL's mavlink instances: the GCS link starts first (px4-rc.mavlink)
-        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us, link_id=1)
-        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us, link_id=0)
+        # link ids (1, 0) are PX4 SITL's mavlink instances: the GCS link starts first (px4-rc.mavlink)
+        # a message both links send in a tick is built once (telemetry/streams.py SharedBuilds)
+        shared = SharedBuilds()
+        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us, 1, shared)
+        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us, 0, shared)
         self.endpoints: tuple[Endpoint, ...] = (self.api, self.gcs)
         self._event_seq = -1
         self._snapshot: VehicleSnapshot | None = None
@@ -166,7 +168,7 @@ class VehicleNode:
         """COMMAND_ACK on every link where the commanding component has been heard (mavlink_main.cpp ~l.2996)."""
         for ep in self.endpoints:
             if (target_system, target_component) in ep.seen_components:
-                ep.send(ep.mav.command_ack_encode(command, result, 0, 0, target_system, target_component))
+                ep.send(ep.encoder.command_ack_encode(command, result, 0, 0, target_system, target_component))
 
     def close(self) -> None:
         for ep in self.endpoints:

@@ -1,7 +1,7 @@
 """In-memory LinkContext and a small stand-in Vehicle for unit tests of the protocol handlers and shells.
 
-Messages go through pymavlink's real encoder and parser: what a handler sends is packed to bytes and parsed back,
-so tests see exactly what a client would receive.
+What a handler sends is framed by the endpoint's encoder (fastpack) and parsed back by pymavlink's parser, so tests
+see exactly what a client would receive.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.mavlink.wire.fastpack import ENCODER, Packed, frame_message
 from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.px4 import LandedState, MavResult, NavState, Severity
@@ -56,8 +57,8 @@ class MemoryContext:
         self.link_name = link_name
         self.sysid = sysid
         self.compid = compid
-        self._sink = _Sink()
-        self.mav = dialect.MAVLink(self._sink, srcSystem=sysid, srcComponent=compid)
+        self.encoder = ENCODER
+        self.seq = 0
         self._now_us = 0
         self.sent: list[Any] = []
         self.broadcasts: list[Any] = []
@@ -69,13 +70,16 @@ class MemoryContext:
     def advance(self, dt_us: int) -> None:
         self._now_us += dt_us
 
-    def send(self, msg: Any) -> None:
-        self.mav.send(msg)
-        self.sent.extend(_parse(self._sink.chunks.pop()))
+    def _frame(self, msg: Packed) -> bytes:
+        frame = frame_message(msg, self.seq, self.sysid, self.compid)
+        self.seq = (self.seq + 1) % 256
+        return frame
 
-    def broadcast(self, msg: Any) -> None:
-        self.mav.send(msg)
-        self.broadcasts.extend(_parse(self._sink.chunks.pop()))
+    def send(self, msg: Packed) -> None:
+        self.sent.extend(_parse(self._frame(msg)))
+
+    def broadcast(self, msg: Packed) -> None:
+        self.broadcasts.extend(_parse(self._frame(msg)))
 
     def take(self, msg_type: str | None = None) -> list[Any]:
         """Sent messages (of one type, if given) since the last take; clears the record."""

@@ -47,6 +47,7 @@ if TYPE_CHECKING:
     from pymavlink.dialects.v20.development import MAVLink_file_transfer_protocol_message, MAVLink_message
 
     from sitl_emu.mavlink.context import LinkContext
+    from sitl_emu.mavlink.wire.fastpack import Packed
 
 PAYLOAD_LEN = 251
 MAX_DATA = 239  # PAYLOAD_LEN - the 12-byte header (kMaxDataLength)
@@ -187,7 +188,7 @@ class FtpProtocol:
         self._file: io.FileIO | None = None
         self._file_size = 0  # of the file last opened (PX4 keeps it after the session ends)
         self._burst: _Burst | None = None
-        self._kept_reply: MAVLink_message | None = None
+        self._kept_reply: Packed | None = None
         self._kept_seq = -1
         self._last_request_us = 0
         self._source = (0, 0)
@@ -236,7 +237,7 @@ class FtpProtocol:
             p.fail(nak)
 
     def _reply(self, p: Payload, target: tuple[int, int], ctx: LinkContext) -> None:
-        msg = ctx.mav.file_transfer_protocol_encode(0, target[0], target[1], p.pack())
+        msg = ctx.encoder.file_transfer_protocol_encode(0, target[0], target[1], p.pack())
         if p.size <= KEPT_REPLY_MAX_SIZE:
             self._kept_reply, self._kept_seq = msg, p.seq
         ctx.send(msg)

@@ -131,7 +131,7 @@ class LogProtocol:
         self._stop()
         self._logs = self.source.list_logs()
         if not self._logs:
-            ctx.send(ctx.mav.log_entry_encode(0, 0, 0, 0, 0))
+            ctx.send(ctx.encoder.log_entry_encode(0, 0, 0, 0, 0))
             return
         last = len(self._logs) if msg.end == LIST_ALL else msg.end
         self._listing = _Listing(msg.start, last)
@@ -181,7 +181,7 @@ class LogProtocol:
                 self._listing = None
                 return
             log = logs[listing.next_id]
-            ctx.send(ctx.mav.log_entry_encode(listing.next_id, len(logs), listing.last_log_num & 0xFFFF,
+            ctx.send(ctx.encoder.log_entry_encode(listing.next_id, len(logs), listing.last_log_num & 0xFFFF,
                                               log.time_utc & 0xFFFFFFFF, log.size_bytes & 0xFFFFFFFF))
             listing.next_id += 1
 
@@ -190,7 +190,7 @@ class LogProtocol:
         for _ in range(DATA_PER_TICK):
             log.file.seek(log.offset)
             data = log.file.read(min(LOG_DATA_LEN, max(log.size_bytes - log.offset, 0)))
-            ctx.send(ctx.mav.log_data_encode(log.log_id, log.offset, len(data), data.ljust(LOG_DATA_LEN, b"\0")))
+            ctx.send(ctx.encoder.log_data_encode(log.log_id, log.offset, len(data), data.ljust(LOG_DATA_LEN, b"\0")))
             log.offset += len(data)
             if not data or log.offset >= min(log.end, log.size_bytes):
                 log.sending = False

@@ -130,15 +130,15 @@ class MissionProtocol:
             self._seen = seen
             if store.count(PLAN_MISSION) > 0:
                 fields = mission_current_fields(store, ctx.vehicle.snapshot().nav_state)
-                ctx.send(ctx.mav.mission_current_encode(*fields))
+                ctx.send(ctx.encoder.mission_current_encode(*fields))
         if store.seq_reached != self._seen_reached:
             self._seen_reached = store.seq_reached
             self._reached_repeats = 0
             if store.count(PLAN_MISSION) > 0 and store.seq_reached >= 0:
-                ctx.send(ctx.mav.mission_item_reached_encode(store.seq_reached))
+                ctx.send(ctx.encoder.mission_item_reached_encode(store.seq_reached))
                 self._reached_repeats, self._next_repeat_us = 10, ctx.now_us + REPEAT_US
         elif self._reached_repeats and ctx.now_us >= self._next_repeat_us and store.count(PLAN_MISSION) > 0:
-            ctx.send(ctx.mav.mission_item_reached_encode(self._seen_reached))
+            ctx.send(ctx.encoder.mission_item_reached_encode(self._seen_reached))
             self._reached_repeats -= 1
             self._next_repeat_us = ctx.now_us + REPEAT_US
 
@@ -245,9 +245,9 @@ class MissionProtocol:
     def _request(self, ctx: LinkContext, seq: int) -> None:
         self._sent_us = ctx.now_us
         if self._int_mode:
-            ctx.send(ctx.mav.mission_request_int_encode(*self._partner, seq, self._type))
+            ctx.send(ctx.encoder.mission_request_int_encode(*self._partner, seq, self._type))
         else:
-            ctx.send(ctx.mav.mission_request_encode(*self._partner, seq, self._type))
+            ctx.send(ctx.encoder.mission_request_encode(*self._partner, seq, self._type))
 
     # ---- download -------------------------------------------------------------------------------------------------
     def _on_request_list(self, msg: Any, ctx: LinkContext) -> None:
@@ -266,7 +266,7 @@ class MissionProtocol:
 
     def _send_count(self, ctx: LinkContext, count: int) -> None:
         self._sent_us = ctx.now_us
-        ctx.send(ctx.mav.mission_count_encode(*self._partner, count, self._type))
+        ctx.send(ctx.encoder.mission_count_encode(*self._partner, count, self._type))
 
     def _on_request(self, msg: Any, ctx: LinkContext) -> None:
         if _sender(msg) != self._partner:
@@ -291,7 +291,7 @@ class MissionProtocol:
             return
         current = seq == store.current_seq  # PX4 compares with the mission's current item for every plan type
         self._sent_us = ctx.now_us
-        ctx.send(item_message(ctx.mav, self._partner, plan.items[seq], current, self._type, self._int_mode))
+        ctx.send(item_message(ctx.encoder, self._partner, plan.items[seq], current, self._type, self._int_mode))
 
     def _refuse_request(self, ctx: LinkContext) -> None:
         self._state = TransferState.IDLE
@@ -338,7 +338,7 @@ class MissionProtocol:
              mission_type: int | None = None) -> None:
         to = self._partner if target is None else target
         kind = self._type if mission_type is None else mission_type
-        ctx.send(ctx.mav.mission_ack_encode(*to, result, kind))
+        ctx.send(ctx.encoder.mission_ack_encode(*to, result, kind))
 
     # ---- dispatch ---------------------------------------------------------------------------------------------------
     _HANDLERS: ClassVar[dict[str, Callable[[MissionProtocol, Any, LinkContext], None]]] = {

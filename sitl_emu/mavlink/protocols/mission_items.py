@@ -21,7 +21,8 @@ from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, MissionIt
 from sitl_emu.px4 import MavCmd, MavFrame, NavState
 
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
+    from sitl_emu.mavlink.wire.encoding import MessageEncoder
+    from sitl_emu.mavlink.wire.fastpack import Packed
 
 # MAV_MISSION_RESULT (common.xml)
 MAV_MISSION_ACCEPTED = 0
@@ -143,19 +144,19 @@ def plan_check(plan_type: int, item: MissionItem) -> bool:
     return True
 
 
-def item_message(mav: MAVLink, target: tuple[int, int], item: MissionItem, current: bool, plan_type: int,
-                 int_mode: bool) -> MAVLink_message:
+def item_message(encoder: MessageEncoder, target: tuple[int, int], item: MissionItem, current: bool, plan_type: int,
+                 int_mode: bool) -> Packed:
     """The MISSION_ITEM_INT (or legacy MISSION_ITEM) PX4 sends for a stored item."""
     p = (item.param1, item.param2, item.param3, item.param4)
     if int_mode:
-        return mav.mission_item_int_encode(*target, item.seq, item.frame, item.command, int(current),
-                                           item.autocontinue, *p, item.x, item.y, item.z, plan_type)
+        return encoder.mission_item_int_encode(*target, item.seq, item.frame, item.command, int(current),
+                                               item.autocontinue, *p, item.x, item.y, item.z, plan_type)
     if item.frame == MavFrame.MISSION:
         frame, x, y = MavFrame.MISSION, float(item.x), float(item.y)
     else:
         frame, x, y = _FLOAT_FRAMES[item.frame], item.lat_deg, item.lon_deg
-    return mav.mission_item_encode(*target, item.seq, frame, item.command, int(current), item.autocontinue, *p,
-                                   x, y, item.z, plan_type)
+    return encoder.mission_item_encode(*target, item.seq, frame, item.command, int(current), item.autocontinue, *p,
+                                       x, y, item.z, plan_type)
 
 
 def mission_current_fields(store: MissionStore, nav_state: NavState) -> tuple[int, int, int, int]:

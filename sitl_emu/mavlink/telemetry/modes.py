@@ -14,9 +14,9 @@ from sitl_emu import px4
 from sitl_emu.px4 import NavState
 
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.development import MAVLink_available_modes_message
 
     from sitl_emu.mavlink.context import LinkContext
+    from sitl_emu.mavlink.wire.fastpack import Packed
 
 # Multicopter modes of PX4 v1.15 in nav_state order (mode_util::getValidNavStates() of that era).
 VALID_MODES: tuple[NavState, ...] = (
@@ -32,7 +32,7 @@ MODE_PROPERTY_ADVANCED = 1
 MODE_PROPERTY_NOT_USER_SELECTABLE = 2
 
 
-def available_modes(ctx: LinkContext, index_param: float) -> list[MAVLink_available_modes_message] | None:
+def available_modes(ctx: LinkContext, index_param: float) -> list[Packed] | None:
     """The AVAILABLE_MODES messages for REQUEST_MESSAGE param2; None (DENIED) for an index past the end."""
     index = round(index_param) if math.isfinite(index_param) else 0
     total = len(VALID_MODES)
@@ -43,10 +43,10 @@ def available_modes(ctx: LinkContext, index_param: float) -> list[MAVLink_availa
     return None
 
 
-def _mode_message(ctx: LinkContext, index: int, nav: NavState) -> MAVLink_available_modes_message:
+def _mode_message(ctx: LinkContext, index: int, nav: NavState) -> Packed:
     standard = STANDARD_MODE.get(nav, 0)
     properties = 0 if nav in (NavState.ALTCTL, NavState.POSCTL) else MODE_PROPERTY_ADVANCED
     if nav in NOT_USER_SELECTABLE:
         properties |= MODE_PROPERTY_NOT_USER_SELECTABLE
     name = b"" if standard else px4.UI_NAMES[nav].encode()
-    return ctx.mav.available_modes_encode(len(VALID_MODES), index, standard, px4.custom_mode(nav), properties, name)
+    return ctx.encoder.available_modes_encode(len(VALID_MODES), index, standard, px4.custom_mode(nav), properties, name)

@@ -86,8 +86,8 @@ ON_DEMAND_STREAMS: dict[int, tm.Builder] = {
 STREAMS: dict[int, tm.Builder] = {**BUILDERS, **ON_DEMAND_STREAMS}
 # messages PX4 sends only on request (REQUEST_MESSAGE), not as periodic streams
 ON_REQUEST: dict[int, tm.Builder] = {
-    148: lambda ctx, snap: autopilot_version(ctx.mav, ctx.sysid),
-    300: lambda ctx, snap: protocol_version(ctx.mav),
+    148: lambda ctx, snap: autopilot_version(ctx.encoder, ctx.sysid),
+    300: lambda ctx, snap: protocol_version(),
 }
 
 # Hz, from mavlink_main.cpp configure_streams_to_default (MAVLINK_MODE_ONBOARD); GPS_RAW_INT "unlimited" = SIH GPS 8 Hz
@@ -102,6 +102,9 @@ NORMAL_RATES_HZ: dict[int, float] = {
     33: 50, 441: 1, 24: 5, 242: 0.5, 32: 50, 12901: 1, 12904: 1, 4: 0.1, 85: 50, 36: 50, 1: 1, 380: 1, 74: 4,
     241: 0.1, 8: 1, 29: 1, 42: 1, 360: 2,
 }
+# Builders that read more than the snapshot: the link's own counters (LINK_NODE_STATUS), the vehicle's mission store
+# (MISSION_CURRENT) or its physics (HIL_STATE_QUATERNION). Each link builds these itself; SharedBuilds the others.
+PER_LINK: frozenset[int] = frozenset({8, 42, 115})
 # A stream sends only when its source topic has news: a topic slower than the stream sets the pace. PX4's navigator
 # publishes rtl_time_estimate every 2 s, so TIME_ESTIMATE_TO_TARGET (1 Hz configured) goes out at 0.5 Hz.
 SOURCE_PERIOD_US: dict[int, int] = {380: 2_000_000}
@@ -126,11 +129,39 @@ class _Stream:
     next_us: int = UNSET
 
 
+class SharedBuilds:
+    """The stream messages built from one snapshot, shared by a vehicle's links.
+
+    When both links send a message in the same tick (ATTITUDE_QUATERNION at 50 Hz on each), it is built once and its
+    payload packed once (fastpack.Packed keeps it); each link frames it with its own sequence number and, when
+    signing, its own link id. Only for builders that read nothing but the snapshot (not PER_LINK). A builder that
+    fails is not remembered: the other link tries again and counts its own error.
+    """
+
+    def __init__(self) -> None:
+        self._snap: VehicleSnapshot | None = None
+        self._built: dict[int, OutMessage | None] = {}
+
+    def build(self, msg_id: int, builder: tm.Builder, ctx: EndpointContext, snap: VehicleSnapshot
+              ) -> OutMessage | None:
+        if snap is not self._snap:  # a new instant (or an input changed the vehicle): forget the old messages
+            self._snap = snap
+            self._built = {}
+        built = self._built
+        if msg_id in built:
+            return built[msg_id]
+        msg = builder(ctx, snap)
+        built[msg_id] = msg
+        return msg
+
+
 class Streams:
     """One link's stream table: interval per message id (None = off) and the next due time, in simulated µs."""
 
-    def __init__(self, mode: StreamMode, start_delay_us: int = 0) -> None:
+    def __init__(self, mode: StreamMode, start_delay_us: int = 0, shared: SharedBuilds | None = None) -> None:
+        """`shared`: the vehicle's SharedBuilds, when its links share what they build in a tick."""
         self.mode = mode
+        self.shared = shared
         # the streams (heartbeat included) begin this long after the first pass: runtime/swarm.py staggers its
         # vehicles' links, as separately started PX4 instances are out of phase with each other
         self.start_delay_us = start_delay_us
@@ -205,10 +236,15 @@ class Streams:
         if not due:
             return 0
         snap = get_snapshot()
+        shared = self.shared
         sent = 0
         for msg_id in due:
+            builder = tm.heartbeat if msg_id == HEARTBEAT_ID else STREAMS[msg_id]
             try:
-                msg = tm.heartbeat(ctx, snap) if msg_id == HEARTBEAT_ID else STREAMS[msg_id](ctx, snap)
+                if shared is None or msg_id in PER_LINK:
+                    msg = builder(ctx, snap)
+                else:
+                    msg = shared.build(msg_id, builder, ctx, snap)
             except Exception as err:  # a bad snapshot value must cost one message, not the link
                 self._build_failed(msg_id, err)
                 continue

@@ -7,13 +7,11 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.development import MAVLink_message
-
     from sitl_emu.mavlink.wire.fastpack import Packed
 
 
 class MessageEncoder(Protocol):
-    """Builds messages by name: `encoder.attitude_encode(...)`. The endpoint's is fastpack.ENCODER; pymavlink's
-    MAVLink takes the same calls (the tests compare the two)."""
+    """Builds messages by name: `encoder.attitude_encode(...)`, the calls of pymavlink's MAVLink. The one
+    implementation is fastpack.ENCODER."""
 
-    def __getattr__(self, name: str) -> Callable[..., MAVLink_message | Packed]: ...  # context.OutMessage
+    def __getattr__(self, name: str) -> Callable[..., Packed]: ...  # context.OutMessage

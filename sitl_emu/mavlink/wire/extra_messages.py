@@ -76,10 +76,7 @@ def make_spec(msg_id: int, name: str, fields: Sequence[Field]) -> MessageSpec:
                 flat.append(value)
         return Packed(spec, tuple(flat))
 
-    def payload_of(msg: Any) -> bytes:
-        raise TypeError(f"{name} is not a pymavlink class: send it as a Packed")
-
-    spec = MessageSpec(msg_id, name, bytes((crc_extra(name, fields),)), layout.pack, encode, payload_of)
+    spec = MessageSpec(msg_id, name, bytes((crc_extra(name, fields),)), layout.pack, encode)
     return spec
 
 

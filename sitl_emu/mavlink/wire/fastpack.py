@@ -1,23 +1,26 @@
-"""MAVLink 2 frames for what the vehicle sends: the bytes pymavlink's `msg.pack(mav)` makes, at a fraction of the cost.
+"""The one encoder: MAVLink 2 frames of all the vehicle sends, the bytes pymavlink's `msg.pack(mav)` makes, cheaper.
 
-pymavlink builds a message object, a header object and a bytearray per message and checksums through two wrapper
-objects; at ~700 messages per simulated second per vehicle that was most of the cost of the link. Here:
+pymavlink stays the parser and the source of each message's metadata (field order, types, struct layout,
+crc_extra, its encode functions' defaults); this module is the one encoder. pymavlink builds a message object, a
+header object and a bytearray per message and checksums through two wrapper objects; at ~700 messages per simulated
+second per vehicle that was most of the cost of the link. Here:
 - `ENCODER.<name>_encode(...)` takes the same arguments (and defaults) as pymavlink's `MAVLink.<name>_encode` and
   returns a `Packed`: the message's spec and its field values in wire order, packed when sent (as pymavlink packs a
   message object when it is sent, so a value out of its wire range fails at the same place).
-- `frame_message(msg, seq, sysid, compid)` frames a Packed or any pymavlink message object (what handlers build
-  with `ctx.mav`) as MAVLink 2: trailing zero bytes of the payload cut (at least one byte kept), incompat/compat
-  flags 0 (incompat flags as given: MAVLINK_IFLAG_SIGNED for a frame wire/signing.py then signs), X.25
-  (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra. The caller owns the sequence number
-  (Endpoint: its `mav.seq`).
+- `frame_message(msg, seq, sysid, compid)` frames a Packed as MAVLink 2: trailing zero bytes of the payload cut (at
+  least one byte kept), compat flags 0, incompat flags as given (MAVLINK_IFLAG_SIGNED for a frame wire/signing.py
+  then signs), X.25 (CRC-16/MCRF4XX) checksum over header, payload and the message's crc_extra. The caller owns the
+  sequence number (Endpoint: its `seq`, one per link).
 
-The field order, struct layout and crc_extra come from the pymavlink message classes themselves, so the wire format is
-theirs. Each class gets two small functions generated from that metadata, mirroring pymavlink's own generated
-`pack()` expression term by term (arrays indexed element by element, char arrays passed whole), so bad values fail
-the same way (struct.error, IndexError...). tests/sitl_emu/mavlink/wire/test_fastpack.py checks the bytes against
-pymavlink for every message type the emulator sends.
+What this module reads of pymavlink (tests/sitl_emu/mavlink/wire/test_pymavlink_internals.py fails when a new
+pymavlink changes it; pyproject.toml bounds the version to the newest checked): the dialect module's
+`MAVLink_<name>_message` classes with their `id`, `msgname`, `fieldnames`, `fieldtypes`, `ordered_fieldnames`,
+`array_lengths`, `crc_extra` and `unpacker` (a struct.Struct of the whole payload in wire order), and the defaults
+of `MAVLink.<name>_encode`. Each class gets an encode function generated from that metadata, mirroring pymavlink's
+own generated `pack()` expression term by term (arrays indexed element by element, char arrays passed whole), so bad
+values fail the same way (struct.error, IndexError...). tests/sitl_emu/mavlink/wire/test_fastpack.py checks the
+bytes against pymavlink's for every message of the dialect.
 """
-
 from __future__ import annotations
 
 import binascii
@@ -30,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 from pymavlink.dialects.v20 import development as dialect
 
 if TYPE_CHECKING:
-    from pymavlink.dialects.v20.development import MAVLink, MAVLink_message
+    from pymavlink.dialects.v20.development import MAVLink
 
 _mcrf4xx: Callable[[bytes, int], int] | None
 try:  # pymavlink's own CRC dependency (a C extension); the stdlib fallback below gives the same numbers
@@ -61,21 +64,22 @@ class MessageSpec:
     crc_extra: bytes  # one byte, appended to the checksummed data
     pack: Callable[..., bytes]  # the class's struct: wire-ordered values -> whole payload
     encode: Callable[..., Packed]  # pymavlink's <name>_encode signature
-    payload_of: Callable[[Any], bytes]  # payload of a pymavlink message object of this class
 
 
 class Packed:
-    """A message as the fast encoder returns it: its spec and its field values in wire order (arrays flattened).
+    """A message as the encoder returns it: its spec and its field values in wire order (arrays flattened).
 
-    Endpoint.send() frames it directly. It also packs like a pymavlink message, so a plain pymavlink
-    `MAVLink.send()` (test contexts) can send it too.
+    Endpoint.send() frames it directly; the first framing keeps the packed payload (`body`, trailing zeros cut), so
+    a message both links send is packed once (telemetry/streams.py SharedBuilds). It also packs like a pymavlink
+    message, so a plain pymavlink `MAVLink.send()` can send it too.
     """
 
-    __slots__ = ("spec", "values")
+    __slots__ = ("body", "spec", "values")
 
     def __init__(self, spec: MessageSpec, values: tuple[Any, ...]) -> None:
         self.spec = spec
         self.values = values
+        self.body: bytes | None = None
 
     def get_type(self) -> str:
         return self.spec.name
@@ -86,16 +90,14 @@ class Packed:
         return frame_message(self, mav.seq, mav.srcSystem, mav.srcComponent)
 
 
-def frame_message(msg: MAVLink_message | Packed, seq: int, sysid: int, compid: int, incompat_flags: int = 0) -> bytes:
-    """The MAVLink 2 frame of a Packed or of any pymavlink message object, exactly as pymavlink's
-    MAVLink_message._pack builds it, without a signature block (a struct.error etc. for a value out of range)."""
-    if type(msg) is Packed:
-        spec = msg.spec
+def frame_message(msg: Packed, seq: int, sysid: int, compid: int, incompat_flags: int = 0) -> bytes:
+    """The MAVLink 2 frame of a Packed, exactly as pymavlink's MAVLink_message._pack builds it, without a signature
+    block (a struct.error etc. for a value out of range)."""
+    spec = msg.spec
+    body = msg.body
+    if body is None:
         payload = spec.pack(*msg.values)
-    else:
-        spec = _SPECS_BY_CLASS.get(type(msg)) or spec_for_class(type(msg))
-        payload = spec.payload_of(msg)
-    body = payload.rstrip(b"\0") or payload[:1]
+        body = msg.body = payload.rstrip(b"\0") or payload[:1]
     msg_id = spec.msg_id
     head = _HEADER.pack(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
     return MAGIC_V2 + head + _CRC.pack(x25_crc(head + spec.crc_extra, 0xFFFF))
@@ -114,20 +116,14 @@ def spec_for_class(cls: type) -> MessageSpec:
     return spec
 
 
-def _wire_terms(cls: Any, of_object: bool) -> list[str]:
-    """The arguments pymavlink's generated pack() passes to the class's struct, in wire order.
-
-    Of an object, a char array is read from `_<name>_raw` where the class keeps the bytes given to it there (newer
-    pymavlink decodes the public attribute to str).
-    """
+def _wire_terms(cls: Any) -> list[str]:
+    """The arguments pymavlink's generated pack() passes to the class's struct, in wire order: an array element by
+    element, a char array (bytes) whole."""
     types = dict(zip(cls.fieldnames, cls.fieldtypes, strict=True))
-    stored = cls.__init__.__code__.co_names
     terms: list[str] = []
     for name, length in zip(cls.ordered_fieldnames, cls.array_lengths, strict=True):
         if length and types[name] != "char":
             terms.extend(f"{name}[{i}]" for i in range(length))
-        elif of_object and f"_{name}_raw" in stored:
-            terms.append(f"_{name}_raw")
         else:
             terms.append(name)
     return terms
@@ -135,22 +131,19 @@ def _wire_terms(cls: Any, of_object: bool) -> list[str]:
 
 def _build_spec(cls: Any) -> MessageSpec:
     fields = list(cls.fieldnames)
-    if {"_pk", "_mk", "_spec", "_m"} & set(fields):
+    if {"_mk", "_spec"} & set(fields):
         raise ValueError(f"{cls.msgname}: a field name collides with the generated code")
-    namespace: dict[str, Any] = {"_pk": cls.unpacker.pack, "_mk": Packed}
+    namespace: dict[str, Any] = {"_mk": Packed}
     # Generated from pymavlink's own metadata: the same expressions its generated pack() evaluates. A trailing comma
     # keeps a one-term tuple a tuple.
     source = (
         f"def encode({', '.join(fields)}):\n"
-        f"    return _mk(_spec, ({', '.join(_wire_terms(cls, False))},))\n"
-        f"def payload_of(_m):\n"
-        f"    return _pk({', '.join('_m.' + t for t in _wire_terms(cls, True))})\n"
+        f"    return _mk(_spec, ({', '.join(_wire_terms(cls))},))\n"
     )
     exec(compile(source, f"<fastpack {cls.msgname}>", "exec"), namespace)
     encode = namespace["encode"]
     encode.__defaults__ = _encode_defaults(cls)
-    spec = MessageSpec(cls.id, cls.msgname, bytes((cls.crc_extra,)), cls.unpacker.pack, encode,
-                       namespace["payload_of"])
+    spec = MessageSpec(cls.id, cls.msgname, bytes((cls.crc_extra,)), cls.unpacker.pack, encode)
     namespace["_spec"] = spec
     return spec
 

@@ -1,9 +1,10 @@
-"""The emulator's own MAVLink packer sends exactly the bytes pymavlink's `msg.pack(mav)` would.
+"""The one encoder (fastpack) sends exactly the bytes pymavlink's `msg.pack(mav)` would.
 
-A client sees no difference: same frames (header, MAVLink 2 zero truncation, checksum), one datagram per message, one
-sequence number per link whichever way a message was built. Checked for every message class of the dialect with edge
-values, for every telemetry builder on real and extreme vehicle states, and end to end over UDP for everything a
-session with a ground station makes the vehicle send (streams, acks, params, mission, shell, status texts).
+Table-driven over pymavlink's own messages: every message class of the dialect (and PROTOCOL_VERSION, which the
+emulator defines from common.xml in pymavlink's shape), one test per property, each reporting every message that
+breaks it. Then every telemetry builder on real and extreme vehicle states, and end to end over UDP everything a
+session with a ground station makes the vehicle send (streams, acks, params, mission, shell, status texts), one
+sequence number per link.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from __future__ import annotations
 import itertools
 import math
 import random
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -22,15 +24,19 @@ from support.ports import pending_datagrams
 from sitl_emu.mavlink.telemetry.streams import BUILDERS, ON_REQUEST
 from sitl_emu.mavlink.version import ProtocolVersionMessage
 from sitl_emu.mavlink.wire import extra_messages, fastpack
+from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, sign_frame
 from sitl_emu.px4 import MavCmd, NavState
 from sitl_emu.types import HomePosition, OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle.vehicle import Vehicle
 
 # (test_commands_wire.py adds PROTOCOL_VERSION to the dialect's map for its client: not a dialect class here)
-DIALECT_CLASSES = [cls for cls in dialect.mavlink_map.values() if cls is not ProtocolVersionMessage]
-ALL_CLASSES = [*DIALECT_CLASSES, ProtocolVersionMessage]
+DIALECT_CLASSES = sorted((c for c in dialect.mavlink_map.values() if c is not ProtocolVersionMessage),
+                         key=lambda c: c.id)
+TABLE = [*DIALECT_CLASSES, ProtocolVersionMessage]
 FLOAT_EDGES = (0.0, -0.0, 1.5, -2.75e-3, math.nan, math.inf, -math.inf, 3.4e38, -1.0e-45)
 NAN = math.nan
+SIZES = {"char": 1, "int8_t": 1, "uint8_t": 1, "int16_t": 2, "uint16_t": 2, "int32_t": 4, "uint32_t": 4, "float": 4,
+         "int64_t": 8, "uint64_t": 8, "double": 8}  # MAVLink's types, bytes on the wire
 
 
 def _scalar(ctype: str, rng: random.Random) -> Any:
@@ -65,33 +71,122 @@ def _parse(frame: bytes) -> list[Any]:
     return parser.parse_buffer(frame) or []
 
 
-@pytest.mark.parametrize("cls", ALL_CLASSES, ids=lambda c: c.msgname)
-def test_every_message_class_frames_byte_for_byte_like_pymavlink(cls):
-    rng = random.Random(cls.id)
+def _breaking(check: Callable[[Any], object], table: list[Any] = TABLE) -> list[str]:
+    """The messages of the table for which `check(cls)` fails (an assertion or any error), as 'NAME: why'."""
+    broken = []
+    for cls in table:
+        try:
+            check(cls)
+        except Exception as err:
+            broken.append(f"{cls.msgname}: {type(err).__name__} {err}"[:300])
+    return broken
+
+
+def _mav(rng: random.Random) -> Any:
     mav = dialect.MAVLink(None, srcSystem=rng.randrange(1, 256), srcComponent=rng.randrange(256))
-    encode = fastpack.spec_for_class(cls).encode
-    for _ in range(6):
+    mav.seq = rng.randrange(256)
+    return mav
+
+
+def test_fastpack_frames_every_message_as_pymavlink_packs_it():
+    def check(cls: Any) -> None:
+        rng = random.Random(cls.id)
+        encode = fastpack.spec_for_class(cls).encode
+        for _ in range(6):
+            args, mav = _args(cls, rng), _mav(rng)
+            expected = cls(*args).pack(mav)
+            assert fastpack.frame_message(encode(*args), mav.seq, mav.srcSystem, mav.srcComponent) == expected
+            if cls is not ProtocolVersionMessage:  # pymavlink's parser does not know #300
+                (parsed,) = _parse(expected)
+                assert parsed.get_type() == cls.msgname and parsed.get_seq() == mav.seq
+
+    assert _breaking(check) == []
+
+
+def test_fastpack_takes_pymavlinks_encode_arguments_and_defaults():
+    def check(cls: Any) -> None:
+        name = f"{cls.msgname.lower()}_encode"
+        ours, theirs = getattr(fastpack.ENCODER, name), getattr(dialect.MAVLink, name)
+        assert ours.__code__.co_varnames[:ours.__code__.co_argcount] == theirs.__code__.co_varnames[1:][
+            :theirs.__code__.co_argcount - 1]
+        required = len(cls.fieldnames) - len(theirs.__defaults__ or ())
+        args = _args(cls, random.Random(cls.id + 7))[:required]
+        mav = dialect.MAVLink(None, srcSystem=1, srcComponent=1)
+        assert ours(*args).pack(mav) == getattr(mav, name)(*args).pack(mav)
+        assert ours(*args).get_type() == cls.msgname
+
+    assert _breaking(check, DIALECT_CLASSES) == []
+
+
+def _only_first_field_set(cls: Any) -> tuple[list[Any], int]:
+    """Arguments with every byte of the first field on the wire non-zero and all else zero, and that field's size."""
+    types = dict(zip(cls.fieldnames, cls.fieldtypes, strict=True))
+    lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
+    first = cls.ordered_fieldnames[0]
+    args: list[Any] = []
+    for name in cls.fieldnames:
+        ctype, length = types[name], lengths[name]
+        value: Any = b"\x01" * length if ctype == "char" else -1.0 if ctype in ("float", "double") else (
+            -1 if ctype.startswith("int") else 2 ** (8 * SIZES[ctype]) - 1)  # the last byte is never zero
+        if name != first:
+            value = b"" if ctype == "char" else 0
+        args.append([value] * length if length and ctype != "char" else value)
+    return args, SIZES[types[first]] * max(lengths[first], 1)
+
+
+def test_trailing_zero_bytes_are_cut_as_mavlink2_says_and_the_parser_fills_them_back():
+    """MAVLink 2 payload truncation: the zero bytes at the end of the payload (extension fields included) are not
+    sent, at least one byte is; a receiver reads the missing bytes as zero."""
+    def check(cls: Any) -> None:
+        encode = fastpack.spec_for_class(cls).encode
+        args, first_size = _only_first_field_set(cls)
+        frame = fastpack.frame_message(encode(*args), 0, 1, 1)
+        assert frame[1] == first_size and len(frame) == 10 + first_size + 2
+        if cls is not ProtocolVersionMessage:
+            (parsed,) = _parse(frame)
+            assert parsed.get_type() == cls.msgname
+            sent = cls(*args)
+            assert [getattr(parsed, f) for f in cls.fieldnames] == [getattr(sent, f) for f in cls.fieldnames]
+
+    assert _breaking(check) == []
+
+
+def test_an_all_zero_message_keeps_one_payload_byte():
+    def check(cls: Any) -> None:
+        types = dict(zip(cls.fieldnames, cls.fieldtypes, strict=True))
+        lengths = dict(zip(cls.ordered_fieldnames, cls.array_lengths, strict=True))
+        args = [b"" if types[n] == "char" else [0] * lengths[n] if lengths[n] else 0 for n in cls.fieldnames]
+        frame = fastpack.frame_message(fastpack.spec_for_class(cls).encode(*args), 0, 1, 1)
+        assert frame[1] == 1 and frame[10] == 0 and len(frame) == 13
+
+    assert _breaking(check) == []
+
+
+def test_the_checksum_covers_the_header_the_payload_and_the_messages_crc_extra():
+    def check(cls: Any) -> None:
+        frame = fastpack.frame_message(fastpack.spec_for_class(cls).encode(*_args(cls, random.Random(cls.id))), 9, 1, 1)
+        crc = dialect.x25crc(frame[1:-2])
+        crc.accumulate(bytes((cls.crc_extra,)))
+        assert frame[-2:] == crc.crc.to_bytes(2, "little")
+
+    assert _breaking(check) == []
+
+
+def test_signed_frames_are_the_ones_pymavlink_signs():
+    key = bytes(range(100, 132))
+
+    def check(cls: Any) -> None:
+        rng = random.Random(cls.id + 11)
+        mav = _mav(rng)
+        link_id, timestamp = rng.randrange(256), rng.randrange(1 << 48)
+        mav.signing.secret_key, mav.signing.sign_outgoing, mav.signing.link_id = key, True, link_id
+        mav.signing.timestamp = timestamp
         args = _args(cls, rng)
-        mav.seq = rng.randrange(256)
-        expected = cls(*args).pack(mav)
-        assert fastpack.frame_message(cls(*args), mav.seq, mav.srcSystem, mav.srcComponent) == expected
-        assert encode(*args).pack(mav) == expected
-        if cls is not ProtocolVersionMessage:  # pymavlink's parser does not know #300
-            (parsed,) = _parse(expected)
-            assert parsed.get_type() == cls.msgname and parsed.get_seq() == mav.seq
+        frame = fastpack.frame_message(fastpack.spec_for_class(cls).encode(*args), mav.seq, mav.srcSystem,
+                                       mav.srcComponent, IFLAG_SIGNED)
+        assert sign_frame(frame, key, link_id, timestamp) == cls(*args).pack(mav)
 
-
-@pytest.mark.parametrize("cls", DIALECT_CLASSES, ids=lambda c: c.msgname)
-def test_fast_encoder_has_pymavlinks_signature_and_defaults(cls):
-    name = f"{cls.msgname.lower()}_encode"
-    ours, theirs = getattr(fastpack.ENCODER, name), getattr(dialect.MAVLink, name)
-    assert ours.__code__.co_varnames[:ours.__code__.co_argcount] == theirs.__code__.co_varnames[1:][
-        :theirs.__code__.co_argcount - 1]
-    required = len(cls.fieldnames) - len(theirs.__defaults__ or ())
-    args = _args(cls, random.Random(cls.id + 7))[:required]
-    mav = dialect.MAVLink(None, srcSystem=1, srcComponent=1)
-    assert ours(*args).pack(mav) == getattr(mav, name)(*args).pack(mav)
-    assert ours(*args).get_type() == cls.msgname
+    assert _breaking(check) == []
 
 
 def test_checksum_fallback_without_fastcrc_gives_the_same_crc():
@@ -118,13 +213,33 @@ class _Node:
     epoch_unix_us = 1_700_000_000_000_000
 
 
-class _BuilderCtx:
-    """What a builder reads of its link, with either pymavlink's encoder or the fast one."""
+class _PymavlinkEncoder:
+    """pymavlink's encoder behind fastpack's type (a compiled builder returns only a Packed): the message a builder
+    gets is a Packed whose one value is pymavlink's own message object, which the test then packs with pymavlink."""
 
-    def __init__(self, encoder: Any) -> None:
+    SPEC = fastpack.MessageSpec(-1, "PYMAVLINK", b"\0", lambda *values: b"", lambda *args: None)
+
+    def __init__(self, mav: Any) -> None:
+        self._mav = mav
+        self.calls = 0
+
+    def __getattr__(self, name: str) -> Any:
+        encode = getattr(self._mav, name)
+
+        def reference(*args: Any) -> fastpack.Packed:
+            self.calls += 1
+            return fastpack.Packed(self.SPEC, (encode(*args),))
+
+        return reference
+
+
+class _BuilderCtx:
+    """What a builder reads of its link, with pymavlink's encoder (the reference) or fastpack."""
+
+    def __init__(self, pymavlink: bool) -> None:
         self.sysid, self.compid = 1, 1
         self.mav = dialect.MAVLink(None, srcSystem=1, srcComponent=1)
-        self.encoder = self.mav if encoder is None else encoder
+        self.encoder = _PymavlinkEncoder(self.mav) if pymavlink else fastpack.ENCODER
         self.node = _Node()
 
 
@@ -166,30 +281,29 @@ def _extreme_snapshots() -> list[Any]:
 
 
 def _outcome(builder: Any, ctx: Any, snap: Any, seq: int) -> Any:
+    """The frame the builder's message makes (pymavlink packs the reference's), or the error it fails with."""
     try:
         msg = builder(ctx, snap)
         if msg is None:
             return None
-        return fastpack.frame_message(msg, seq, 1, 1) if ctx.encoder is not ctx.mav else msg.pack(_seq(ctx, seq))
+        if msg.spec is _PymavlinkEncoder.SPEC:
+            ctx.mav.seq = seq
+            return msg.values[0].pack(ctx.mav)
+        return fastpack.frame_message(msg, seq, 1, 1)
     except Exception as err:  # a value out of range: both encoders must refuse it alike
         return type(err)
 
 
-def _seq(ctx: Any, seq: int) -> Any:
-    ctx.mav.seq = seq
-    return ctx.mav
-
-
 @pytest.mark.parametrize("snaps", [_flight_snapshots, _extreme_snapshots], ids=["flight", "extreme"])
 def test_every_telemetry_builder_sends_what_pymavlink_would(snaps):
-    reference, fast = _BuilderCtx(None), _BuilderCtx(fastpack.ENCODER)
+    reference, fast = _BuilderCtx(pymavlink=True), _BuilderCtx(pymavlink=False)
     sent = 0
     for i, snap in enumerate(snaps()):
         for msg_id, builder in {**BUILDERS, **ON_REQUEST}.items():
             expected = _outcome(builder, reference, snap, i % 256)
             assert _outcome(builder, fast, snap, i % 256) == expected, (msg_id, snap.time_us)
             sent += isinstance(expected, bytes)
-    assert sent > 20
+    assert sent > 20 and reference.encoder.calls > 20
 
 
 # --- end to end -----------------------------------------------------------------------------------------------------
