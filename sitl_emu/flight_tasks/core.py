@@ -19,6 +19,7 @@ from typing import Any, Final
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.geo import SIH_HOME
 from sitl_emu.motion_planning.heading import HeadingSmoother
 from sitl_emu.motion_planning.heading import wrap_pi as wrap_pi  # the tasks import it from here
 from sitl_emu.motion_planning.smoothing import PositionSmoother
@@ -68,12 +69,12 @@ class NavInput:
     landed: bool
     armed: bool
     takeoff_state: TakeoffState = TakeoffState.FLIGHT
-    ref_alt_amsl_m: float = 488.0
+    ref_alt_amsl_m: float = SIH_HOME[2]
     vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD  # the position controller's last velocity setpoint (NaN: none)
 
     def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
                  home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: TakeoffState = TakeoffState.FLIGHT,
-                 ref_alt_amsl_m: float = 488.0, vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD) -> None:
+                 ref_alt_amsl_m: float = SIH_HOME[2], vel_sp_ned_m_s: Vec3 = _NO_FEEDFORWARD) -> None:
         self.time_us = time_us
         self.pos_ned_m = pos_ned_m
         self.vel_ned_m_s = vel_ned_m_s

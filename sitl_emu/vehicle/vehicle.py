@@ -30,7 +30,7 @@ from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.flight_tasks.core import NavInput, SetpointType
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
-from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
+from sitl_emu.geo import SIH_HOME, GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
@@ -66,7 +66,7 @@ class Vehicle:
     dt_us: int = 4000  # 250 Hz, SIH lockstep
 
     def __init__(self, *, params: ParamRegistry | None = None,
-                 home: tuple[float, float, float] = (47.397742, 8.545594, 488.0), seed: int = 0, sysid: int = 1,
+                 home: tuple[float, float, float] = SIH_HOME, seed: int = 0, sysid: int = 1,
                  ready_delay_s: float = 2.0, position_noise_m: float = 0.0, wind: WindSettings | None = None,
                  estimate_noise: EstimateNoiseSettings | None = None) -> None:
         """Boot disarmed in Hold on the ground at `home` (lat_deg, lon_deg, alt_amsl_m), the local frame's origin.

@@ -214,7 +214,7 @@ def test_roi_location_turns_the_vehicle_towards_it_until_roi_none() -> None:
 
 
 def test_amsl_altitude_frame() -> None:
-    f = Flight([TAKEOFF_ITEM, wp(10, 0, 488.0 + 9.0, frame=AMSL)])
+    f = Flight([TAKEOFF_ITEM, wp(10, 0, 489.4 + 9.0, frame=AMSL)])
     f.start()
     f.run_until(lambda: f.store.finished)
     f.v.run_for(5.0)
