@@ -269,7 +269,7 @@ def test_rtl_near_home_uses_the_cone_altitude(params):
     pm = PointMass(pos=(5.0, 0.0, -3.0))
     task = make_rtl(pm.nav(), params)
     assert task.return_alt_up_m == pytest.approx(10.0)  # within NAV_ACC_RAD: twice the distance
-    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 500 m (10 m above destination)")]  # 489.4 + 10
+    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 500 m (10 m above destination)")]
 
 
 @pytest.mark.parametrize(("return_alt", "home_alt", "text"), [
