@@ -290,7 +290,7 @@ class Commander:
         ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
                                    in_termination=self.nav_state is NavState.TERMINATION)
         if ok:
-            self._failsafe.reset()  # a user mode change ends the failsafe actions (OnModeChangeOrDisarm)
+            self._failsafe.reset(user_mode_change=True)  # ends the failsafe actions (OnModeChangeOrDisarm)
             self._apply_mode(self.now_us)
         return ok
 
