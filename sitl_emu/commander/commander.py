@@ -350,6 +350,13 @@ class Commander:
         if self.armed and not self.landed and self._task_finished and self.nav_state is NavState.AUTO_TAKEOFF:
             self.change_mode(NavState.AUTO_LOITER)
 
+    def on_mission_finished(self) -> None:
+        """Commander::checkForMissionUpdate: a mission that finished in the air while in AUTO_MISSION hands over to
+        Hold as the user's mode; so after its RTL item's return lands, the vehicle disarms into Hold, not Mission
+        (../shared/reference/px4-mission/cases.json flight1/2.sequence: AUTO.LOITER disarmed)."""
+        if self.armed and not self.landed and self.nav_state is NavState.AUTO_MISSION:
+            self.change_mode(NavState.AUTO_LOITER)
+
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:
         """Land detector output after physics: "Takeoff detected" / "Landing detected" while armed."""
         was_landed = self.landed

@@ -82,6 +82,14 @@ class MissionTask(Task):
         wants, nav.wants_rtl = nav.wants_rtl, False
         return wants
 
+    def end_loiter_point(self) -> Vec3 | None:
+        """Where a finished mission loiters (its last setpoint, SETPOINT_TYPE_LOITER), else None: the Hold the
+        commander switches to then keeps it (loiter.cpp set_loiter_position with can_loiter_at_sp)."""
+        cur = self._flight.navigator.current
+        if not self._flight.navigator.result.finished or cur is None or not cur.loiter:
+            return None
+        return cur.target_ned_m if _finite(cur.target_ned_m) else None
+
     def loiter_point(self, nav: NavInput) -> Vec3 | None:
         """The loiter setpoint the vehicle is established on (within NAV_ACC_RAD + NAV_LOITER_RAD), else None."""
         cur = self._flight.navigator.current

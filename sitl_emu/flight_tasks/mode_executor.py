@@ -5,7 +5,8 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 - a new task starts when the mode in force changes, at arming, and when a command brings new navigator parameters;
   no task runs while disarmed (navigator_main.cpp);
 - Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
-  loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
+  loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136); so does Hold after a finished mission at the
+  mission's last setpoint (Commander::checkForMissionUpdate, can_loiter_at_sp);
 - OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
 - POSCTL and ALTCTL run the manual flight tasks (flight_tasks/manual.py) on the latest sticks; STABILIZED and
   MANUAL turn the sticks into an attitude and thrust every tick (flight_tasks/stabilized.py); termination has no
@@ -208,9 +209,11 @@ class ModeExecutor:
         return None if last.kind is NavCommandKind.TAKEOFF else last
 
     def _start_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
-        takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
+        takeoff_target: Vec3 | None = None  # Hold after a finished takeoff or mission holds at its last target
         if self._task_mode is NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
+        elif isinstance(self.task, MissionTask):
+            takeoff_target = self.task.end_loiter_point()
         self._task_mode = nav_state
         if nav_state is NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, self._pending_takeoff, ref)

@@ -101,6 +101,7 @@ class Vehicle:
         self.chain = ControlChain(self.params)
         self._setpoint_type = SetpointType.NONE
         self._task_finished = False
+        self._mission_finished = False  # the mission result's `finished` the commander last saw
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
         self._missions = MissionStore()  # in memory only: a reboot empties it (navigator/mission_store.py)
@@ -153,8 +154,12 @@ class Vehicle:
         if out.messages:  # the task said something this tick
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)
-        if c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL:
-            # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
+        wants_rtl = c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL
+        finished = self._missions.finished
+        if finished and not self._mission_finished:
+            c.on_mission_finished()
+        self._mission_finished = finished
+        if wants_rtl:  # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
             handle_command(c, VehicleCommand(MavCmd.NAV_RETURN_TO_LAUNCH, from_external=False), now)
 
     def run_until(self, time_us: int) -> None:

@@ -167,3 +167,6 @@ def test_the_stick_loss_after_a_takeoff_holds_then_returns():
     p.run(5.0)
     assert p.v.commander.nav_state is NavState.AUTO_RTL
     assert p.texts()[-3:-1] == ["Failsafe activated: entering Hold for 5 seconds", "Failsafe activated"]
+    p.run(15.0)
+    # disarmed into Hold, not back into the take-off (PX4 PR 25735: a take-off is never the mode after disarming)
+    assert not p.v.commander.armed and p.v.commander.nav_state is NavState.AUTO_LOITER
