@@ -119,11 +119,14 @@ class MissionStore:
             self.replace(t, ())
 
     def set_current(self, seq: int) -> bool:
-        """MISSION_SET_CURRENT: only an index inside the stored mission."""
+        """MISSION_SET_CURRENT / MISSION_START: only an index inside the stored mission. A mission pointed at an item
+        is not complete any more (the navigator's set_current clears mission_result.finished): MISSION_CURRENT says
+        so at once, not COMPLETE until the navigator's next cycle."""
         if not 0 <= seq < self.count(PLAN_MISSION):
             return False
         self.current_seq = seq
         self.current_changes += 1
+        self.finished = False
         return True
 
     def try_lock(self, owner: object) -> bool:

@@ -233,3 +233,25 @@ def test_auto_mission_needs_a_mission() -> None:
     f.run_until(lambda: True)
     assert f.texts[-3:] == ["Mission start denied! No valid mission", "Preflight Fail: No valid mission available",
                             "Arming denied: Resolve system health failures first"]
+
+
+def _state(f: Flight) -> int:
+    """MISSION_CURRENT.mission_state now (mission_items.mission_current_fields)."""
+    return f.store.mission_state(f.v.snapshot().nav_state is NavState.AUTO_MISSION)
+
+
+def test_a_finished_mission_started_again_is_active_from_its_first_report() -> None:
+    """MISSION_CURRENT.mission_state: ACTIVE while a mission runs, COMPLETE only after its last item (px4-mission
+    cases.json flight1.sequence: 3, 3, 3, 3, 5); a finished mission started again is not reported COMPLETE."""
+    f = Flight([TAKEOFF_ITEM, wp(10, 0), do(MavCmd.NAV_RETURN_TO_LAUNCH)])
+    f.start()
+    assert _state(f) == MISSION_STATE_ACTIVE
+    f.run_until(lambda: f.store.finished)
+    assert _state(f) == MISSION_STATE_COMPLETE
+    f.run_until(lambda: not f.v.snapshot().armed, 90.0)
+    f.v.run_for(1.0)
+    assert f.command(MavCmd.COMPONENT_ARM_DISARM, 1, 0) == MavResult.ACCEPTED
+    assert f.command(MavCmd.MISSION_START, 0, 0) == MavResult.ACCEPTED
+    for _ in range(50):
+        assert _state(f) == MISSION_STATE_ACTIVE
+        f.v.step()
