@@ -36,18 +36,24 @@ class MissionFlight:
         self._plan_id: int | None = None
         self._items_ref: object = None
         self._changes_seen = store.current_changes
+        self._resets_seen = store.jump_resets
 
     def sync(self, ref: GeoRef, home_alt_amsl_m: float, nav: NavInput | None, settings: MissionSettings) -> None:
-        """Follow the store: a changed plan is loaded (relative altitudes above home), a new current item is set."""
+        """Follow the store: a changed plan is loaded (relative altitudes above home), a new current item is set,
+        the DO_JUMP counters start over."""
         plan = self.store.plan(PLAN_MISSION)
         if plan.items is not self._items_ref:
             self._items_ref = plan.items
             self.navigator.load(nav_items(plan.items, ref, home_alt_amsl_m), self.store.current_seq, nav, settings)
             self._changes_seen = self.store.current_changes
             self._publish()
-        elif self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)
+        if self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)
             self._changes_seen = self.store.current_changes
             self.navigator.set_current(self.store.current_seq, nav, settings)
+            self._publish()
+        if self.store.jump_resets != self._resets_seen:  # DO_SET_MISSION_CURRENT with param2 = 1
+            self._resets_seen = self.store.jump_resets
+            self.navigator.reset_jump_counters()
             self._publish()
 
     def _publish(self) -> None:

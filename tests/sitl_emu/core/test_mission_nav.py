@@ -255,3 +255,18 @@ def test_a_finished_mission_started_again_is_active_from_its_first_report() -> N
     for _ in range(50):
         assert _state(f) == MISSION_STATE_ACTIVE
         f.v.step()
+
+
+@pytest.mark.parametrize(("reset", "currents"), [(0, [1, 2, 4]), (1, [1, 2, 1, 2, 4])])
+def test_set_mission_current_param2_resets_the_jump_counters(reset: int, currents: list[int]) -> None:
+    """navigator_main.cpp DO_SET_MISSION_CURRENT: param2 1 resets every DO_JUMP's repeat count
+    (Mission::set_current_mission_index), so a jump already used repeats again; 0 keeps the counts."""
+    f = Flight([TAKEOFF_ITEM, wp(6, 0), wp(6, 6), do(DO_JUMP, 1, 1), wp(0, 6), wp(0, 12)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 4, 120.0)
+    assert f.currents == [0, 1, 2, 1, 2, 4]
+    f.currents.clear()
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 1, reset) == MavResult.ACCEPTED
+    f.run_until(lambda: f.store.current_seq == 5, 120.0)
+    flown = [seq for seq in f.currents if seq != 5]
+    assert (flown[1:] if flown[0] == 4 else flown) == currents  # from the item set, until item 5 is current
