@@ -185,6 +185,11 @@ class AutoCore:
         self._land_heading = NAN
         self.want_takeoff = False
 
+    def carry_heading(self, previous: AutoCore) -> None:
+        """Continue the previous auto mode's heading setpoint and rate (see Task.continue_heading)."""
+        self.heading.reset(previous.heading.heading_rad, previous.heading.rate_rad_s)
+        self._yaw_sp_prev = previous._yaw_sp_prev
+
     def step(self, nav: NavInput, dt_s: float, wp: Waypoint) -> TrajectorySetpoint:
         kind = wp.kind
         if kind is SetpointType.IDLE:
@@ -322,6 +327,12 @@ class Task:
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
         raise NotImplementedError
+
+    def continue_heading(self, previous: Task) -> None:
+        """FlightModeManager::switchTask does not activate FlightTaskAuto again when one auto mode follows another
+        (the same task), so the heading setpoint and its rate carry on instead of restarting at the vehicle's
+        heading with no rate."""
+        self._core.carry_heading(previous._core)
 
     @property
     def setpoint_type(self) -> SetpointType:

@@ -47,6 +47,10 @@ _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.A
                          NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
                          NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
 _STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
+# the modes flight_mode_manager flies with FlightTaskAuto (FlightModeManager::start_flight_task): one after another
+# the task runs on, so the heading setpoint carries over
+_FLIGHT_TASK_AUTO = frozenset({NavState.AUTO_TAKEOFF, NavState.AUTO_LOITER, NavState.AUTO_MISSION, NavState.AUTO_RTL,
+                               NavState.AUTO_LAND})
 FlightTask = tasks.Task | ManualAltitudeTask | tasks_orbit.FailedOrbitHold | FollowTargetTask
 
 
@@ -214,7 +218,15 @@ class ModeExecutor:
             takeoff_target = getattr(self.task, "target_ned_m", None)
         elif isinstance(self.task, MissionTask):
             takeoff_target = self.task.end_loiter_point()
+        previous, previous_mode = self.task, self._task_mode
         self._task_mode = nav_state
+        self._make_task(nav_state, nav, command, ref, takeoff_target)
+        if (previous_mode in _FLIGHT_TASK_AUTO and nav_state in _FLIGHT_TASK_AUTO
+                and isinstance(previous, tasks.Task) and isinstance(self.task, tasks.Task)):
+            self.task.continue_heading(previous)
+
+    def _make_task(self, nav_state: NavState, nav: tasks.NavInput, command: NavCommand | None, ref: GeoRef,
+                   takeoff_target: Vec3 | None) -> None:
         if nav_state is NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, self._pending_takeoff, ref)
             self._pending_takeoff = None

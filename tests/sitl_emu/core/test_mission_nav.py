@@ -270,3 +270,22 @@ def test_set_mission_current_param2_resets_the_jump_counters(reset: int, current
     f.run_until(lambda: f.store.current_seq == 5, 120.0)
     flown = [seq for seq in f.currents if seq != 5]
     assert (flown[1:] if flown[0] == 4 else flown) == currents  # from the item set, until item 5 is current
+
+
+def test_the_heading_setpoint_and_its_rate_carry_over_into_hold() -> None:
+    """FlightModeManager::switchTask keeps FlightTaskAuto running when Hold follows Mission (the same task): the
+    heading setpoint turns on at the rate it had and slows down from there, rather than restarting at rest."""
+    f = Flight([TAKEOFF_ITEM, wp(20, 0), wp(20, -20), wp(0, -20)])
+    f.start()
+
+    def yawspeed() -> float:
+        sp = f.v.snapshot().local_setpoint
+        return sp.yawspeed_rad_s if sp is not None else 0.0
+
+    f.run_until(lambda: f.store.current_seq == 2 and abs(yawspeed()) > 0.3, 60.0)
+    before = yawspeed()
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 3) == MavResult.ACCEPTED  # AUTO.LOITER
+    f.v.step()
+    f.v.step()
+    assert f.v.snapshot().nav_state is NavState.AUTO_LOITER
+    assert abs(yawspeed() - before) < 0.1
