@@ -28,6 +28,7 @@ from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
 
 WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
+YAW_FIRST: Final = 4  # MPC_YAW_MODE towards_waypoint_yaw_first
 REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
 IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
@@ -198,10 +199,13 @@ class AutoCore:
         target, ff = wp.target_ned_m, _NO_FEEDFORWARD
         if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
+        # MPC_YAW_MODE 4, yaw first: no motion while the heading is not aligned (FlightTaskAuto::_generateSetpoints
+        # force_zero_velocity_setpoint)
+        wait = self.s.yaw_mode == YAW_FIRST and not self.yaw_sp_aligned
         if wp.next_ned_m is not None and kind is SetpointType.POSITION:
-            vz = self._unsmoothed_vz = self._path_step(nav, wp, dt_s)
+            vz = self._unsmoothed_vz = self._path_step(nav, wp, dt_s, wait)
         else:
-            vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
+            vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s, wait)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
         yaw, yawspeed = self._smooth_yaw(self._yaw_target(nav, wp), dt_s)
         self._kind_prev = kind
@@ -211,7 +215,7 @@ class AutoCore:
             out = self._hold_before_ramp(nav, out)
         return out
 
-    def _path_step(self, nav: NavInput, wp: Waypoint, dt_s: float) -> float:
+    def _path_step(self, nav: NavInput, wp: Waypoint, dt_s: float, wait: bool) -> float:
         """A mission leg: previous -> target -> next (FlightTaskAuto passes the triplet to PositionSmoothing)."""
         sm, target = self.smoother, wp.target_ned_m
         sm.acceptance_xy_m = self._acceptance(wp)
@@ -219,7 +223,7 @@ class AutoCore:
         sm.traj_gain = self.s.xy_traj_p
         previous = wp.previous_ned_m if wp.previous_ned_m is not None else target
         following = wp.next_ned_m if wp.next_ned_m is not None else target
-        return sm.update_path(nav.pos_ned_m, previous, target, following, dt_s)[2]
+        return sm.update_path(nav.pos_ned_m, previous, target, following, dt_s, wait)[2]
 
     def _acceptance(self, wp: Waypoint) -> float:
         return wp.acceptance_m if isfinite(wp.acceptance_m) else self.s.nav_acc_rad

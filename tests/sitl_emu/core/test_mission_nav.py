@@ -289,3 +289,20 @@ def test_the_heading_setpoint_and_its_rate_carry_over_into_hold() -> None:
     f.v.step()
     assert f.v.snapshot().nav_state is NavState.AUTO_LOITER
     assert abs(yawspeed() - before) < 0.1
+
+
+@pytest.mark.parametrize("yaw_mode", [0, 4])
+def test_yaw_mode_4_turns_to_the_waypoint_before_it_moves(yaw_mode: int) -> None:
+    """MPC_YAW_MODE 4 (towards the waypoint, yaw first): FlightTaskAuto forces a zero velocity setpoint while the
+    heading setpoint is not aligned (within MIS_YAW_ERR, not turning at the rate limit); 0 turns while it flies."""
+    f = Flight([TAKEOFF_ITEM, wp(0, 30), wp(0, 0)])
+    f.v.params.set("MPC_YAW_MODE", yaw_mode)
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1, 60.0)
+    moved_while_turning = 0.0
+    while f.v.snapshot().euler_rad[2] < math.radians(60.0):  # turning from north to east
+        f.v.step()
+        moved_while_turning = max(moved_while_turning, abs(f.v.snapshot().pos_ned_m[1]))
+        assert f.v.time_us < 60e6
+    assert (moved_while_turning < 0.2) if yaw_mode == 4 else (moved_while_turning > 0.5)
+    f.run_until(lambda: f.store.seq_reached == 1, 60.0)  # and it does get there
