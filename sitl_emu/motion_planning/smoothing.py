@@ -25,8 +25,6 @@ from sitl_emu.types import Vec3
 
 _EPS: Final = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
 
-_ZERO3: Vec3 = (0.0, 0.0, 0.0)
-
 
 def max_speed_from_distance(jerk: float, accel: float, distance_m: float, final_speed: float) -> float:
     """Largest speed from which the vehicle can slow to `final_speed` within `distance_m` (TrajMath.hpp)."""
@@ -291,7 +289,7 @@ class PositionSmoother:
         """One cycle along a path (all three waypoints finite; `following` = `target` when there is no next one).
         Returns the unsmoothed velocity target (PositionSmoothing::_generateVelocitySetpoint, 3D case)."""
         if force_zero_velocity:
-            return self.update(vehicle_pos, target, _ZERO3, dt_s, force_zero_velocity=True)
+            return self.update(vehicle_pos, target, (0.0, 0.0, 0.0), dt_s, force_zero_velocity=True)
         pos = self.position
         turning = self._is_turning(target)
         crossing = self._l1_point(previous, target) if turning else target
