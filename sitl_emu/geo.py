@@ -13,6 +13,10 @@ from typing import Final
 from sitl_emu.types import Vec3
 
 EARTH_RADIUS_M: Final = 6371000.0  # PX4 lib/geo/geo.h CONSTANTS_RADIUS_OF_EARTH
+# Where PX4's SIH starts (lat_deg, lon_deg, alt_amsl_m): the defaults of SIH_LOC_LAT0 / SIH_LOC_LON0 / SIH_LOC_H0
+# (src/modules/simulation/simulator_sih/sih_params.yaml; ../shared/reference/px4-params.json reads 489.4 m), the
+# emulator's default home
+SIH_HOME: Final[tuple[float, float, float]] = (47.397742, 8.545594, 489.4)
 
 
 @dataclass(frozen=True, slots=True)

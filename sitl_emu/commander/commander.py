@@ -290,7 +290,7 @@ class Commander:
         ok = self.intention.change(nav_state, armed=self.armed, can_run=self.can_run(nav_state), force=force,
                                    in_termination=self.nav_state is NavState.TERMINATION)
         if ok:
-            self._failsafe.reset()  # a user mode change ends the failsafe actions (OnModeChangeOrDisarm)
+            self._failsafe.reset(user_mode_change=True)  # ends the failsafe actions (OnModeChangeOrDisarm)
             self._apply_mode(self.now_us)
         return ok
 
@@ -348,6 +348,13 @@ class Commander:
     def _takeoff_completion(self) -> None:
         """Commander.cpp ~l.2208: takeoff finished in the air -> Hold (COM_TAKEOFF_ACT 0)."""
         if self.armed and not self.landed and self._task_finished and self.nav_state is NavState.AUTO_TAKEOFF:
+            self.change_mode(NavState.AUTO_LOITER)
+
+    def on_mission_finished(self) -> None:
+        """Commander::checkForMissionUpdate: a mission that finished in the air while in AUTO_MISSION hands over to
+        Hold as the user's mode; so after its RTL item's return lands, the vehicle disarms into Hold, not Mission
+        (../shared/reference/px4-mission/cases.json flight1/2.sequence: AUTO.LOITER disarmed)."""
+        if self.armed and not self.landed and self.nav_state is NavState.AUTO_MISSION:
             self.change_mode(NavState.AUTO_LOITER)
 
     def on_land_detector(self, landed: bool, maybe_landed: bool) -> None:

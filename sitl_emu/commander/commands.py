@@ -205,14 +205,16 @@ def _mission_start(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck
 
 
 def _set_mission_current(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
-    """navigator_main.cpp DO_SET_MISSION_CURRENT: param1 the item (-1: keep), param2 0/1 (reset the jump counters:
-    not emulated); FAILED out of range or without a mission."""
+    """navigator_main.cpp DO_SET_MISSION_CURRENT: param1 the item (-1: keep), param2 a MAV_BOOL: 1 resets the DO_JUMP
+    counters and the completion (Mission::set_current_mission_index); FAILED out of range or without a mission."""
     p1, p2 = cmd.param(1), cmd.param(2)
     if not (isfinite(p1) and p1 >= -1 and isfinite(p2) and p2 in (0.0, 1.0)):
         return _ack(cmd, MavResult.DENIED)
     store = c.mission_store
     if store is None or not c.mission_valid or not (int(p1) == -1 or store.set_current(int(p1))):
         return _ack(cmd, MavResult.FAILED)
+    if p2 == 1.0:
+        store.reset_jumps()
     return _ack(cmd, MavResult.ACCEPTED)
 
 

@@ -138,11 +138,12 @@ class Failsafe:
         self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
 
-    def reset(self) -> None:
-        """Arming, disarming or a user mode change ends every failsafe action."""
+    def reset(self, *, user_mode_change: bool = False) -> None:
+        """Arming, disarming or a user mode change ends every failsafe action (a mode change during the
+        manual-control loss action is the user's takeover, manual_control.py)."""
         self.active = False
         self._rank = 0
-        self.manual_loss.reset()
+        self.manual_loss.reset(user_mode_change=user_mode_change)
         self.faults.reset()
         self.geofence.reset()
 

@@ -13,6 +13,10 @@ ManualControlSelector.cpp, commander's manual-control checks):
    COM_FAIL_ACT_T ("Failsafe activated: entering Hold for 5 seconds", then "Failsafe activated"), in every mode
    but those COM_RCL_EXCEPT excepts, and not at all if the vehicle was armed without manual control. Sticks coming
    back do not end it: a mode change or disarming does (failsafe.cpp: clear condition OnModeChangeOrDisarm).
+5. A mode the user selects during that Hold or action (Hold, Return, Land) is a takeover (framework.cpp
+   getSelectedAction: a user-intended mode update makes the action a warning): the mode runs although the sticks
+   are still gone, and the failsafe comes back only with a new loss, after the sticks returned. So MAVSDK-Python's
+   manual_control example (one MANUAL_CONTROL, arm, take off) takes off even when the loss is noticed first.
 """
 
 from __future__ import annotations
@@ -101,12 +105,22 @@ class ManualLossFailsafe:
         self.disarm = False
         self._active = False
         self._hold_until_us = 0
+        self._taken_over = False  # the user changed mode during this loss: no action until the next loss
 
-    def reset(self) -> None:
+    def reset(self, *, user_mode_change: bool = False) -> None:
+        """End the action (arming, disarming, a user mode change). A user mode change while an action that allows
+        it (anything but disarm and termination) is in force is a takeover (framework.cpp actionAllowsUserTakeover)."""
+        if not user_mode_change:
+            self._taken_over = False
+        elif self._active and not self.disarm and self.action is not NavState.TERMINATION:
+            self._taken_over = True
         self.action, self.disarm, self._active, self._hold_until_us = None, False, False, 0
 
     def update(self, now_us: int, lost: bool, user: NavState, s: ManualLossSettings) -> NavState | None:
-        if not self._active and lost and not s.input_disabled and not loss_ignored(user, s.rcl_except):
+        if not lost:
+            self._taken_over = False  # the next loss is a new failsafe (checkFailsafe adds the action again)
+        if (not self._active and lost and not self._taken_over and not s.input_disabled
+                and not loss_ignored(user, s.rcl_except)):
             self._start(now_us, user, s)
         if not self._active or (self.action is None and not self.disarm):
             return None

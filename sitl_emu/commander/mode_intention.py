@@ -3,13 +3,16 @@
 After src/modules/commander/UserModeIntention.cpp (v1.15-v1.17):
 - a change is always allowed while disarmed (or when forced); when armed only if the mode can run;
 - nothing leaves TERMINATION;
-- the mode to return to after disarming is the last accepted one that does not prevent arming (TERMINATION sticks).
+- the mode to return to after disarming is the last accepted one that does not prevent arming (TERMINATION sticks)
+  and is no take-off (PX4 PR 25735: a vehicle that landed during a take-off would take off again at the next arming).
 """
 
 from __future__ import annotations
 
 from sitl_emu.commander.arming import mode_prevents_arming
 from sitl_emu.px4 import NavState
+
+_TAKEOFFS = (NavState.AUTO_TAKEOFF, NavState.AUTO_VTOL_TAKEOFF)
 
 
 class ModeIntention:
@@ -29,7 +32,7 @@ class ModeIntention:
         if not allowed:
             return False
         self.user_intended = nav_state
-        if not mode_prevents_arming(nav_state) or nav_state is NavState.TERMINATION:
+        if (not mode_prevents_arming(nav_state) and nav_state not in _TAKEOFFS) or nav_state is NavState.TERMINATION:
             self.after_disarming = nav_state
         return True
 

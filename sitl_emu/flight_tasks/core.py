@@ -27,6 +27,7 @@ from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
 
 WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed vz < -0.3
+YAW_FIRST: Final = 4  # MPC_YAW_MODE towards_waypoint_yaw_first
 REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
 IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
 _IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
@@ -129,6 +130,11 @@ class AutoCore:
         self._land_heading = NAN
         self.want_takeoff = False
 
+    def carry_heading(self, previous: AutoCore) -> None:
+        """Continue the previous auto mode's heading setpoint and rate (see Task.continue_heading)."""
+        self.heading.reset(previous.heading.heading_rad, previous.heading.rate_rad_s)
+        self._yaw_sp_prev = previous._yaw_sp_prev
+
     def step(self, nav: NavInput, dt_s: float, wp: Waypoint) -> TrajectorySetpoint:
         kind = wp.kind
         if kind is SetpointType.IDLE:
@@ -137,10 +143,13 @@ class AutoCore:
         target, ff = wp.target_ned_m, NO_FEEDFORWARD
         if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
+        # MPC_YAW_MODE 4, yaw first: no motion while the heading is not aligned (FlightTaskAuto::_generateSetpoints
+        # force_zero_velocity_setpoint)
+        wait = self.s.yaw_mode == YAW_FIRST and not self.yaw_sp_aligned
         if wp.next_ned_m is not None and kind is SetpointType.POSITION:
-            vz = self._unsmoothed_vz = self._path_step(nav, wp, dt_s)
+            vz = self._unsmoothed_vz = self._path_step(nav, wp, dt_s, wait)
         else:
-            vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s)[2]
+            vz = self._unsmoothed_vz = self.smoother.update(nav.pos_ned_m, target, ff, dt_s, wait)[2]
         self.want_takeoff = vz < WANT_TAKEOFF_VZ_M_S
         yaw, yawspeed = self._smooth_yaw(self._yaw_target(nav, wp), dt_s)
         self._kind_prev = kind
@@ -150,7 +159,7 @@ class AutoCore:
             out = self._hold_before_ramp(nav, out)
         return out
 
-    def _path_step(self, nav: NavInput, wp: Waypoint, dt_s: float) -> float:
+    def _path_step(self, nav: NavInput, wp: Waypoint, dt_s: float, wait: bool) -> float:
         """A mission leg: previous -> target -> next (FlightTaskAuto passes the triplet to PositionSmoothing)."""
         sm, target = self.smoother, wp.target_ned_m
         sm.acceptance_xy_m = self._acceptance(wp)
@@ -158,7 +167,7 @@ class AutoCore:
         sm.traj_gain = self.s.xy_traj_p
         previous = wp.previous_ned_m if wp.previous_ned_m is not None else target
         following = wp.next_ned_m if wp.next_ned_m is not None else target
-        return sm.update_path(nav.pos_ned_m, previous, target, following, dt_s)[2]
+        return sm.update_path(nav.pos_ned_m, previous, target, following, dt_s, wait)[2]
 
     def _acceptance(self, wp: Waypoint) -> float:
         return wp.acceptance_m if isfinite(wp.acceptance_m) else self.s.nav_acc_rad
@@ -266,6 +275,12 @@ class Task:
 
     def _waypoint(self, nav: NavInput) -> Waypoint:
         raise NotImplementedError
+
+    def continue_heading(self, previous: Task) -> None:
+        """FlightModeManager::switchTask does not activate FlightTaskAuto again when one auto mode follows another
+        (the same task), so the heading setpoint and its rate carry on instead of restarting at the vehicle's
+        heading with no rate."""
+        self._core.carry_heading(previous._core)
 
     @property
     def setpoint_type(self) -> SetpointType:

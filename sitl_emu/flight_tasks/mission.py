@@ -37,18 +37,24 @@ class MissionFlight:
         self._plan_id: int | None = None
         self._items_ref: object = None
         self._changes_seen = store.current_changes
+        self._resets_seen = store.jump_resets
 
     def sync(self, ref: GeoRef, home_alt_amsl_m: float, nav: NavInput | None, settings: MissionSettings) -> None:
-        """Follow the store: a changed plan is loaded (relative altitudes above home), a new current item is set."""
+        """Follow the store: a changed plan is loaded (relative altitudes above home), a new current item is set,
+        the DO_JUMP counters start over."""
         plan = self.store.plan(PLAN_MISSION)
         if plan.items is not self._items_ref:
             self._items_ref = plan.items
             self.navigator.load(nav_items(plan.items, ref, home_alt_amsl_m), self.store.current_seq, nav, settings)
             self._changes_seen = self.store.current_changes
             self._publish()
-        elif self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)
+        if self.store.current_changes != self._changes_seen:  # MISSION_SET_CURRENT or MISSION_START(n)
             self._changes_seen = self.store.current_changes
             self.navigator.set_current(self.store.current_seq, nav, settings)
+            self._publish()
+        if self.store.jump_resets != self._resets_seen:  # DO_SET_MISSION_CURRENT with param2 = 1
+            self._resets_seen = self.store.jump_resets
+            self.navigator.reset_jump_counters()
             self._publish()
 
     def _publish(self) -> None:
@@ -82,6 +88,14 @@ class MissionTask(Task):
         nav = self._flight.navigator
         wants, nav.wants_rtl = nav.wants_rtl, False
         return wants
+
+    def end_loiter_point(self) -> Vec3 | None:
+        """Where a finished mission loiters (its last setpoint, SETPOINT_TYPE_LOITER), else None: the Hold the
+        commander switches to then keeps it (loiter.cpp set_loiter_position with can_loiter_at_sp)."""
+        cur = self._flight.navigator.current
+        if not self._flight.navigator.result.finished or cur is None or not cur.loiter:
+            return None
+        return cur.target_ned_m if _finite(cur.target_ned_m) else None
 
     def loiter_point(self, nav: NavInput) -> Vec3 | None:
         """The loiter setpoint the vehicle is established on (within NAV_ACC_RAD + NAV_LOITER_RAD), else None."""

@@ -5,7 +5,8 @@ takeoff/reposition) and flight_mode_manager; here it is one small object. Rules:
 - a new task starts when the mode in force changes, at arming, and when a command brings new navigator parameters;
   no task runs while disarmed (navigator_main.cpp);
 - Takeoff -> Hold after the takeoff finished holds at the takeoff target (navigator converts the takeoff item into a
-  loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136);
+  loiter there, Commander.cpp ~l.2208, loiter.cpp ~l.54-136); so does Hold after a finished mission at the
+  mission's last setpoint (Commander::checkForMissionUpdate, can_loiter_at_sp);
 - OFFBOARD uses the latest offboard setpoint (trajectory for position/velocity/acceleration, else attitude/rates);
 - POSCTL and ALTCTL run the manual flight tasks (flight_tasks/manual.py) on the latest sticks; STABILIZED and
   MANUAL turn the sticks into an attitude and thrust every tick (flight_tasks/stabilized.py); termination has no
@@ -45,6 +46,10 @@ _TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.A
                          NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
                          NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
 _STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
+# the modes flight_mode_manager flies with FlightTaskAuto (FlightModeManager::start_flight_task): one after another
+# the task runs on, so the heading setpoint carries over
+_FLIGHT_TASK_AUTO = frozenset({NavState.AUTO_TAKEOFF, NavState.AUTO_LOITER, NavState.AUTO_MISSION, NavState.AUTO_RTL,
+                               NavState.AUTO_LAND})
 FlightTask = auto.Task | ManualAltitudeTask | orbit.FailedOrbitHold | FollowTargetTask
 
 
@@ -208,10 +213,20 @@ class ModeExecutor:
         return None if last.kind is NavCommandKind.TAKEOFF else last
 
     def _start_task(self, nav_state: NavState, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef) -> None:
-        takeoff_target: Vec3 | None = None  # Hold after a finished takeoff holds at the takeoff target
+        takeoff_target: Vec3 | None = None  # Hold after a finished takeoff or mission holds at its last target
         if self._task_mode is NavState.AUTO_TAKEOFF and self.task is not None and self.task.finished:
             takeoff_target = getattr(self.task, "target_ned_m", None)
+        elif isinstance(self.task, MissionTask):
+            takeoff_target = self.task.end_loiter_point()
+        previous, previous_mode = self.task, self._task_mode
         self._task_mode = nav_state
+        self._make_task(nav_state, nav, command, ref, takeoff_target)
+        if (previous_mode in _FLIGHT_TASK_AUTO and nav_state in _FLIGHT_TASK_AUTO
+                and isinstance(previous, auto.Task) and isinstance(self.task, auto.Task)):
+            self.task.continue_heading(previous)
+
+    def _make_task(self, nav_state: NavState, nav: auto.NavInput, command: NavCommand | None, ref: GeoRef,
+                   takeoff_target: Vec3 | None) -> None:
         if nav_state is NavState.AUTO_TAKEOFF:
             self.task = self._make_takeoff(nav, self._pending_takeoff, ref)
             self._pending_takeoff = None

@@ -1,4 +1,10 @@
-"""One vehicle's logger: a ULog file per flight, from arming to disarming, as PX4's logger with SDLOG_MODE 0.
+"""One vehicle's logger: ULog files as PX4's logger writes them, when SDLOG_MODE says (read when logging starts).
+
+SDLOG_MODE (logger.cpp start_stop_logging, _log_on_start): 0 a file per flight, from arming to disarming; 1 (PX4
+SITL's value) the first file from boot to the first disarming, then one per flight, so the first arming sends no
+"[logger]" text (../shared/reference/px4-mission cases.json: flight1.arm has none, flight2.arm has); 2 one file from
+boot to shutdown; 4 one file from the first arming to shutdown; -1 and 3 (an RC AUX1 switch, which the emulator
+does not have) none.
 
 Source: PX4 src/modules/logger/logger.cpp. On arming it names the file from the UTC time
 (`<log dir>/YYYY-MM-DD/HH_MM_SS.ulg`, get_log_file_name), sends "[logger] <file>" (mavlink_log_info, also an
@@ -35,6 +41,7 @@ from sitl_emu.px4 import Severity
 log = logging.getLogger(__name__)
 
 SYNC_INTERVAL_US = 500_000  # logger.cpp: "Add sync magic" every 500 ms
+WHILE_ARMED, BOOT_UNTIL_DISARM, BOOT_UNTIL_SHUTDOWN, FIRST_ARM_UNTIL_SHUTDOWN = 0, 1, 2, 4  # SDLOG_MODE
 BUFFER_BYTES = 64 * 1024
 Opener = Callable[[Path], IO[bytes]]
 
@@ -86,6 +93,9 @@ class FlightLogger:
         self._next_sync_us = 0
         self._plan: list[tuple[Topic, _Schedule]] = []  # in msg_id order: the topic, when it is next due
         self._inputs: Inputs | None = None  # what the topics read, from the start of a log
+        params = node.vehicle.params
+        self.mode = int(params.get("SDLOG_MODE")) if "SDLOG_MODE" in params else WHILE_ARMED
+        self._ever_armed = False
 
     @property
     def writing(self) -> bool:
@@ -98,7 +108,7 @@ class FlightLogger:
         self._last_us = now_us
         vehicle = self.node.vehicle
         armed = vehicle.commander.armed
-        if not armed:
+        if not self._wanted(armed):
             self._failed = False
             if self._file is not None:
                 self._record()  # the disarmed state and its texts end the log
@@ -109,6 +119,18 @@ class FlightLogger:
             self._start(vehicle.time_us)
         if self._file is not None:
             self._record()
+
+    def _wanted(self, armed: bool) -> bool:
+        """Whether a log is open now, by SDLOG_MODE (module docstring)."""
+        first_flight = not self._ever_armed
+        self._ever_armed = self._ever_armed or armed
+        if self.mode == WHILE_ARMED:
+            return armed
+        if self.mode == BOOT_UNTIL_DISARM:
+            return armed or first_flight
+        if self.mode == BOOT_UNTIL_SHUTDOWN:
+            return True
+        return self.mode == FIRST_ARM_UNTIL_SHUTDOWN and self._ever_armed
 
     def close(self) -> None:
         """End the log being written (disarm, shutdown)."""

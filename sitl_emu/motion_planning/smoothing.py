@@ -274,17 +274,22 @@ class PositionSmoother:
         ay.max_jerk, ay.max_accel, ay.max_vel = jerk, accel_xy, vel_xy
         az.max_jerk, az.max_accel, az.max_vel = jerk, accel_z, vel_z
 
-    def update(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float) -> Vec3:
+    def update(self, vehicle_pos: Vec3, target: Vec3, feedforward_vel: Vec3, dt_s: float,
+               force_zero_velocity: bool = False) -> Vec3:
         """One cycle: target xy (pair) and/or z may be NaN (then the feed-forward velocity drives that axis).
-        The axes hold the new setpoint; returns the unsmoothed velocity target."""
-        vel_sp = self._velocity_target(target, feedforward_vel)
+        The axes hold the new setpoint; returns the unsmoothed velocity target (zero when `force_zero_velocity`:
+        PositionSmoothing::generateSetpoints brakes to a stop)."""
+        vel_sp = (0.0, 0.0, 0.0) if force_zero_velocity else self._velocity_target(target, feedforward_vel)
         if all_finite3(vel_sp):
             self._advance(vehicle_pos, vel_sp, dt_s)
         return vel_sp
 
-    def update_path(self, vehicle_pos: Vec3, previous: Vec3, target: Vec3, following: Vec3, dt_s: float) -> Vec3:
+    def update_path(self, vehicle_pos: Vec3, previous: Vec3, target: Vec3, following: Vec3, dt_s: float,
+                    force_zero_velocity: bool = False) -> Vec3:
         """One cycle along a path (all three waypoints finite; `following` = `target` when there is no next one).
         Returns the unsmoothed velocity target (PositionSmoothing::_generateVelocitySetpoint, 3D case)."""
+        if force_zero_velocity:
+            return self.update(vehicle_pos, target, (0.0, 0.0, 0.0), dt_s, force_zero_velocity=True)
         pos = self.position
         turning = self._is_turning(target)
         crossing = self._l1_point(previous, target) if turning else target

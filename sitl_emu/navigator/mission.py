@@ -111,6 +111,11 @@ class MissionNavigator:
             self._work = Work.DEFAULT
             self._set_items(nav, s)
 
+    def reset_jump_counters(self) -> None:
+        """DO_SET_MISSION_CURRENT param2 = 1: the DO_JUMP repeat counts and the completion flag start over."""
+        self._jumps = {}
+        self.result.finished = False
+
     def set_current(self, seq: int, nav: NavInput | None, s: MissionSettings) -> None:
         """MISSION_SET_CURRENT / MISSION_START(n) (Mission::set_current_mission_index): the same item keeps
         everything; another one becomes current, and while flying the vehicle turns to it at once (the triplet is

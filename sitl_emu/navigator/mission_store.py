@@ -96,6 +96,7 @@ class MissionStore:
     seq_reached: int = -1
     finished: bool = False
     current_changes: int = 0  # MISSION_SET_CURRENT / MISSION_START requests, for the navigator to follow
+    jump_resets: int = 0  # DO_SET_MISSION_CURRENT param2 = 1 requests, for the navigator to follow
     fence_violation: str | None = None  # the navigator's mission-vs-geofence check (vehicle/fence.py), None: passes
 
     def plan(self, plan_type: int) -> Plan:
@@ -119,12 +120,21 @@ class MissionStore:
             self.replace(t, ())
 
     def set_current(self, seq: int) -> bool:
-        """MISSION_SET_CURRENT: only an index inside the stored mission."""
+        """MISSION_SET_CURRENT / MISSION_START: only an index inside the stored mission. A mission pointed at an item
+        is not complete any more (the navigator's set_current clears mission_result.finished): MISSION_CURRENT says
+        so at once, not COMPLETE until the navigator's next cycle."""
         if not 0 <= seq < self.count(PLAN_MISSION):
             return False
         self.current_seq = seq
         self.current_changes += 1
+        self.finished = False
         return True
+
+    def reset_jumps(self) -> None:
+        """DO_SET_MISSION_CURRENT param2 = 1: every DO_JUMP counts from zero again and the mission is not complete
+        (Mission::set_current_mission_index with reset_jump_counters)."""
+        self.jump_resets += 1
+        self.finished = False
 
     def try_lock(self, owner: object) -> bool:
         if self.transfer_owner is not None and self.transfer_owner is not owner:

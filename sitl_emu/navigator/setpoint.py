@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.geo import SIH_HOME
 from sitl_emu.types import NAN, Vec3
 
 NO_FEEDFORWARD: Vec3 = (NAN, NAN, NAN)
@@ -49,12 +50,12 @@ class NavInput:
     landed: bool
     armed: bool
     takeoff_state: TakeoffState = TakeoffState.FLIGHT
-    ref_alt_amsl_m: float = 488.0
+    ref_alt_amsl_m: float = SIH_HOME[2]
     vel_sp_ned_m_s: Vec3 = NO_FEEDFORWARD  # the position controller's last velocity setpoint (NaN: none)
 
     def __init__(self, time_us: int, pos_ned_m: Vec3, vel_ned_m_s: Vec3, yaw_rad: float, home_ned_m: Vec3,
                  home_yaw_rad: float, landed: bool, armed: bool, takeoff_state: TakeoffState = TakeoffState.FLIGHT,
-                 ref_alt_amsl_m: float = 488.0, vel_sp_ned_m_s: Vec3 = NO_FEEDFORWARD) -> None:
+                 ref_alt_amsl_m: float = SIH_HOME[2], vel_sp_ned_m_s: Vec3 = NO_FEEDFORWARD) -> None:
         self.time_us = time_us
         self.pos_ned_m = pos_ned_m
         self.vel_ned_m_s = vel_ned_m_s

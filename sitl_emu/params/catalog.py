@@ -44,9 +44,7 @@ DOMAINS = ("sih", "mpc", "mc", "commander", "navigator", "system", "faults")  # 
 VOLATILE = frozenset({"COM_FLIGHT_UUID", "LND_FLIGHT_T_HI", "LND_FLIGHT_T_LO"})
 
 # Defaults where the emulator deliberately differs from PX4 SITL, and why.
-EMULATOR_DEFAULTS: dict[str, str] = {
-    "SIH_LOC_H0": "488.0 m, the Gazebo/jMAVSim world elevation the project's home uses, not SIH's 489.4 m",
-}
+EMULATOR_DEFAULTS: dict[str, str] = {}
 
 
 @dataclasses.dataclass(frozen=True)

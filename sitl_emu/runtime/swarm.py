@@ -18,13 +18,13 @@ import math
 import time
 from collections.abc import Callable, Sequence
 
-from sitl_emu.geo import GeoRef, ned_to_global
+from sitl_emu.geo import SIH_HOME, GeoRef, ned_to_global
 from sitl_emu.runtime.node import LinkSettings, NodeVehicle, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner
 
 log = logging.getLogger(__name__)
 
-DEFAULT_HOME = (47.397742, 8.545594, 488.0)  # Vehicle's default home (PX4 SIH default, Zurich)
+DEFAULT_HOME = SIH_HOME  # Vehicle's default home (PX4 SIH default, Zurich)
 DEFAULT_SPACING_M = 3.0  # gazebo-classic sitl_multiple_run.sh: instance N spawned at 3*N m
 # Vehicle i of a swarm starts streaming i ticks after the first (wrapping at 1 s), as PX4 instances started one after
 # another are out of phase. In phase, every vehicle's 1 Hz messages would go out in the same tick: with 64 vehicles

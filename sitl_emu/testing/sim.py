@@ -61,8 +61,9 @@ class LockstepClock:
         return self._sim.time_us / 1e6
 
     def sleep(self, seconds: float) -> None:
+        """At least one microsecond for any positive `seconds`: a wait that rounded to 0 us would never end."""
         if seconds > 0:
-            self._sim.advance_to(self._sim.time_us + round(seconds * 1e6))
+            self._sim.advance_to(self._sim.time_us + max(1, round(seconds * 1e6)))
 
 
 class Sim:

@@ -27,7 +27,7 @@ from sitl_emu.control.qmath import euler_from_q, yaw_from_q
 from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
-from sitl_emu.geo import GeoRef, global_to_ned, ned_to_global
+from sitl_emu.geo import SIH_HOME, GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry, default_registry
@@ -65,7 +65,7 @@ class Vehicle:
     dt_us: int = 4000  # 250 Hz, SIH lockstep
 
     def __init__(self, *, params: ParamRegistry | None = None,
-                 home: tuple[float, float, float] = (47.397742, 8.545594, 488.0), seed: int = 0, sysid: int = 1,
+                 home: tuple[float, float, float] = SIH_HOME, seed: int = 0, sysid: int = 1,
                  ready_delay_s: float = 2.0, wind: WindSettings | None = None,
                  estimate_noise: EstimateNoiseSettings | None = None) -> None:
         """Boot disarmed in Hold on the ground at `home` (lat_deg, lon_deg, alt_amsl_m), the local frame's origin.
@@ -98,6 +98,7 @@ class Vehicle:
         self.chain = ControlChain(self.params)
         self._setpoint_type = SetpointType.NONE
         self._task_finished = False
+        self._mission_finished = False  # the mission result's `finished` the commander last saw
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
         self._missions = MissionStore()  # in memory only: a reboot empties it (navigator/mission_store.py)
@@ -148,8 +149,12 @@ class Vehicle:
         if out.messages:  # the task said something this tick
             for severity, text in out.messages:
                 self._emit(severity, "navigator", text, True, True)
-        if c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL:
-            # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
+        wants_rtl = c.nav_state is NavState.AUTO_MISSION and chain.executor.take_mode_request() is NavState.AUTO_RTL
+        finished = self._missions.finished
+        if finished and not self._mission_finished:
+            c.on_mission_finished()
+        self._mission_finished = finished
+        if wants_rtl:  # the mission's RTL item: navigator issue_command -> the commander handles NAV_RETURN_TO_LAUNCH
             handle_command(c, VehicleCommand(MavCmd.NAV_RETURN_TO_LAUNCH, from_external=False), now)
 
     def run_until(self, time_us: int) -> None:

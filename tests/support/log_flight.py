@@ -43,9 +43,10 @@ class Flight:
     log_dir: Path
 
 
-def fly_takeoff_land(log_dir: Path, seed: int = 0, change_param: bool = True) -> Flight:
-    """Arm, take off to TAKEOFF_ALT_M, hold, (set MPC_XY_VEL_MAX in flight), land, auto-disarm; the Sim stays open."""
-    sim = Sim(log_dir=log_dir, seed=seed, params={"MIS_TAKEOFF_ALT": TAKEOFF_ALT_M})
+def fly_takeoff_land(log_dir: Path, seed: int = 0, change_param: bool = True, sdlog_mode: int = 0) -> Flight:
+    """Arm, take off to TAKEOFF_ALT_M, hold, (set MPC_XY_VEL_MAX in flight), land, auto-disarm; the Sim stays open.
+    SDLOG_MODE 0 (a log from arming to disarming) unless `sdlog_mode` says otherwise (PX4 SITL's is 1)."""
+    sim = Sim(log_dir=log_dir, seed=seed, params={"MIS_TAKEOFF_ALT": TAKEOFF_ALT_M, "SDLOG_MODE": sdlog_mode})
     c = RecordingClient(sim.ports(0).gcs, sim.clock)
     c.wait(lambda: c.healthy, 30.0, "health all good")
     assert c.command(MavCmd.COMPONENT_ARM_DISARM, 1) == MavResult.ACCEPTED

@@ -32,13 +32,13 @@ class ServedPorts(NamedTuple):
 
 
 @contextmanager
-def serve(workdir: Path, log_path: Path, speed: float) -> Iterator[ServedPorts]:
-    """`sitl-emu serve --speed SPEED` on free ports, run in `workdir` (its parameters file and FTP root go there);
-    yields the UDP ports its two links send to. The log's tail is printed at the end."""
+def serve(workdir: Path, log_path: Path, speed: float, *extra: str) -> Iterator[ServedPorts]:
+    """`sitl-emu serve --speed SPEED` (and `extra` options) on free ports, run in `workdir` (its parameters file and
+    FTP root go there); yields the UDP ports its two links send to. The log's tail is printed at the end."""
     client_port, api_port, gcs_port, gcs_remote = free_udp_ports(4)
     args = [sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(speed),
             "--port", str(api_port), "--remote", f"127.0.0.1:{client_port}",
-            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"]
+            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}", *extra]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO_ROOT), os.environ.get("PYTHONPATH", "")])}
     with log_path.open("w") as log_file:
         proc = subprocess.Popen(args, cwd=workdir, env=env, stdout=log_file, stderr=subprocess.STDOUT,

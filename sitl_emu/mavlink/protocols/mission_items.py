@@ -7,9 +7,9 @@ that frame with MAV_MISSION_UNSUPPORTED. PX4 keeps its own parsed item, not the 
 kept: the altitude reference as the INT or float variant of the global frame, and only the params the command uses
 (e.g. a waypoint's pass radius comes back as 0, its yaw wrapped into [0, 360)).
 
-One check is taken from real PX4 main (../shared/reference/px4-mission/cases.json `bad.rtl_global_frame_zero_xy`)
-rather than from the older source read: a positional item at latitude 0 and longitude 0 is refused with
-MAV_MISSION_INVALID_PARAM5_X (PX4 main answers so for an RTL item in a global frame with x = y = 0).
+Before any of that PX4 main refuses a value in a param the command does not use (mission_params.py): e.g. an RTL
+item in a global frame at x = y = 0 is MAV_MISSION_INVALID_PARAM5_X, a waypoint's pass radius (param3)
+MAV_MISSION_INVALID_PARAM3.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from sitl_emu.mavlink.protocols.mission_params import unused_param_result
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.px4 import MavCmd, MavFrame, NavState
 
@@ -88,10 +89,15 @@ def parse_item(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
     """(MAV_MISSION_RESULT, the item PX4 would keep) for a MISSION_ITEM(_INT); int_mode: it came as MISSION_ITEM_INT."""
     frame, command = msg.frame, msg.command
     int_frames = (MavFrame.GLOBAL_INT, MavFrame.GLOBAL_RELATIVE_ALT_INT)
-    if frame in (MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT) or (int_mode and frame in int_frames):
-        return _parse_global(msg, int_mode)
-    if frame != MavFrame.MISSION:
+    is_global = frame in (MavFrame.GLOBAL, MavFrame.GLOBAL_RELATIVE_ALT) or (int_mode and frame in int_frames)
+    if not is_global and frame != MavFrame.MISSION:
         return MAV_MISSION_UNSUPPORTED_FRAME, None
+    unused = unused_param_result(command, (msg.param1, msg.param2, msg.param3, msg.param4), msg.x, msg.y, msg.z,
+                                 int_mode and is_global)
+    if unused is not None:
+        return unused, None
+    if is_global:
+        return _parse_global(msg, int_mode)
     if command not in _MISSION_FRAME_COMMANDS:
         return MAV_MISSION_UNSUPPORTED, None
     if command in _ROI_COMMANDS and int(msg.param1) not in (MAV_ROI_NONE, MAV_ROI_WPNEXT, MAV_ROI_WPINDEX):
@@ -103,8 +109,6 @@ def parse_item(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
 
 def _parse_global(msg: Any, int_mode: bool) -> tuple[int, MissionItem | None]:
     x, y = (msg.x, msg.y) if int_mode else (_round(msg.x * 1e7), _round(msg.y * 1e7))
-    if x == 0 and y == 0:
-        return MAV_MISSION_INVALID_PARAM5_X, None  # PX4 main (reference), see the module docstring
     kept = _GLOBAL_COMMANDS.get(msg.command)
     if kept is None:
         return MAV_MISSION_UNSUPPORTED, None

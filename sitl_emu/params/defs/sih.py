@@ -1,11 +1,12 @@
 """SIH simulator parameters (PX4 src/modules/simulation/simulator_sih/sih_params.yaml).
 
-Deviation: SIH_LOC_H0 defaults to 488.0 m (the Gazebo/jMAVSim world elevation) instead of SIH's 489.4 m, so the
-project's home is 47.397742, 8.545594, 488.0 m AMSL.
+SIH_LOC_LAT0 / LON0 / H0 default to PX4's starting point, geo.SIH_HOME (47.397742, 8.545594, 489.4 m AMSL), which is
+also the emulator's default home.
 """
 
 from __future__ import annotations
 
+from sitl_emu.geo import SIH_HOME
 from sitl_emu.params.registry import ParamDef, integer, real
 
 PARAMS: list[ParamDef] = [
@@ -25,9 +26,9 @@ PARAMS: list[ParamDef] = [
     real("SIH_T_TAU", 0.05, 0.0, 10.0, "s"),
     real("SIH_WIND_N", 0.0, -100.0, 100.0, "m/s"),
     real("SIH_WIND_E", 0.0, -100.0, 100.0, "m/s"),
-    real("SIH_LOC_LAT0", 47.397742, -90.0, 90.0, "deg"),
-    real("SIH_LOC_LON0", 8.545594, -180.0, 180.0, "deg"),
-    real("SIH_LOC_H0", 488.0, -420.0, 8848.0, "m"),
+    real("SIH_LOC_LAT0", SIH_HOME[0], -90.0, 90.0, "deg"),
+    real("SIH_LOC_LON0", SIH_HOME[1], -180.0, 180.0, "deg"),
+    real("SIH_LOC_H0", SIH_HOME[2], -420.0, 8848.0, "m"),
     real("SIH_LOC_YAW0", 0.0, -3.14159, 3.14159, "rad"),
     integer("SIH_VEHICLE_TYPE", 0, 0, 0),  # 0 multicopter: the only type emulated
 ]

@@ -36,6 +36,9 @@ _SYSTEM = [
     integer("SYS_MC_EST_GROUP", 2, 1, 3, doc="Estimator group (2 = EKF2)"),
     integer("SYS_HAS_MAG", 1, 0, 2),
     integer("SYS_HAS_BARO", 1, 0, 1),
+    # logger_params.yaml: -1 off, 0 armed to disarmed, 1 boot to first disarm (SITL's), 2 boot to shutdown, 3 RC
+    # AUX1, 4 first arming to shutdown (the enum's values as bounds: PX4 states none); read once at start (log/)
+    integer("SDLOG_MODE", 1, -1, 4),
 ]
 
 _BATTERY = [

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from sitl_emu.params import default_registry
-from sitl_emu.px4 import MavCmd, NavState
+from sitl_emu.px4 import MavCmd, MavState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleCommand
 from sitl_emu.vehicle.vehicle import Vehicle
 
@@ -122,3 +122,51 @@ def test_sticks_lost_in_position_mode_hold_first_then_return():
     assert p.v.commander.nav_state is NavState.AUTO_RTL
     assert p.texts()[n:n + 2] == ["Failsafe activated: entering Hold for 5 seconds", "Failsafe activated"]
     assert p.v.commander.intention.user_intended is NavState.POSCTL
+
+
+def _one_sample_then_armed() -> Pilot:
+    """MAVSDK-Python's manual_control example: one MANUAL_CONTROL, then arm (px4-recorded-facts.md section 3)."""
+    p = Pilot()
+    p.sticks = None
+    p.run(2.5)
+    p.v.manual_control_input(CENTRED)
+    p.run(0.2)
+    p.command(MavCmd.COMPONENT_ARM_DISARM, 1)
+    return p
+
+
+def test_a_takeoff_commanded_during_the_stick_loss_hold_is_a_takeover_and_flies():
+    """framework.cpp getSelectedAction: a user-intended mode change while the manual-control loss holds (Hold,
+    Return, Land) is a takeover; the action becomes a warning, the mode runs, and the loss acts again only after the
+    sticks came back and were lost anew."""
+    p = _one_sample_then_armed()
+    p.run(1.0)
+    assert p.v.commander.failsafe and "Failsafe activated: entering Hold for 5 seconds" in p.texts()
+    assert p.v.commander.system_status() is MavState.CRITICAL
+    n = len(p.texts())
+    p.command(MavCmd.NAV_TAKEOFF)
+    p.run(0.2)
+    assert p.v.commander.nav_state is NavState.AUTO_TAKEOFF and not p.v.commander.failsafe
+    assert p.v.commander.system_status() is MavState.ACTIVE
+    p.run(15.0)
+    assert -p.v.snapshot().pos_ned_m[2] > 2.3 and p.v.commander.nav_state is NavState.AUTO_LOITER
+    assert not any(t.startswith("Failsafe") for t in p.texts()[n:])
+    p.sticks = CENTRED  # the sticks come back, then go again: a new loss, a new failsafe
+    p.run(1.0)
+    p.sticks = None
+    p.run(1.0)
+    assert p.v.commander.failsafe and p.texts()[-1] == "Failsafe activated: entering Hold for 5 seconds"
+
+
+def test_the_stick_loss_after_a_takeoff_holds_then_returns():
+    """px4-recorded-facts.md section 3: taken off before the loss is noticed, the vehicle holds, then returns."""
+    p = _one_sample_then_armed()
+    p.command(MavCmd.NAV_TAKEOFF)
+    p.run(1.0)
+    assert p.v.commander.nav_state is NavState.AUTO_LOITER and p.v.commander.failsafe
+    p.run(5.0)
+    assert p.v.commander.nav_state is NavState.AUTO_RTL
+    assert p.texts()[-3:-1] == ["Failsafe activated: entering Hold for 5 seconds", "Failsafe activated"]
+    p.run(15.0)
+    # disarmed into Hold, not back into the take-off (PX4 PR 25735: a take-off is never the mode after disarming)
+    assert not p.v.commander.armed and p.v.commander.nav_state is NavState.AUTO_LOITER

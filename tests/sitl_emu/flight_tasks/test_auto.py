@@ -246,7 +246,8 @@ def rtl_phases(pm: PointMass) -> list[str]:
 def test_rtl_climbs_returns_and_lands_home(params):
     pm = PointMass(pos=(60.0, 30.0, -5.0), yaw=0.0)
     task = make_rtl(pm.nav(), params)
-    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 518 m (30 m above destination)")]
+    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 520 m (31 m above destination)")]
+    # 489.4 + 30 m: as 32-bit floats 519.4f - 489.4f = 30.00003, which PX4's ceilf makes 31
     pm.fly(task, 20.0)
     climb = [(pos, vel) for _t, pos, vel, _k, _sp in pm.history if -pos[2] < 29.0]
     assert all(math.hypot(pos[0] - 60.0, pos[1] - 30.0) < 0.5 for pos, _v in climb)  # straight up first
@@ -268,7 +269,7 @@ def test_rtl_near_home_uses_the_cone_altitude(params):
     pm = PointMass(pos=(5.0, 0.0, -3.0))
     task = make_rtl(pm.nav(), params)
     assert task.return_alt_up_m == pytest.approx(10.0)  # within NAV_ACC_RAD: twice the distance
-    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 498 m (10 m above destination)")]
+    assert task.drain_messages() == [(Severity.INFO, "RTL: start return at 500 m (10 m above destination)")]
 
 
 @pytest.mark.parametrize(("return_alt", "home_alt", "text"), [

@@ -158,3 +158,38 @@ def test_same_seed_same_data(flight, ulog, tmp_path):
         assert a.keys() == b.keys()
         for key in a:
             np.testing.assert_array_equal(a[key], b[key], err_msg=f"{name}.{key}")
+
+
+def _two_flights(log_dir: Path, mode: int) -> tuple[list[Path], list[list[str]]]:
+    """Boot, arm, disarm, arm, disarm on the ground (SDLOG_MODE `mode`): the files and each file's logged texts."""
+    from sitl_emu.px4 import MavCmd
+    from sitl_emu.testing.sim import Sim
+    from sitl_emu.types import VehicleCommand
+
+    nan = float("nan")
+    with Sim(log_dir=log_dir, params={"SDLOG_MODE": mode}) as sim:
+        vehicle = sim.vehicle(0)
+        sim.run_for(3.0)
+        for _ in range(2):
+            vehicle.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0) + (nan,) * 5))
+            sim.run_for(1.0)
+            vehicle.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (0.0, 21196.0) + (nan,) * 5))
+            sim.run_for(1.0)
+        files = list(sim.loggers[0].files)
+        sim.loggers[0].close()
+    return files, [[m.message for m in ULog(str(f)).logged_messages] for f in files]
+
+
+@pytest.mark.parametrize(("mode", "count"), [(-1, 0), (0, 2), (1, 2), (2, 1), (4, 1)])
+def test_sdlog_mode_says_when_logs_begin_and_end(tmp_path, mode, count):
+    """logger.cpp start_stop_logging: 0 a log per flight; 1 (PX4 SITL's) the first from boot to the first disarming,
+    so the first arming logs no "[logger]" text (px4-mission cases.json: flight1.arm none, flight2.arm one); 2 one
+    log from boot to shutdown; 4 one from the first arming on; -1 none."""
+    files, texts = _two_flights(tmp_path, mode)
+    assert len(files) == count
+    if mode == 1:
+        assert texts[0][0].startswith("[logger]") and texts[0][1] == "Armed by external command\t"
+        assert texts[0][-1].startswith("Disarmed by") and texts[1][0] == "Armed by external command\t"
+        assert texts[1][1].startswith("[logger]")
+    if mode in (2, 4):
+        assert sum(t.startswith("Armed by") for t in texts[0]) == 2

@@ -65,6 +65,7 @@ async def _download(mavsdk_asyncio: Any, port: int, out: Path, size: int) -> Non
         assert system is not None, "MAVSDK found no autopilot"
         log_files = LogFilesAsync(system)
         entries = await _call(log_files.get_entries())
-        assert [e.size_bytes for e in entries] == [size]
-        async for _ in log_files.download_log_file(entries[0], str(out)):
+        # the copied log, and serve's own log running since its boot (SDLOG_MODE 1, as PX4 SITL lists its own)
+        (entry,) = [e for e in entries if e.size_bytes == size]
+        async for _ in log_files.download_log_file(entry, str(out)):
             pass

@@ -219,7 +219,7 @@ def test_rtl_lands_at_the_closest_rally_point(sim):
     gcs.wait(lambda: not gcs.armed, 60.0, "landed")
     assert gcs.seen.pos_ned_m is not None and abs(gcs.seen.pos_ned_m[1] - 40.0) < 1.0
     # the destination's altitude is home's (a rally point 0 m above home); STATUSTEXT chunks at 50 characters
-    assert "RTL: start return at 518 m (30 m above destination" in gcs.texts_after(n0)
+    assert "RTL: start return at 520 m (31 m above destination" in gcs.texts_after(n0)  # 519.4f - 489.4f: 30.00003
 
 
 @pytest.mark.parametrize(("count", "answer"), [(2, 1), (4, 0)])
@@ -237,16 +237,25 @@ def test_bad_polygons(sim, count, answer):
         assert sim.vehicle().commander.geofence.triggered is False
 
 
-def test_nan_vertex_is_refused(sim):
-    """A legacy MISSION_ITEM with NaN coordinates: PX4 main refuses a positional item at 0/0 (INVALID_PARAM5_X)."""
+@pytest.mark.parametrize("with_circle", [True, False])
+def test_a_placeholder_circle_at_0_0_is_stored_and_the_fence_refused(sim, with_circle):
+    """../shared/reference/px4-recorded-facts.md section 4 (what MAVSDK-Python's geofence example uploads): four
+    polygon vertices +-0.0001 deg around home and a circle at x = y = 0 with radius 0. PX4 accepts all five items
+    (a fence circle uses x and y, so 0, 0 is a position, not the unused-param check of an RTL item) and then says,
+    once, that the fence does not contain home; without the circle the fence is valid."""
     gcs = Gcs(sim)
     gcs.wait(lambda: gcs.healthy, 10.0, "healthy")
-    gcs.mission.clear()
-    gcs.send(gcs.mav.mission_count_encode(1, 1, 3, FENCE))
-    gcs.wait(lambda: bool(gcs.mission), 2.0, "the first request")
-    gcs.send(gcs.mav.mission_item_encode(1, 1, 0, 3, POLY_IN, 0, 1, 3, 0, 0, 0, NAN, NAN, 0.0, FENCE))
-    gcs.wait(lambda: gcs.mission[-1].get_type() == "MISSION_ACK", 2.0, "the ACK")
-    assert gcs.mission[-1].type == 10  # MAV_MISSION_INVALID_PARAM5_X
+    lat, lon = round(_ref(sim).lat_deg * 1e7), round(_ref(sim).lon_deg * 1e7)
+    corners = [(lat + 1000, lon + 1000), (lat + 1000, lon - 1000), (lat - 1000, lon - 1000), (lat - 1000, lon + 1000)]
+    items = [gcs.mav.mission_item_int_encode(1, 1, i, 6, POLY_IN, 0, 1, 4, 0, 0, 0, x, y, 0.0, FENCE)
+             for i, (x, y) in enumerate(corners)]
+    if with_circle:
+        items.append(gcs.mav.mission_item_int_encode(1, 1, 4, 6, CIRCLE_IN, 0, 1, 0, 0, 0, 0, 0, 0, 0.0, FENCE))
+    n0 = len(gcs.seen.texts)
+    assert gcs.upload(items, FENCE) == 0  # MAV_MISSION_ACCEPTED
+    gcs.spin(1.0)
+    invalid = ["Geofence invalid, doesn't contain Home position"] if with_circle else []
+    assert gcs.texts_after(n0) == invalid
 
 
 def test_reposition_outside_the_fence_is_refused(sim):

@@ -29,6 +29,7 @@ CASES: dict[str, Any] = json.loads((REF / "cases.json").read_text())
 METRICS: dict[str, Any] = json.loads((REF / "metrics.json").read_text())["flight1"]
 WAYPOINTS = ((12.0, 0.0), (-6.0, 12.0), (-5.0, -7.0))
 MISSION_MODE = 67371008  # custom_mode of AUTO.MISSION
+LOITER_MODE, RTL_MODE = 50593792, 84148224  # AUTO.LOITER, AUTO.RTL
 
 
 @dataclass
@@ -152,6 +153,16 @@ def test_sequence_and_texts(name: str, request: pytest.FixtureRequest) -> None:
     texts = [t for _, t in flight.texts]
     alternatives = [ref["statustext"]] + [alt["statustext"] for alt in ref.get("_alt", [])]
     assert texts in alternatives, texts
+
+
+@pytest.mark.parametrize("name", ["flight1", "flight2"])
+def test_modes_end_in_hold_disarmed(name: str, request: pytest.FixtureRequest) -> None:
+    """PX4 main's commander makes Hold the user's mode when the mission finishes in the air
+    (Commander::checkForMissionUpdate), so the RTL item's return disarms into AUTO.LOITER, not AUTO.MISSION."""
+    flight: Flight = request.getfixturevalue(name)
+    names = {MISSION_MODE: "AUTO.MISSION", LOITER_MODE: "AUTO.LOITER", RTL_MODE: "AUTO.RTL"}
+    seen = [[names.get(mode, str(mode)), int(armed)] for mode, armed, _t in flight.modes]
+    assert seen == CASES[f"{name}.sequence"]["modes"][1:]  # the first, Hold armed, is before the start
 
 
 def test_flight1_times_against_the_reference(flight1: Flight) -> None:

@@ -214,7 +214,7 @@ def test_roi_location_turns_the_vehicle_towards_it_until_roi_none() -> None:
 
 
 def test_amsl_altitude_frame() -> None:
-    f = Flight([TAKEOFF_ITEM, wp(10, 0, 488.0 + 9.0, frame=AMSL)])
+    f = Flight([TAKEOFF_ITEM, wp(10, 0, 489.4 + 9.0, frame=AMSL)])
     f.start()
     f.run_until(lambda: f.store.finished)
     f.v.run_for(5.0)
@@ -233,3 +233,76 @@ def test_auto_mission_needs_a_mission() -> None:
     f.run_until(lambda: True)
     assert f.texts[-3:] == ["Mission start denied! No valid mission", "Preflight Fail: No valid mission available",
                             "Arming denied: Resolve system health failures first"]
+
+
+def _state(f: Flight) -> int:
+    """MISSION_CURRENT.mission_state now (mission_items.mission_current_fields)."""
+    return f.store.mission_state(f.v.snapshot().nav_state is NavState.AUTO_MISSION)
+
+
+def test_a_finished_mission_started_again_is_active_from_its_first_report() -> None:
+    """MISSION_CURRENT.mission_state: ACTIVE while a mission runs, COMPLETE only after its last item (px4-mission
+    cases.json flight1.sequence: 3, 3, 3, 3, 5); a finished mission started again is not reported COMPLETE."""
+    f = Flight([TAKEOFF_ITEM, wp(10, 0), do(MavCmd.NAV_RETURN_TO_LAUNCH)])
+    f.start()
+    assert _state(f) == MISSION_STATE_ACTIVE
+    f.run_until(lambda: f.store.finished)
+    assert _state(f) == MISSION_STATE_COMPLETE
+    f.run_until(lambda: not f.v.snapshot().armed, 90.0)
+    f.v.run_for(1.0)
+    assert f.command(MavCmd.COMPONENT_ARM_DISARM, 1, 0) == MavResult.ACCEPTED
+    assert f.command(MavCmd.MISSION_START, 0, 0) == MavResult.ACCEPTED
+    for _ in range(50):
+        assert _state(f) == MISSION_STATE_ACTIVE
+        f.v.step()
+
+
+@pytest.mark.parametrize(("reset", "currents"), [(0, [1, 2, 4]), (1, [1, 2, 1, 2, 4])])
+def test_set_mission_current_param2_resets_the_jump_counters(reset: int, currents: list[int]) -> None:
+    """navigator_main.cpp DO_SET_MISSION_CURRENT: param2 1 resets every DO_JUMP's repeat count
+    (Mission::set_current_mission_index), so a jump already used repeats again; 0 keeps the counts."""
+    f = Flight([TAKEOFF_ITEM, wp(6, 0), wp(6, 6), do(DO_JUMP, 1, 1), wp(0, 6), wp(0, 12)])
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 4, 120.0)
+    assert f.currents == [0, 1, 2, 1, 2, 4]
+    f.currents.clear()
+    assert f.command(MavCmd.DO_SET_MISSION_CURRENT, 1, reset) == MavResult.ACCEPTED
+    f.run_until(lambda: f.store.current_seq == 5, 120.0)
+    flown = [seq for seq in f.currents if seq != 5]
+    assert (flown[1:] if flown[0] == 4 else flown) == currents  # from the item set, until item 5 is current
+
+
+def test_the_heading_setpoint_and_its_rate_carry_over_into_hold() -> None:
+    """FlightModeManager::switchTask keeps FlightTaskAuto running when Hold follows Mission (the same task): the
+    heading setpoint turns on at the rate it had and slows down from there, rather than restarting at rest."""
+    f = Flight([TAKEOFF_ITEM, wp(20, 0), wp(20, -20), wp(0, -20)])
+    f.start()
+
+    def yawspeed() -> float:
+        sp = f.v.snapshot().local_setpoint
+        return sp.yawspeed_rad_s if sp is not None else 0.0
+
+    f.run_until(lambda: f.store.current_seq == 2 and abs(yawspeed()) > 0.3, 60.0)
+    before = yawspeed()
+    assert f.command(MavCmd.DO_SET_MODE, 1, 4, 3) == MavResult.ACCEPTED  # AUTO.LOITER
+    f.v.step()
+    f.v.step()
+    assert f.v.snapshot().nav_state is NavState.AUTO_LOITER
+    assert abs(yawspeed() - before) < 0.1
+
+
+@pytest.mark.parametrize("yaw_mode", [0, 4])
+def test_yaw_mode_4_turns_to_the_waypoint_before_it_moves(yaw_mode: int) -> None:
+    """MPC_YAW_MODE 4 (towards the waypoint, yaw first): FlightTaskAuto forces a zero velocity setpoint while the
+    heading setpoint is not aligned (within MIS_YAW_ERR, not turning at the rate limit); 0 turns while it flies."""
+    f = Flight([TAKEOFF_ITEM, wp(0, 30), wp(0, 0)])
+    f.v.params.set("MPC_YAW_MODE", yaw_mode)
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 1, 60.0)
+    moved_while_turning = 0.0
+    while f.v.snapshot().euler_rad[2] < math.radians(60.0):  # turning from north to east
+        f.v.step()
+        moved_while_turning = max(moved_while_turning, abs(f.v.snapshot().pos_ned_m[1]))
+        assert f.v.time_us < 60e6
+    assert (moved_while_turning < 0.2) if yaw_mode == 4 else (moved_while_turning > 0.5)
+    f.run_until(lambda: f.store.seq_reached == 1, 60.0)  # and it does get there

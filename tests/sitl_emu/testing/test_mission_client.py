@@ -41,7 +41,9 @@ def test_upload_start_and_wait_for_each_item() -> None:
         # item 2 and the RTL item complete in one navigator cycle: only the latest is reported (as PX4 does)
         assert client.seen.reached == [0, 1, 3] and client.seen.mission_current.mission_state == 5  # COMPLETE
         client.wait(lambda: not client.armed, 90.0, "return, landing and disarm")
-        assert client.seen.modes[-2:] == ["AUTO.RTL", "AUTO.MISSION"]  # after disarming: the user's mode again
+        # after disarming: Hold, which the commander made the user's mode when the mission finished (as recorded
+        # from PX4, px4-mission cases.json flight1.sequence)
+        assert client.seen.modes[-2:] == ["AUTO.RTL", "AUTO.LOITER"]
         client.close()
 
 

@@ -7,6 +7,8 @@ from collections.abc import Callable
 
 import pytest
 
+from sitl_emu.geo import SIH_HOME
+from sitl_emu.params.catalog import px4_catalog
 from sitl_emu.px4 import LandedState, MavCmd, MavResult, MavState, NavState, Severity, custom_mode, decode_custom_mode
 from sitl_emu.types import NAN3, OffboardControlMode, TrajectorySetpoint, VehicleCommand, VehicleSnapshot
 from sitl_emu.vehicle.vehicle import Vehicle
@@ -263,14 +265,28 @@ def test_snapshot_local_setpoint_and_geo() -> None:
     f.takeoff()
     s = f.snap
     assert s.local_setpoint is not None and s.local_setpoint.position_ned_m != NAN3
-    assert s.alt_amsl_m == pytest.approx(488.0 - s.pos_ned_m[2])
-    assert s.home is not None and s.home.alt_amsl_m == pytest.approx(488.0, abs=0.01)
+    assert s.alt_amsl_m == pytest.approx(489.4 - s.pos_ned_m[2])
+    assert s.home is not None and s.home.alt_amsl_m == pytest.approx(489.4, abs=0.01)
+
+
+def test_the_vehicle_starts_where_px4s_sih_does() -> None:
+    """SIH_LOC_LAT0 / LON0 / H0 as PX4 reports them (params/px4_params.csv, from ../shared/reference/
+    px4-params.json: H0 489.4 m) are the default home, so every AMSL altitude and RTL text matches PX4's."""
+    recorded = px4_catalog().px4_defaults
+    f = Flight()
+    f.run(2.5)
+    home = f.snap.home
+    assert home is not None
+    assert (home.lat_deg, home.lon_deg) == pytest.approx((recorded["SIH_LOC_LAT0"], recorded["SIH_LOC_LON0"]),
+                                                         abs=1e-6)
+    assert home.alt_amsl_m == pytest.approx(recorded["SIH_LOC_H0"], abs=0.01) == pytest.approx(489.4, abs=0.01)
+    assert tuple(f.v.params.get(f"SIH_LOC_{k}") for k in ("LAT0", "LON0", "H0")) == SIH_HOME
 
 
 def test_takeoff_command_before_arming_keeps_its_altitude() -> None:
     f = Flight()
     f.run(2.5)
-    assert f.cmd(MavCmd.NAV_TAKEOFF, NAN, NAN, NAN, NAN, NAN, NAN, 488.0 + 4.0) == MavResult.ACCEPTED  # param7 AMSL
+    assert f.cmd(MavCmd.NAV_TAKEOFF, NAN, NAN, NAN, NAN, NAN, NAN, 489.4 + 4.0) == MavResult.ACCEPTED  # param7 AMSL
     f.run(1.0)
     assert f.snap.nav_state == NavState.AUTO_TAKEOFF and not f.snap.armed
     assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.ACCEPTED  # as pxh> commander takeoff: takeoff, then arm
@@ -318,7 +334,7 @@ def test_reposition_without_yaw_faces_the_target() -> None:
 def test_change_altitude_in_hold() -> None:
     f = Flight()
     f.takeoff()
-    assert f.cmd(MavCmd.DO_CHANGE_ALTITUDE, 488.0 + 6.0, 0.0) == MavResult.ACCEPTED  # MAV_FRAME_GLOBAL: AMSL
+    assert f.cmd(MavCmd.DO_CHANGE_ALTITUDE, 489.4 + 6.0, 0.0) == MavResult.ACCEPTED  # MAV_FRAME_GLOBAL: AMSL
     f.run(10.0)
     s = f.snap
     assert _alt(s) == pytest.approx(6.0, abs=0.15) and math.hypot(s.pos_ned_m[0], s.pos_ned_m[1]) < 0.3

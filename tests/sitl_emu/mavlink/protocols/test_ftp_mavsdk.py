@@ -30,7 +30,8 @@ def served(tmp_path: Path):
     (root / "hello.txt").write_bytes(b"hello from the emulator\n")
     (root / "big.bin").write_bytes(os.urandom(80_000))
     (tmp_path / "outside.txt").write_bytes(b"secret")
-    with serve(work, tmp_path / "serve.log", SPEED) as ports:
+    # SDLOG_MODE 0: no log before arming (PX4 SITL's 1 would start one at boot, and LogFiles would list it)
+    with serve(work, tmp_path / "serve.log", SPEED, "--param", "SDLOG_MODE=0") as ports:
         yield ports.api_remote, root
 
 

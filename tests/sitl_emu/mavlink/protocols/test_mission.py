@@ -26,6 +26,9 @@ from sitl_emu.px4 import NavState, Severity
 
 LAT, LON = 473977420, 85455940
 WAYPOINT, TAKEOFF, RTL, FENCE_POLY_IN, FENCE_CIRCLE_IN, RALLY = 16, 22, 20, 5001, 5003, 5100
+MAV_MISSION_INVALID_PARAM2, MAV_MISSION_INVALID_PARAM3, MAV_MISSION_INVALID_PARAM4 = 7, 8, 9  # common.xml
+MAV_MISSION_INVALID_PARAM7 = 12
+INT32_MAX = 2**31 - 1  # MISSION_ITEM_INT's "no value" in x, y
 
 
 @pytest.fixture()
@@ -34,8 +37,9 @@ def setup() -> tuple[MissionProtocol, MemoryContext, Client]:
 
 
 def item(client: Client, seq: int, command: int = WAYPOINT, frame: int = 6, mission_type: int = 0,
-         x: int = LAT, y: int = LON, params: tuple[float, ...] = (0.0, 0.0, 0.0, math.nan), current: int = 0):
-    return client.msg("MISSION_ITEM_INT", 1, 1, seq, frame, command, current, 1, *params, x, y, 5.0, mission_type)
+         x: int = LAT, y: int = LON, params: tuple[float, ...] = (0.0, 0.0, 0.0, math.nan), current: int = 0,
+         z: float = 5.0):
+    return client.msg("MISSION_ITEM_INT", 1, 1, seq, frame, command, current, 1, *params, x, y, z, mission_type)
 
 
 def upload(proto: MissionProtocol, ctx: MemoryContext, client: Client, items: list, mission_type: int = 0) -> int:
@@ -78,7 +82,7 @@ def test_download_of_an_empty_plan_is_a_count_of_zero(setup, mission_type):
 def test_mission_upload_is_stored_and_downloaded_with_the_current_item(setup):
     proto, ctx, client = setup
     items = [item(client, 0, TAKEOFF), item(client, 1, x=LAT + 1000), item(client, 2, x=LAT + 2000),
-             item(client, 3, RTL, frame=2, x=0, y=0, params=(0, 0, 0, 0))]
+             item(client, 3, RTL, frame=2, x=0, y=0, params=(0, 0, 0, 0), z=0.0)]
     assert upload(proto, ctx, client, items) == MAV_MISSION_ACCEPTED
     got = download(proto, ctx, client)
     assert [(m.seq, m.command, m.frame, m.x, m.current) for m in got] == [
@@ -106,17 +110,22 @@ def test_legacy_float_upload_and_download(setup):
 
 def test_download_keeps_only_the_params_px4_keeps(setup):
     proto, ctx, client = setup
-    assert upload(proto, ctx, client, [item(client, 0, params=(2.0, 3.0, 9.0, -90.0))]) == MAV_MISSION_ACCEPTED
+    assert upload(proto, ctx, client, [item(client, 0, params=(2.0, 3.0, math.nan, -90.0))]) == MAV_MISSION_ACCEPTED
     (got,) = download(proto, ctx, client)
     assert (got.param1, got.param2, got.param3, got.param4) == (2.0, 3.0, 0.0, pytest.approx(270.0))
 
 
 @pytest.mark.parametrize(("kwargs", "result"), [
     ({"command": 31010}, MAV_MISSION_UNSUPPORTED),
-    ({"command": RTL}, MAV_MISSION_UNSUPPORTED),  # RTL in a global frame with a position
+    ({"command": RTL, "params": (0, 0, 0, 0), "x": INT32_MAX, "y": INT32_MAX, "z": 0.0}, MAV_MISSION_UNSUPPORTED),
+    ({"command": RTL, "params": (0, 0, 0, 0), "z": 0.0}, MAV_MISSION_INVALID_PARAM5_X),  # RTL has no position
+    ({"params": (0, 0, 2.0, math.nan)}, MAV_MISSION_INVALID_PARAM3),  # PX4 flies no pass radius
+    ({"command": TAKEOFF, "params": (-1.0, 3.0, 0, 0)}, MAV_MISSION_INVALID_PARAM2),  # param1 -1: QGC's pitch
+    ({"frame": 2, "command": RTL, "params": (0, 0, 0, 0), "x": 0, "y": 0}, MAV_MISSION_INVALID_PARAM7),
+    ({"frame": 2, "command": 178, "params": (1, 5, -1, 7.0), "z": 0.0}, MAV_MISSION_INVALID_PARAM4),  # speed
     ({"frame": 10}, MAV_MISSION_UNSUPPORTED_FRAME),  # terrain frame
     ({"frame": 1}, MAV_MISSION_UNSUPPORTED_FRAME),  # local NED
-    ({"command": RTL, "x": 0, "y": 0}, MAV_MISSION_INVALID_PARAM5_X),
+    ({"command": RTL, "x": 0, "y": 0, "params": (0, 0, 0, 0), "z": 0.0}, MAV_MISSION_INVALID_PARAM5_X),
     ({"frame": 2, "command": 31010}, MAV_MISSION_UNSUPPORTED),
 ])
 def test_invalid_item_ends_the_upload_and_keeps_the_stored_plan(setup, kwargs, result):
@@ -126,6 +135,25 @@ def test_invalid_item_ends_the_upload_and_keeps_the_stored_plan(setup, kwargs, r
     assert texts(ctx) == ["IGN MISSION_ITEM: Invalid item"]
     assert ctx.vehicle.events[0].severity == Severity.CRITICAL and ctx.vehicle.events[0].is_event
     assert [m.command for m in download(proto, ctx, client)] == [WAYPOINT]  # never half-written
+
+
+@pytest.mark.parametrize(("x", "result"), [(0, MAV_MISSION_ACCEPTED), (-(2**31), MAV_MISSION_ACCEPTED),
+                                           (INT32_MAX, MAV_MISSION_ACCEPTED), (7, MAV_MISSION_INVALID_PARAM5_X)])
+def test_an_item_without_position_takes_0_or_the_int32_sentinels_in_x(setup, x, result):
+    """mavlink_command_params.hpp: QGroundControl's camera items come in MAV_FRAME_MISSION with x, y INT32_MIN (a
+    NaN as int32; PR 28079 accepts it), its RTL with 0; any other value where the command has no param5 is refused."""
+    proto, ctx, client = setup
+    stop = item(client, 1, 2001, frame=2, x=x, y=x, params=(0, math.nan, math.nan, math.nan), z=math.nan)
+    assert upload(proto, ctx, client, [item(client, 0, TAKEOFF), stop]) == result
+
+
+def test_a_fence_circle_at_0_0_with_radius_0_is_stored(setup):
+    """MAVSDK-Python's geofence example uploads such a placeholder circle; a fence circle uses x and y, so PX4 stores
+    it (px4-recorded-facts.md section 4) where an RTL item at 0, 0 is refused."""
+    proto, ctx, client = setup
+    circle = item(client, 0, FENCE_CIRCLE_IN, mission_type=1, x=0, y=0, params=(0, 0, 0, 0), z=0.0)
+    assert upload(proto, ctx, client, [circle], 1) == MAV_MISSION_ACCEPTED
+    assert [(m.command, m.x, m.y) for m in download(proto, ctx, client, 1)] == [(FENCE_CIRCLE_IN, 0, 0)]
 
 
 def test_too_many_items_is_no_space(setup):
@@ -144,7 +172,8 @@ def test_count_zero_clears_the_plan(setup):
 
 def test_fence_and_rally_plans_are_stored_apart(setup):
     proto, ctx, client = setup
-    fence = [item(client, i, FENCE_POLY_IN, mission_type=1, x=LAT + i * 100, params=(3, 0, 0, 0)) for i in range(3)]
+    fence = [item(client, i, FENCE_POLY_IN, mission_type=1, x=LAT + i * 100, params=(3, 0, 0, 0), z=0.0)
+             for i in range(3)]
     assert upload(proto, ctx, client, fence, 1) == MAV_MISSION_ACCEPTED
     assert upload(proto, ctx, client, [item(client, 0, RALLY, mission_type=2)], 2) == MAV_MISSION_ACCEPTED
     assert [m.command for m in download(proto, ctx, client, 1)] == [FENCE_POLY_IN] * 3
@@ -160,8 +189,8 @@ def test_fence_and_rally_plans_are_stored_apart(setup):
 
 def test_plan_checks_refuse_a_fence_item_in_a_mission_and_a_short_polygon(setup):
     proto, ctx, client = setup
-    assert upload(proto, ctx, client, [item(client, 0, FENCE_CIRCLE_IN)]) == MAV_MISSION_ERROR
-    short = [item(client, 0, FENCE_POLY_IN, mission_type=1, params=(2, 0, 0, 0))]
+    assert upload(proto, ctx, client, [item(client, 0, FENCE_CIRCLE_IN, z=0.0)]) == MAV_MISSION_ERROR
+    short = [item(client, 0, FENCE_POLY_IN, mission_type=1, params=(2, 0, 0, 0), z=0.0)]
     assert upload(proto, ctx, client, short, 1) == MAV_MISSION_ERROR
 
 
