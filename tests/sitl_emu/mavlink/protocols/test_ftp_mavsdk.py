@@ -75,6 +75,8 @@ async def _check_ftp(ftp: Any, root: Path, tmp_path: Path) -> None:
 
     listed = await _call(ftp.list_directory("/"))
     kinds = {e.name: (e.entry_type, e.size_bytes) for e in listed.entries}
+    # the parameter file serve keeps (SDLOG_MODE is set), in the root as in PX4 SITL's
+    assert kinds.pop("parameters.params")[0] == FilesystemEntry.EntryType.FILE
     assert kinds == {"etc": (FilesystemEntry.EntryType.DIRECTORY, 0),  # PX4 SITL's ROMFS extras: the metadata
                      "sub": (FilesystemEntry.EntryType.DIRECTORY, 0),
                      "hello.txt": (FilesystemEntry.EntryType.FILE, 24),
