@@ -52,10 +52,12 @@ def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: st
     the options give, on a pool of processes or Ray; write one row per case and print a summary with the command
     that reruns each failed case alone. Exit status 1 when a case failed. The file format: sitl_emu/campaign/spec.py.
     """
+    from sitl_emu._speedups import build_line
     from sitl_emu.campaign.errors import CampaignError, CampaignInterrupted
     from sitl_emu.campaign.progress import CampaignProgress
     from sitl_emu.campaign.run import run_campaign
 
+    click.echo(f"sitl-emu campaign: {build_line()}", err=True)  # the workers import the same sitl_emu
     progress = None if no_progress else CampaignProgress()
     try:
         ref, cases, limits = _inputs(cases_file, scenario, seeds, assignments, faults, options, sim_limit, wall_limit)

@@ -18,6 +18,7 @@ import click
 from flightview.options import view_options, view_settings
 from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
 from px4common.clock import SPEED_MAX, SPEED_MIN
+from sitl_emu._speedups import build_line
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli.options import (
     MAX_SYSID,
@@ -282,6 +283,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
     signals.stop_with(runner.stop)  # a signal from now on (or one already received) stops the loop, or never starts it
+    click.echo(f"sitl-emu: {build_line()}")
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
     sys.stdout.flush()
