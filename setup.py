@@ -63,7 +63,8 @@ class MypycBuildExt(build_ext):
             os.environ.pop(var, None)  # keep -march=native / -ffast-math out (tools/build_speedups.py)
         self.sources = asked_sources(speedups.DEFAULT_MODULES)
         self.jobs = speedups.build_jobs()
-        self.distribution.ext_modules = speedups.extensions(self.sources, self.jobs, speedups.opt_level())
+        self.distribution.ext_modules = speedups.extensions(self.sources, speedups.group_count(self.jobs),
+                                                            speedups.opt_level())
         super().finalize_options()
         self.parallel = self.parallel or self.jobs
 

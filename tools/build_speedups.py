@@ -1,11 +1,16 @@
-"""`make speedups`: compile the hot modules of the vehicle core in place with mypyc (opt-in, never by default).
+"""`make speedups`: compile the hot modules of sitl_emu in place with mypyc (opt-in, never by default).
 
 usage: .venv/bin/python tools/build_speedups.py [--clean] [MODULE.py ...]
 
-The compiled extension modules are written next to their sources (sitl_emu/.../*.so), plus one shared library
-(sitl_emu/_speedups_native__mypyc*.so) and a manifest (sitl_emu/_speedups_manifest.json) that records the sha256 of
-every source the build read. At import time sitl_emu/_speedups.py compares the manifest with the sources and falls
-back to the pure-Python modules, with one warning, when anything changed since the build.
+The compiled extension modules are written next to their sources (sitl_emu/.../*.so), plus one shared library per
+compilation group (sitl_emu/_speedups_native<N>__mypyc*.so) and a manifest (sitl_emu/_speedups_manifest.json) that
+records the sha256 of every source the build read. At import time sitl_emu/_speedups.py compares the manifest with
+the sources and falls back to the pure-Python modules, with one warning, when anything changed since the build.
+setup.py builds the same modules the same way for `SITL_EMU_COMPILE=1 pip install .` and `python -m build`.
+
+Build time (README, "The compiled build"): the modules are the ones a profile finds the time in (DEFAULT_MODULES),
+mypyc compiles them in separate groups (each its own C file and shared library) that the C compilers build side by
+side (build_ext --parallel), at MYPYC_OPT_LEVEL (default DEFAULT_OPT_LEVEL, the level that pays).
 
 Exactness: the C compiler must evaluate every float expression as written. -ffp-contract=off forbids fusing a*b+c into
 one FMA (which rounds once instead of twice); nothing here passes -march=native or -ffast-math, and CFLAGS from the
@@ -108,6 +113,7 @@ DEFAULT_MODULES = (
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]
 OPT_LEVEL_ENV = "MYPYC_OPT_LEVEL"
 DEFAULT_OPT_LEVEL = "2"  # measured: README, "The compiled build"
+MIN_GROUPS = 4
 
 
 def sha256_of(path: Path) -> str:
@@ -179,6 +185,12 @@ def build_jobs() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1))
 
 
+def group_count(jobs: int) -> int:
+    """Compilation groups: one a compiler, and at least MIN_GROUPS, as gcc's time grows faster than a C file's size
+    (53 modules at -O2, CPU seconds of the whole build: 2 groups 65, 4 groups 53, 8 groups 54, 16 groups 64)."""
+    return max(MIN_GROUPS, jobs)
+
+
 def groups(sources: list[str], count: int) -> list[tuple[list[str], str]]:
     """`sources` split into `count` compilation groups of about equal size (largest file first onto the smallest
     group), each its own C file and shared library (GROUP + index), so that the C compilers can run side by side.
@@ -194,11 +206,12 @@ def groups(sources: list[str], count: int) -> list[tuple[list[str], str]]:
     return [(sorted(files), f"{GROUP}{i}") for i, files in enumerate(members)]
 
 
-def extensions(sources: list[str], jobs: int, level: str) -> list[Any]:
-    """mypyc's C extensions for `sources` (setuptools Extension objects), with the exact-float flags."""
+def extensions(sources: list[str], count: int, level: str) -> list[Any]:
+    """mypyc's C extensions for `sources` in `count` groups (setuptools Extension objects), with the exact-float
+    flags."""
     from mypyc.build import mypycify
 
-    built = mypycify(sources, opt_level=level, debug_level="0", separate=list(groups(sources, jobs)),
+    built = mypycify(sources, opt_level=level, debug_level="0", separate=list(groups(sources, count)),
                      target_dir=str(BUILD_DIR))
     for ext in built:
         ext.extra_compile_args = [*ext.extra_compile_args, *EXACT_FLOAT_FLAGS]
@@ -216,7 +229,7 @@ def compile_in_place(sources: list[str]) -> None:
     jobs = build_jobs()
     setup(
         name="sitl_emu_speedups",
-        ext_modules=extensions(sources, jobs, opt_level()),
+        ext_modules=extensions(sources, group_count(jobs), opt_level()),
         script_args=["-q", "build_ext", "--inplace", "--force", "--parallel", str(jobs),
                      "--build-temp", str(BUILD_DIR / "temp"), "--build-lib", str(BUILD_DIR / "lib")],
     )
@@ -249,7 +262,7 @@ def manifest(sources: list[str], shared_libs: list[str], out: Path = ROOT) -> di
 
 
 def write_manifest(sources: list[str], out: Path = ROOT) -> None:
-    names = [name for _, name in groups(sources, build_jobs())]
+    names = [name for _, name in groups(sources, group_count(build_jobs()))]
     path = out / MANIFEST.relative_to(ROOT)
     path.write_text(json.dumps(manifest(sources, names, out), indent=1, sort_keys=True) + "\n")
 

@@ -40,13 +40,14 @@ def build():
 
 def test_groups_split_the_modules_evenly_once_each_whatever_their_order(build):
     sources = list(build.DEFAULT_MODULES)
-    split = build.groups(sources, 2)
-    assert [name for _, name in split] == [f"{build.GROUP}0", f"{build.GROUP}1"]
+    assert build.group_count(1) == build.group_count(2) == build.MIN_GROUPS and build.group_count(16) == 16
+    split = build.groups(sources, 4)
+    assert [name for _, name in split] == [f"{build.GROUP}{i}" for i in range(4)]
     members = [rel for files, _ in split for rel in files]
     assert sorted(members) == sorted(sources)
     sizes = [sum((REPO_ROOT / rel).stat().st_size for rel in files) for files, _ in split]
     assert max(sizes) < 1.2 * min(sizes)
-    assert build.groups(list(reversed(sources)), 2) == split
+    assert build.groups(list(reversed(sources)), 4) == split
     assert build.groups(sources[:1], 4) == [(sources[:1], f"{build.GROUP}0")]
 
 
