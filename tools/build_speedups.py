@@ -112,7 +112,7 @@ DEFAULT_MODULES = (
 
 EXACT_FLOAT_FLAGS = ["-ffp-contract=off", "-fno-fast-math"]
 OPT_LEVEL_ENV = "MYPYC_OPT_LEVEL"
-DEFAULT_OPT_LEVEL = "2"  # measured: README, "The compiled build"
+DEFAULT_OPT_LEVEL = "1"  # measured: README, "The compiled build"
 MIN_GROUPS = 4
 
 

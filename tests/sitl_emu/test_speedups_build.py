@@ -51,10 +51,11 @@ def test_groups_split_the_modules_evenly_once_each_whatever_their_order(build):
     assert build.groups(sources[:1], 4) == [(sources[:1], f"{build.GROUP}0")]
 
 
-@pytest.mark.parametrize(("value", "level"), [("", "3"), ("0", "0"), ("2", "2"), (" 1 ", "1"), ("fast", "3"),
-                                              ("4", "3")])
+@pytest.mark.parametrize(("value", "level"), [("", None), ("0", "0"), ("3", "3"), (" 2 ", "2"), ("fast", None),
+                                              ("4", None)])
 def test_the_optimisation_level_comes_from_mypyc_opt_level_or_the_measured_default(build, value, level):
-    assert build.opt_level({build.OPT_LEVEL_ENV: value}) == (build.DEFAULT_OPT_LEVEL if level == "3" else level)
+    assert build.opt_level({build.OPT_LEVEL_ENV: value}) == (level or build.DEFAULT_OPT_LEVEL)
+    assert build.opt_level({}) == build.DEFAULT_OPT_LEVEL == "1"
 
 
 def test_every_task_subclass_is_compiled_with_the_task_it_inherits(build):
