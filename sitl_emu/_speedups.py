@@ -154,7 +154,8 @@ def build_line(package_dir: Path = _PACKAGE_DIR, environ: Mapping[str, str] = os
         return ("core: pure Python (`make speedups` in a checkout, or SITL_EMU_COMPILE=1 at pip install, compiles "
                 "it: README, \"The compiled build\")")
     decided = plan(package_dir, environ)
+    count = f"{len(names)} module{'' if len(names) == 1 else 's'}"
     if not decided.sources:
-        return f"core: compiled (mypyc), {len(names)} modules"
+        return f"core: compiled (mypyc), {count}"
     why = f"{PURE_ENV} is set" if decided.warning is None else "the compiled build is stale"
-    return f"core: pure Python ({why}; {len(names)} compiled modules not used)"
+    return f"core: pure Python ({why}; {count} compiled, not used)"

@@ -99,12 +99,12 @@ def _fake_package(tmp_path: Path) -> Path:
 
 def test_the_start_up_line_says_compiled_pure_or_why_not(tmp_path):
     pkg = _fake_package(tmp_path)
-    assert _speedups.build_line(pkg, {}) == "core: compiled (mypyc), 1 modules"
+    assert _speedups.build_line(pkg, {}) == "core: compiled (mypyc), 1 module"
     assert _speedups.build_line(pkg, {_speedups.PURE_ENV: "1"}) == (
-        "core: pure Python (SITL_EMU_PURE is set; 1 compiled modules not used)")
+        "core: pure Python (SITL_EMU_PURE is set; 1 module compiled, not used)")
     (pkg / "mod.py").write_text("X = 2\n")
     assert _speedups.build_line(pkg, {}) == (
-        "core: pure Python (the compiled build is stale; 1 compiled modules not used)")
+        "core: pure Python (the compiled build is stale; 1 module compiled, not used)")
     for built in pkg.glob(f"*{SUFFIX}"):
         built.unlink()
     assert _speedups.build_line(pkg, {}).startswith("core: pure Python (`make speedups` in a checkout, or "
@@ -152,5 +152,5 @@ def test_a_wheel_built_with_sitl_emu_compile_runs_compiled(tmp_path):
                          capture_output=True, text=True, timeout=120, check=True)
     where, line = out.stdout.strip().splitlines()[-2:]
     assert where.endswith(SUFFIX) and where.startswith(str(target))
-    assert line == "core: compiled (mypyc), 1 modules"
+    assert line == "core: compiled (mypyc), 1 module"
     assert "stale" not in out.stderr
