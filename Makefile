@@ -41,6 +41,7 @@ test-compiled: $(STAMP)
 compiled-check:
 	rm -rf $(CHECK_DIR) && mkdir -p $(CHECK_DIR)
 	cp -r sitl_emu joyfly flightview px4common tests tools examples pyproject.toml README.md $(CHECK_DIR)/
+	cp setup.py MANIFEST.in $(CHECK_DIR)/  # the wheel build test (tests/sitl_emu/test_speedups_build.py)
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m compiled
 

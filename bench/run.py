@@ -39,7 +39,8 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # `python bench/run.py`
     sys.path.insert(0, str(REPO))
 
-from bench import campaign, core, params, runner, scale, serve  # noqa: E402
+from bench import campaign, params, runner, scale, serve, sides  # noqa: E402
+from sitl_emu._speedups import PURE_ENV, build_line  # noqa: E402
 from sitl_emu.cli.main import DEFAULT_BATCH_MS, wake_period_s  # noqa: E402
 
 DEFAULT = ("core", "runner", "serve", "startup", "flight", "latency", "scale", "params", "view")
@@ -55,23 +56,18 @@ def machine() -> None:
                   if ln.startswith("model name")), platform.processor() or "?")
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     say(f"machine: {model}, {os.cpu_count()} CPUs, load average {load}, Python {platform.python_version()}")
-    # imported first, so that describe() sees whether the vehicle core runs compiled
-    import sitl_emu.control.cascade
-    import sitl_emu.physics
-    import sitl_emu.vehicle.vehicle  # noqa: F401
-    from sitl_emu._speedups import describe
-
-    say(f"build: {describe()} (make speedups compiles the vehicle core; make clean-speedups goes back)")
+    say(f"build: {build_line()}; pure and compiled figures side by side below come from child processes that "
+        f"alternate between the two builds ({PURE_ENV}=1 turns the compiled one off)")
 
 
 def bench_core(quick: bool) -> None:
     runs = 1 if quick else 3
-    speed, sim_s = max(core.core_speed() for _ in range(runs))
-    say(f"core: {speed:.0f} simulated s per CPU s (one vehicle, {sim_s:.0f} s manoeuvre, no I/O, best of {runs}; "
-        "target >= 1000)")
-    with_io = max(core.core_speed_with_io() for _ in range(runs))
-    say(f"core with I/O: {with_io:.0f} simulated s per CPU s (same manoeuvre, MAVLink I/O after every step, default "
-        f"streams on both links, best of {runs})")
+    pure, compiled = sides.side_by_side("core", runs)
+    say(f"core: {sides.ratio_text(pure, compiled, 'simulated s per CPU s')} (one vehicle, the 36 s manoeuvre of "
+        f"bench/core.py, no I/O, best of {runs}; target >= 1000, compiled >= 3000)")
+    pure, compiled = sides.side_by_side("core_io", runs)
+    say(f"core with I/O: {sides.ratio_text(pure, compiled, 'simulated s per CPU s')} (same manoeuvre, MAVLink I/O "
+        f"after every step, default streams on both links, best of {runs}; compiled target >= 500)")
 
 
 def bench_runner(quick: bool) -> None:
@@ -128,8 +124,10 @@ def bench_flight(quick: bool) -> None:
     if not reference.ok:
         say(f"loopback flight: the lockstep reference flight failed: {reference.error}")
         return
+    pure, compiled = sides.side_by_side("flight", 1)
     say(f"loopback flight in-process lockstep: {wall:.2f} s wall for {reference.sim_duration_s:.1f} s simulated "
-        f"({reference.sim_duration_s / wall:.0f}x)")
+        f"({reference.sim_duration_s / wall:.0f}x real time in this process); in child processes: "
+        f"{sides.ratio_text(pure, compiled, 'x real time')}")
     speeds = [10.0, 20.0, 30.0, 40.0] if quick else [5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 60.0, 80.0]
     attempts = serve.fastest_flight(speeds, reference)
     tried = ", ".join(f"x{s:g} {'ok' if ok else 'FAIL'} {w:.1f} s wall, vehicle at x{r.vehicle_duration_s / w:.0f}"
@@ -196,6 +194,19 @@ def bench_campaign(quick: bool) -> None:
         f"{local2.worker_s_per_case:.2f} s, 2 workers); ray.init {init_s:.2f} s once per campaign, not counted above")
     say(f"campaign peak RSS per worker: local {max(local1.peak_rss_mib, local2.peak_rss_mib):.0f} MiB, ray "
         f"{ray2.peak_rss_mib:.0f} MiB (the largest worker's getrusage ru_maxrss after its cases)")
+    bench_campaign_builds(count)
+
+
+def bench_campaign_builds(count: int) -> None:
+    """The local engine with 2 workers, pure and compiled one after the other (the workers take the build)."""
+    runs = {}
+    for pure in (True, False) if sides.compiled_build_here() else (True,):
+        with sides.build_for_children(pure):
+            runs[pure] = campaign.run("local", 2, count)
+    compiled = runs[False].per_minute if False in runs else None
+    cpu = "" if compiled is None else f", compiled {runs[False].case_cpu_s:.2f}"
+    say(f"campaign local x2, ~30 s flights: {sides.ratio_text(runs[True].per_minute, compiled, 'cases per minute')}; "
+        f"CPU s per case: pure {runs[True].case_cpu_s:.2f}{cpu} (target: compiled >= 100 per minute)")
 
 
 BENCHES: dict[str, Callable[[bool], None]] = {

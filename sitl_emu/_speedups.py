@@ -81,7 +81,7 @@ def _module_of(rel_path: str) -> str | None:
 def _first_difference(manifest: dict, built: dict[str, Path], root: Path) -> str | None:
     """Why the build does not match its manifest ('sitl_emu/physics.py changed'), or None when it does."""
     recorded = {m["so"]: m["so_sha256"] for m in manifest["compiled"].values()}
-    recorded[manifest["shared_lib"]["so"]] = manifest["shared_lib"]["so_sha256"]
+    recorded |= {lib["so"]: lib["so_sha256"] for lib in manifest["shared_libs"]}
     for rel in sorted(recorded.keys() - built.keys()):
         return f"{rel} is missing"
     for rel in sorted(built):
@@ -144,3 +144,18 @@ def describe() -> str:
     """One line for a benchmark report: 'pure Python' or 'compiled (mypyc): N modules'."""
     names = compiled_modules()
     return f"compiled (mypyc): {len(names)} modules" if names else "pure Python"
+
+
+def build_line(package_dir: Path = _PACKAGE_DIR, environ: Mapping[str, str] = os.environ) -> str:
+    """One line for start-up (serve, campaign, bench): does the vehicle core run compiled, and if not, why not."""
+    names = [name for name in map(_module_of, built_extensions(package_dir))
+             if name is not None and not name.endswith("__mypyc")]
+    if not names:
+        return ("core: pure Python (`make speedups` in a checkout, or SITL_EMU_COMPILE=1 at pip install, compiles "
+                "it: README, \"The compiled build\")")
+    decided = plan(package_dir, environ)
+    count = f"{len(names)} module{'' if len(names) == 1 else 's'}"
+    if not decided.sources:
+        return f"core: compiled (mypyc), {count}"
+    why = f"{PURE_ENV} is set" if decided.warning is None else "the compiled build is stale"
+    return f"core: pure Python ({why}; {count} compiled, not used)"

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import shlex
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -60,7 +62,8 @@ def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: st
     try:
         ref, cases, limits = _inputs(cases_file, scenario, seeds, assignments, faults, options, sim_limit, wall_limit)
         summary = run_campaign(ref, cases, None if out == "-" else out, engine=engine, workers=workers,
-                               address=address, limits=limits, progress=progress.start if progress else None,
+                               address=address, limits=limits,
+                               progress=_announcing(progress.start if progress else None),
                                worst_by=worst_by, on_row=progress.row if progress else None)
     except CampaignError as err:
         raise UserError(str(err)) from None
@@ -71,6 +74,25 @@ def campaign(cases_file: Path | None, scenario: str | None, out: str, engine: st
         click.echo(f"\nresults: {out}")
     if summary.passed < summary.total:
         sys.exit(1)
+
+
+def _announcing(progress: Callable[[int], AbstractContextManager[Any]] | None,
+                ) -> Callable[[int], AbstractContextManager[Any]]:
+    """The progress display, started after a line that says which build the workers run (they import the same
+    sitl_emu as this process): printed once the cases are checked, so that a mistake stays one line."""
+
+    @contextmanager
+    def start(total: int) -> Iterator[Any]:
+        from sitl_emu._speedups import build_line
+
+        click.echo(f"sitl-emu campaign: {build_line()}", err=True)
+        if progress is None:
+            yield None
+        else:
+            with progress(total) as bar:
+                yield bar
+
+    return start
 
 
 def _inputs(cases_file: Path | None, scenario: str | None, seeds: tuple[int, ...], assignments: tuple[str, ...],

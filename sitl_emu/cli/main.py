@@ -19,6 +19,7 @@ from flightview.options import view_options
 from px4common.cli_style import CONTEXT, FiniteRange, OneLineGroup, UserError, WholeRange
 from px4common.clock import SPEED_MAX, SPEED_MIN
 from px4common.signing_key import SigningKeyError, read_signing_key
+from sitl_emu._speedups import build_line
 from sitl_emu.campaign.cli import campaign
 from sitl_emu.cli.options import (
     MAX_SYSID,
@@ -294,6 +295,7 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     signals.stop_with(runner.stop)  # a signal from now on (or one already received) stops the loop, or never starts it
     for node in nodes:
         click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
+    click.echo(f"sitl-emu: {build_line()}")  # after the vehicles' lines, which scripts read first
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
     live = None if runner.stopped else start_view(vehicles, nodes, view, runner)

@@ -43,7 +43,7 @@ def _fake_build(tmp_path: Path, name: str = "fakepkg") -> Path:
     manifest = {
         "compiled": {f"{name}.mod": {"py": f"{name}/mod.py", "py_sha256": _sha(pkg / "mod.py"),
                                      "so": f"{name}/mod{SUFFIX}", "so_sha256": _sha(pkg / f"mod{SUFFIX}")}},
-        "shared_lib": {"so": f"{name}/_native__mypyc{SUFFIX}", "so_sha256": _sha(pkg / f"_native__mypyc{SUFFIX}")},
+        "shared_libs": [{"so": f"{name}/_native__mypyc{SUFFIX}", "so_sha256": _sha(pkg / f"_native__mypyc{SUFFIX}")}],
         "depends": {f"{name}/helper.py": _sha(pkg / "helper.py")},
     }
     (pkg / _speedups.MANIFEST_NAME).write_text(json.dumps(manifest))

@@ -69,6 +69,7 @@ def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_ot
         lines = [proc.stdout.readline() for _ in range(3)]
         for i, line in enumerate(lines):
             assert f"sysid {i + 1}:" in line and f":{api + i}," in line and f":{gcs + i}," in line
+        assert proc.stdout.readline().startswith("sitl-emu: core: ")  # then which build runs (compiled or pure)
         for c in clients:
             c.wait(lambda c=c: c.healthy and c.seen.lat_lon_deg is not None, 20.0, "a healthy vehicle")
             assert c.seen.heartbeat.get_srcSystem() == c.target[0]
