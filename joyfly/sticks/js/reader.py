@@ -342,6 +342,16 @@ class JsDevice:
                 self.last_error = vanished_error(self.path)
                 log.warning("%s", self.last_error)
             return
+        if self.raw and self._check.records == 0:
+            # A joystick never reads empty (it blocks, or fails when unplugged): a character device that ends before
+            # its first record, such as /dev/null, carries no js_events and never will.
+            self.refused = self.last_error = JoystickError(
+                f"raw:{self.path} ended before its first js_event record (it reads empty), so it is not a joystick: "
+                f"pass {JOYSTICKS}.")
+            log.warning("%s", self.refused)
+            self._close_fd()
+            self.connected = False
+            return
         self._lost(OSError(errno.ENODEV, "end of device"))
 
     def _lost(self, exc: OSError) -> None:

@@ -279,6 +279,18 @@ def test_raw_vouches_for_a_character_device_without_js_ioctls():
     src.close()
 
 
+def test_a_raw_device_that_reads_empty_before_any_record_is_gone_for_good():
+    """raw:/dev/null used to wait for ever, 'a FIFO needs its writer': a device that ends before its first record
+    is no joystick, and the session refuses it before arming (its `gone`)."""
+    clock = FakeClock()
+    src = open_joystick("raw:/dev/null", clock)
+    assert src.poll(0.1).connected is False
+    assert str(src.gone).startswith("raw:/dev/null ended before its first js_event record")
+    clock.sleep(5.0)
+    assert src.poll(0.1).connected is False and src.fileno() is None  # never reopened
+    src.close()
+
+
 def test_a_device_answering_the_js_ioctls_is_a_joystick(monkeypatch):
     real_ioctl = reader.fcntl.ioctl
 
