@@ -135,6 +135,7 @@ def command(mav: mavutil.mavfile, cmd: int, *params: float) -> None:
 def follow(mav: mavutil.mavfile, count: int, deadline: float) -> None:
     """Print progress until the vehicle disarms after the mission."""
     reached, armed_seen, next_heartbeat = -1, False, 0.0
+    chunks: dict[int, str] = {}  # a text longer than 50 characters comes in chunks with one id (MAVLink STATUSTEXT)
     while time.monotonic() < deadline:
         if time.monotonic() >= next_heartbeat:
             heartbeat(mav)
@@ -147,7 +148,11 @@ def follow(mav: mavutil.mavfile, count: int, deadline: float) -> None:
             reached = msg.seq
             print(f"reached item {reached} of {count}")
         elif kind == "STATUSTEXT":
-            print("vehicle:", msg.text.strip())
+            text = chunks.pop(msg.id, "") + msg.text
+            if msg.id and len(msg.text) == 50:  # a full chunk: more of this text follows
+                chunks[msg.id] = text
+            else:
+                print("vehicle:", text.strip())
         elif kind == "HEARTBEAT" and msg.get_srcSystem() == mav.target_system:
             armed = bool(msg.base_mode & mavutil.mavlink.MAV_MODE_FLAG_SAFETY_ARMED)
             armed_seen |= armed
