@@ -73,7 +73,7 @@ def test_position_white_noise_is_one_normal_draw_per_axis_and_tick_from_the_seed
         n = rng.normal(0.0, 0.3, 3)
         truth = v._state.pos_ned_m
         assert v.estimate.pos_ned_m == (truth[0] + float(n[0]), truth[1] + float(n[1]), truth[2] + float(n[2]))
-        assert v.estimate.vel_ned_m_s is v._state.vel_ned_m_s and v.estimate.q_wxyz is v._state.q_wxyz
+        assert v.estimate.vel_ned_m_s == v._state.vel_ned_m_s and v.estimate.q_wxyz == v._state.q_wxyz
 
 
 def test_levels_from_plain_data_and_their_one_sentence_errors():
