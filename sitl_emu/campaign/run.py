@@ -83,5 +83,6 @@ def _summary(results: ResultsFile, cases: Sequence[Case], ref: str, limits: Limi
     ids = {c.id: c for c in cases}
     rows = [typed(r) for r in results.rows if r.get("case") in ids]
     summary = summarize(rows, worst_by)
-    summary.reruns = {r["case"]: rerun_command(ref, ids[r["case"]], limits) for r in rows if not r["passed"]}
+    failed = sorted(r["case"] for r in rows if not r["passed"])  # in case order, not the order they finished
+    summary.reruns = {case: rerun_command(ref, ids[case], limits) for case in failed}
     return summary
