@@ -5,6 +5,9 @@ tests/support/ (on sys.path via pyproject's pytest settings) and the fixtures se
 The folders whose modules `make speedups` compiles (COMPILED_FOLDERS: the vehicle core, Sim, the link, the runners,
 the flight log, the disturbances; COMPILED_FILES: the kernel's) get the `compiled` marker here, and
 `make compiled-check` runs `pytest -m compiled` against the mypyc build.
+
+Every test must leave the checkout as it found it (servers run in tmp_path): `_leaves_no_files_in_the_checkout` fails
+the one that does not.
 """
 
 from __future__ import annotations
@@ -13,6 +16,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from support import REPO_ROOT
+from support.checkout_guard import checkout_files, left_behind
 from support.mavsdk_waits import MAVSDK_SPEED
 from support.serve_process import serve
 
@@ -39,3 +44,16 @@ def mavsdk_port(tmp_path: Path) -> Iterator[int]:
     the repository); yields the UDP port MAVSDK must listen on (the API link's remote)."""
     with serve(tmp_path, tmp_path / "serve.log", MAVSDK_SPEED) as ports:
         yield ports.api_remote
+
+
+@pytest.fixture(autouse=True)
+def _leaves_no_files_in_the_checkout() -> Iterator[None]:
+    """Fails the test after which the checkout holds new files (a walk of about a millisecond on each side). With
+    xdist workers, the writer may be a test running at the same time on the other worker: both are named."""
+    before = checkout_files(REPO_ROOT)
+    yield
+    left = left_behind(before, checkout_files(REPO_ROOT))
+    if left:
+        pytest.fail(f"this test (or one running beside it on another xdist worker) left {', '.join(left)} in the "
+                    f"checkout {REPO_ROOT}: run servers with cwd=tmp_path and write files under tmp_path",
+                    pytrace=False)

@@ -16,6 +16,7 @@ import socket
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from pymavlink.dialects.v20 import development as dialect
@@ -31,10 +32,11 @@ REPO = REPO_ROOT
 
 
 
-def _serve(speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int, *extra: str) -> subprocess.Popen:
+def _serve(cwd: Path, speed: float, api: int, gcs: int, api_remote: int, gcs_remote: int,
+           *extra: str) -> subprocess.Popen:
     args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs), "--remote", f"127.0.0.1:{api_remote}",
             "--gcs-remote", f"127.0.0.1:{gcs_remote}", *extra]
-    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=cwd,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
 
@@ -45,13 +47,13 @@ def _stop(proc: subprocess.Popen) -> str:
     return err
 
 
-def test_speed_20_flies_the_same_flight_as_lockstep():
+def test_speed_20_flies_the_same_flight_as_lockstep(tmp_path):
     with Sim() as sim:
         client = FlightClient(sim.ports(0).api, sim.clock)
         lockstep = fly_square(client)
         client.close()
     api, gcs, sink = free_udp_ports(3)
-    proc = _serve(20.0, api, gcs, sink, sink, "--no-log")  # about simulated time; logs: tests/sitl_emu/log
+    proc = _serve(tmp_path, 20.0, api, gcs, sink, sink, "--no-log")  # about simulated time; logs: tests/sitl_emu/log
     try:
         assert proc.stdout is not None
         proc.stdout.readline()
@@ -69,13 +71,14 @@ def test_speed_20_flies_the_same_flight_as_lockstep():
 
 @pytest.mark.parametrize("batch", [("--batch-ms", "0"), (), ("--batch-ms", "400")],
                          ids=["every-tick", "default-batch", "batch-400ms"])
-def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10(batch):
+def test_heartbeat_and_streams_keep_their_rates_in_simulated_time_at_speed_10(batch, tmp_path):
     api, gcs, listen, gcs_sink = free_udp_ports(4)
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 22)
     sock.bind(("127.0.0.1", listen))
     sock.settimeout(5.0)
-    proc = _serve(10.0, api, gcs, listen, gcs_sink, *batch)  # the API link streams to us from boot (initial remote)
+    # the API link streams to us from boot (initial remote)
+    proc = _serve(tmp_path, 10.0, api, gcs, listen, gcs_sink, *batch)
     parser = dialect.MAVLink(None)
     beats, attitude_ms = 0, []
     try:
