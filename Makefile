@@ -8,7 +8,7 @@ BIN := $(VENV)/bin
 DEMO_STAMP := $(VENV)/.installed-demo
 STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test test-compiled compiled-check lint bench clean speedups clean-speedups
+.PHONY: demo test test-fast test-compiled compiled-check lint bench clean speedups clean-speedups
 
 $(DEMO_STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -28,6 +28,11 @@ test: $(STAMP)
 	$(BIN)/mypy sitl_emu joyfly flightview px4common
 	$(BIN)/python -m pytest -q
 	$(MAKE) test-compiled
+
+# The edit-test loop: every test but the `slow` ones (subprocesses, MAVSDK, MAVProxy, the browser, SDL and long
+# end-to-end flights; tests/conftest.py), in one process, in about a minute and a half here.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow"
 
 # The opt-in compiled build, checked in a scratch copy (your tree is left as it is): build it, then the tests of the
 # vehicle core, Sim and the link (the `compiled` marker, given in tests/conftest.py), including

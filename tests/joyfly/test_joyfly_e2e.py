@@ -29,6 +29,8 @@ from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.sticks.joystick import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.mapping import open_sticks
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SPEED = 8.0
 AXIS_FULL = 32767
 

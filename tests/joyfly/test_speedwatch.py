@@ -84,6 +84,7 @@ def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str
     return seen
 
 
+@pytest.mark.slow
 def test_joyfly_warns_when_serve_runs_faster_than_its_speed(tmp_path: Path) -> None:
     """sitl-emu serve --speed 4 and joyfly fly without --speed, as a user would start them."""
     joy_port, emu_port, gcs_port = free_udp_ports(3)

@@ -28,6 +28,8 @@ from support.serve_process import serve, stop_process
 
 from sitl_emu.params import default_registry
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 WAIT_S = 30.0  # the longest any single step may take (wall clock)
 
 

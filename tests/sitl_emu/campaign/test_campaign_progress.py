@@ -12,6 +12,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 from support import REPO_ROOT, campaign_scenarios
 
@@ -55,6 +56,7 @@ def test_without_a_terminal_the_campaign_prints_progress_lines_not_a_bare_label(
     assert result.stderr.splitlines()[-1].startswith("cases: 2 of 2 done (2 passed, 0 failed), ")
 
 
+@pytest.mark.slow
 def test_ctrl_c_prints_the_summary_so_far_and_the_command_that_resumes(tmp_path: Path) -> None:
     hold, out = tmp_path / "hold", tmp_path / "out.csv"
     hold.write_text("")

@@ -43,6 +43,7 @@ def _first_message(sock: socket.socket) -> object:
             return msg
 
 
+@pytest.mark.slow
 def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigterm(tmp_path):
     api_port, gcs_port, api_remote, gcs_remote = free_udp_ports(4)
     with _listener(api_remote) as api_sock, _listener(gcs_remote) as gcs_sock:
@@ -63,6 +64,7 @@ def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigter
     assert f"{api_port}" in lines[0] and f"{api_remote}" in lines[0] and f"{gcs_port}" in lines[0]
 
 
+@pytest.mark.slow
 def test_ctrl_c_exits_without_traceback(tmp_path):
     api_port, gcs_port, remote = free_udp_ports(3)
     proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}")
@@ -78,6 +80,7 @@ def test_ctrl_c_exits_without_traceback(tmp_path):
     assert out.endswith("\nPX4 Exiting...\n")  # as PX4 SITL on Ctrl-C (main.cpp sig_int_handler)
 
 
+@pytest.mark.slow
 def test_instance_gives_sysid_and_offset_ports(tmp_path):
     base_api, base_gcs, remote = free_udp_ports(3)
     with _listener(remote + 3) if remote + 3 < 65536 else pytest.skip("no room for the offset port") as sock:
@@ -92,6 +95,7 @@ def test_instance_gives_sysid_and_offset_ports(tmp_path):
     assert f":{base_api}," in out and f":{base_gcs}," in out
 
 
+@pytest.mark.slow
 def test_port_in_use_is_one_sentence_and_status_2(tmp_path):
     holder = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     holder.bind(("127.0.0.1", 0))
@@ -115,6 +119,7 @@ def test_port_in_use_is_one_sentence_and_status_2(tmp_path):
     (("--remote", "nowhere"), "HOST:PORT"),
     (("--wind", "5"), "SPEED@FROM_DEG"),
 ])
+@pytest.mark.slow
 def test_bad_options_are_one_sentence_and_status_2(args, words, tmp_path):
     api_port, gcs_port = free_udp_ports(2)
     proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port), *args)
@@ -144,6 +149,7 @@ def test_params_file_in_both_formats_sets_parameters(tmp_path):
     assert registry.get("COM_DISARM_LAND") == 3.0
 
 
+@pytest.mark.slow
 def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve(tmp_path):
     """mavutil's own PX4 mode map and arm helper against the real process (run at 5x real time)."""
     from pymavlink import mavutil
@@ -184,6 +190,7 @@ def test_instance_sets_mav_sys_id_like_rcs():
     assert vehicle.sysid == 4 and vehicle.params.get("MAV_SYS_ID") == 4
 
 
+@pytest.mark.slow
 def test_real_time_runner_follows_the_wall_clock_across_a_reboot():
     import threading
 

@@ -161,6 +161,7 @@ def _numbers_as_hash(texts: list[str]) -> list[str]:
     return [re.sub(r"\d+", "#", t) for t in texts]
 
 
+@pytest.mark.slow
 def test_modes_in_the_air_offboard_and_the_stick_loss_failsafe(pilot):
     assert pilot.h.vehicle.snapshot().armed  # armed in Position mode by the previous case
     pilot.sticks = {"z": 1000}

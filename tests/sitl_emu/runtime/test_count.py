@@ -15,6 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from support import REPO_ROOT
 
 from px4common.clock import ScaledClock
@@ -58,6 +59,7 @@ def _east_m(a: tuple[float, float], b: tuple[float, float]) -> float:
     return (b[1] - a[1]) * math.radians(1.0) * 6371000.0 * math.cos(math.radians(a[0]))
 
 
+@pytest.mark.slow
 def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_others(tmp_path):
     api = _free_run(3)
     gcs = _free_run(3, (api,))
