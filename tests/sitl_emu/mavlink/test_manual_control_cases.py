@@ -18,6 +18,9 @@ from support.fakes import Client, Harness
 from sitl_emu.px4 import MavCmd
 from sitl_emu.vehicle.vehicle import Vehicle
 
+# one vehicle flies the cases in order (the module's `pilot`), the last in the air: the module is one slow flight
+pytestmark = pytest.mark.slow
+
 # a copy of ../shared/reference/px4-manual (recorded from real PX4 SITL; see its README)
 CASES: dict[str, Any] = json.loads((Path(__file__).parents[2] / "reference" / "px4-manual" / "cases.json").read_text())
 MODES = {"POSCTL": (3, 0), "ALTCTL": (2, 0), "STABILIZED": (7, 0), "OFFBOARD": (6, 0)}
@@ -161,7 +164,6 @@ def _numbers_as_hash(texts: list[str]) -> list[str]:
     return [re.sub(r"\d+", "#", t) for t in texts]
 
 
-@pytest.mark.slow
 def test_modes_in_the_air_offboard_and_the_stick_loss_failsafe(pilot):
     assert pilot.h.vehicle.snapshot().armed  # armed in Position mode by the previous case
     pilot.sticks = {"z": 1000}
