@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 from support import REPO_ROOT
-from support.checkout_guard import checkout_files, left_behind
+from support.checkout_guard import checkout_files, left_behind, top_level_files
 from support.mavsdk_waits import MAVSDK_SPEED
 from support.serve_process import serve
 
@@ -54,12 +54,24 @@ def mavsdk_port(tmp_path: Path) -> Iterator[int]:
 
 @pytest.fixture(autouse=True)
 def _leaves_no_files_in_the_checkout() -> Iterator[None]:
-    """Fails the test after which the checkout holds new files (a walk of about a millisecond on each side). With
-    xdist workers, the writer may be a test running at the same time on the other worker: both are named."""
+    """Fails the test after which the checkout's top folder holds new files (where `serve` started without cwd writes
+    log/ and parameters.params). With xdist workers, the writer may be a test running at the same time on the other
+    worker: the message says so."""
+    before = top_level_files(REPO_ROOT)
+    yield
+    _fail_if_left(left_behind(before, top_level_files(REPO_ROOT)), "this test")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _module_leaves_no_files_in_the_checkout() -> Iterator[None]:
+    """The same for the whole tree, once per module (a walk of about 2 ms)."""
     before = checkout_files(REPO_ROOT)
     yield
-    left = left_behind(before, checkout_files(REPO_ROOT))
+    _fail_if_left(left_behind(before, checkout_files(REPO_ROOT)), "a test of this module")
+
+
+def _fail_if_left(left: list[str], who: str) -> None:
     if left:
-        pytest.fail(f"this test (or one running beside it on another xdist worker) left {', '.join(left)} in the "
+        pytest.fail(f"{who} (or one running beside it on another xdist worker) left {', '.join(left)} in the "
                     f"checkout {REPO_ROOT}: run servers with cwd=tmp_path and write files under tmp_path",
                     pytrace=False)

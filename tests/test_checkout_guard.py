@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from support.checkout_guard import checkout_files, left_behind
+from support.checkout_guard import checkout_files, left_behind, top_level_files
 
 
 def test_a_new_folder_is_named_once_and_caches_are_ignored(tmp_path: Path) -> None:
@@ -25,3 +25,13 @@ def test_nothing_new_is_nothing_left(tmp_path: Path) -> None:
     before = checkout_files(tmp_path)
     (tmp_path / "README.md").write_text("edited")
     assert left_behind(before, checkout_files(tmp_path)) == []
+
+
+def test_the_top_level_listing_sees_what_a_server_leaves_in_its_working_directory(tmp_path: Path) -> None:
+    (tmp_path / "tests").mkdir()
+    before = top_level_files(tmp_path)
+    (tmp_path / "tests" / "deep.txt").write_text("")  # the module's walk finds this one
+    (tmp_path / "log").mkdir()
+    (tmp_path / "parameters.params").write_text("")
+    (tmp_path / ".pytest_cache").mkdir()
+    assert left_behind(before, top_level_files(tmp_path)) == ["log", "parameters.params"]
