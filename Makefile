@@ -8,7 +8,14 @@ BIN := $(VENV)/bin
 DEMO_STAMP := $(VENV)/.installed-demo
 STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test test-compiled compiled-check lint bench clean speedups clean-speedups
+.PHONY: demo test test-fast test-compiled compiled-check lint bench clean speedups clean-speedups
+
+# Two pytest workers (pytest-xdist) for the tests that can run side by side; the `serial` ones (tests/conftest.py)
+# run alone after them (pytest's status 5, "no test selected", is not a failure there). A module's tests stay on one
+# worker (--dist loadfile), so a module's fixture runs once. `make test TEST_WORKERS=0`: one process.
+TEST_WORKERS ?= 2
+PARALLEL = -n $(TEST_WORKERS) --dist loadfile
+NONE_SELECTED_IS_OK = || [ $$? -eq 5 ]
 
 $(DEMO_STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -26,8 +33,14 @@ demo: $(DEMO_STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy sitl_emu joyfly flightview px4common
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q $(PARALLEL) -m "not serial"
+	$(BIN)/python -m pytest -q -m serial $(NONE_SELECTED_IS_OK)
 	$(MAKE) test-compiled
+
+# The edit-test loop: every test but the `slow` ones (subprocesses, MAVSDK, MAVProxy, the browser, SDL and long
+# end-to-end flights; tests/conftest.py), in one process: about a minute of CPU time.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow"
 
 # The opt-in compiled build, checked in a scratch copy (your tree is left as it is): build it, then the tests of the
 # vehicle core, Sim and the link (the `compiled` marker, given in tests/conftest.py), including
@@ -43,7 +56,8 @@ compiled-check:
 	cp -r sitl_emu joyfly flightview px4common tests tools examples pyproject.toml README.md $(CHECK_DIR)/
 	cp setup.py MANIFEST.in $(CHECK_DIR)/  # the wheel build test (tests/sitl_emu/test_speedups_build.py)
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
-	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m compiled
+	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider $(PARALLEL) -m "compiled and not serial"
+	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m "compiled and serial" $(NONE_SELECTED_IS_OK)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -44,3 +44,10 @@ def test_test_after_demo_adds_the_test_extra(clone: Path) -> None:
     assert "-m venv" not in commands  # the demo's venv is kept
     assert "-e '.[test]'" in commands
     assert "pytest" in commands
+
+
+def test_test_runs_on_two_workers_then_the_serial_tests_and_test_fast_leaves_the_slow_ones_out(clone: Path) -> None:
+    commands = planned(clone, "test")
+    assert 'pytest -q -n 2 --dist loadfile -m "not serial"' in commands
+    assert "pytest -q -m serial || [ $? -eq 5 ]" in commands  # none marked serial is no failure
+    assert 'pytest -q -m "not slow"' in planned(clone, "test-fast")

@@ -20,6 +20,8 @@ from typing import Any
 import pytest
 from support.view_process import require_rerun, view_process, wait_until
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 CHROMIUM_ARGS = ("--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
                  "--ignore-gpu-blocklist", "--window-size=1024,576")
 FLOWN_S = 15.0  # the script's moves are over (joyfly's take-off, then 5 s of sticks)

@@ -9,6 +9,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import pytest
 from support.view_process import require_rerun
 
 from flightview.live import LiveView
@@ -63,6 +64,7 @@ def viewer(url: str, path: Path) -> subprocess.Popen[bytes]:
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
+@pytest.mark.slow
 def test_a_viewer_gets_every_frame_whether_it_connects_before_the_flight_or_after_it(tmp_path: Path) -> None:
     """The page may be loaded before the first frame or long after: the proxy serve --view starts keeps what was
     logged (up to its memory limit) and hands it to each viewer that connects."""

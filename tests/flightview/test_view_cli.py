@@ -70,6 +70,7 @@ def test_an_unwritable_recording_is_one_sentence(tmp_path: Path, monkeypatch: py
                               "No such file or directory.")
 
 
+@pytest.mark.slow
 def test_serve_view_listens_on_loopback_only_and_records_every_vehicle(tmp_path: Path) -> None:
     require_rerun()
     record = tmp_path / "view.rrd"
@@ -107,6 +108,7 @@ def _entities(record: Path) -> set[str]:
     return {word.rstrip(":,") for word in printed.split() if word.startswith(("/world/", "/plots/"))}
 
 
+@pytest.mark.slow
 def test_both_view_ports_can_be_set(tmp_path: Path) -> None:
     """--view-port sets the page's port, --view-grpc-port the data stream's (Rerun's gRPC proxy) that the page reads."""
     require_rerun()

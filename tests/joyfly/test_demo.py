@@ -21,6 +21,7 @@ SPEED = 10.0  # the built-in emulator: joyfly reads its simulated clock, so time
 URL_SPEED = 4.0
 
 
+@pytest.mark.slow
 def test_demo_flies_the_script_and_ends_with_a_summary() -> None:
     out = io.StringIO()
     assert run_demo(speed=SPEED, live=False, out=out) == 0
@@ -34,6 +35,7 @@ def test_demo_flies_the_script_and_ends_with_a_summary() -> None:
     assert float(distance.split()[2]) > 20.0  # climb + square + fence push + return
 
 
+@pytest.mark.slow
 def test_demo_runs_without_a_terminal_as_in_ci() -> None:
     proc = subprocess.run([sys.executable, "-m", "joyfly", "demo", "--speed", str(SPEED)], stdin=subprocess.DEVNULL,
                           capture_output=True, text=True, timeout=60)
@@ -42,6 +44,7 @@ def test_demo_runs_without_a_terminal_as_in_ci() -> None:
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_demo_flies_a_vehicle_already_listening_at_url() -> None:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
@@ -57,6 +60,7 @@ def test_demo_flies_a_vehicle_already_listening_at_url() -> None:
     assert "Landed and disarmed" in out.getvalue()
 
 
+@pytest.mark.slow
 def test_demo_in_position_mode_takes_off_with_the_throttle_and_stays_inside_the_fence() -> None:
     # PX4 takes MANUAL_CONTROL for lost 0.5 s (simulated) after the last one: 50 ms of wall time at x10, which a busy
     # CI machine can take from the process (joyfly and the emulator share it here); at x4 it is 125 ms
@@ -72,6 +76,7 @@ def test_demo_in_position_mode_takes_off_with_the_throttle_and_stays_inside_the_
     assert float(distance.split()[2]) > 15.0  # climb + square + fence push
 
 
+@pytest.mark.slow
 def test_demo_flies_in_wind_and_lands() -> None:
     out = io.StringIO()
     status = run_demo(speed=SPEED, live=False, out=out, wind="5@270,light")
@@ -102,6 +107,7 @@ def test_demo_refuses_bad_wind_in_one_sentence(kwargs: dict[str, str], said: str
         run_demo(live=False, out=io.StringIO(), **kwargs)  # type: ignore[arg-type]
 
 
+@pytest.mark.slow
 def test_demo_cli_bad_wind_exits_2() -> None:
     proc = subprocess.run([sys.executable, "-m", "joyfly", "demo", "--wind", "north"], stdin=subprocess.DEVNULL,
                           capture_output=True, text=True, timeout=60)
@@ -120,6 +126,7 @@ def test_the_demo_sends_no_ground_station_telemetry_to_14550_unless_asked() -> N
         vehicle.close()
 
 
+@pytest.mark.slow
 def test_gcs_remote_sends_the_telemetry_there_and_the_demo_says_how_to_get_the_view(
         monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "rerun", None)  # as without the view extra, which the demo does not need

@@ -18,11 +18,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import pytest
 from pymavlink import mavutil
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
+
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
 
 SPEED = 8
 # MANUAL_CONTROL goes out at 25 Hz of vehicle time and PX4 takes it for lost after COM_RC_LOSS_T: x4 and 3 s (PX4:

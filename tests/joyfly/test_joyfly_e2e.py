@@ -29,6 +29,8 @@ from joyfly.session.flight_session import FlightSession, Phase, SessionSettings
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 from joyfly.sticks.mapping import open_sticks
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SPEED = 8.0
 AXIS_FULL = 32767
 
@@ -165,10 +167,11 @@ def test_closing_the_fifo_holds_then_lands_after_the_timeout(flight: Flight) -> 
 
 
 
-def _serve(joy_port: int, emu_port: int, gcs_port: int, speed: str) -> subprocess.Popen[bytes]:
+def _serve(cwd: Path, joy_port: int, emu_port: int, gcs_port: int, speed: str) -> subprocess.Popen[bytes]:
+    """In `cwd` (tmp_path), where it writes its parameters file and flight logs."""
     return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
                              f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", speed, "--no-console"],
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                            cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
 Procs = tuple[subprocess.Popen[bytes], subprocess.Popen[str], str]
@@ -178,7 +181,7 @@ def _start_pair(tmp_path: Path, speed: str = "4", script_text: str = "0 forward=
                 ports: tuple[int, int, int] | None = None) -> Procs:
     """`sitl-emu serve` and `joyfly fly` (on a script joystick) as a user runs them, flying in OFFBOARD."""
     joy_port, emu_port, gcs_port = ports or free_udp_ports(3)
-    emu = _serve(joy_port, emu_port, gcs_port, speed)
+    emu = _serve(tmp_path, joy_port, emu_port, gcs_port, speed)
     script = tmp_path / "hover.txt"
     script.write_text(script_text)
     joy = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", f"script:{script}", "--url",
@@ -255,7 +258,7 @@ def test_an_emulator_restarted_mid_flight_is_reported_as_a_restart(tmp_path: Pat
         emu.wait()
         out += _read_until(joy, "Link lost", 10.0)
         time.sleep(1.0)  # 4 s of simulated time with no vehicle
-        emu = _serve(*ports, "4")
+        emu = _serve(tmp_path, *ports, "4")
         out += _read_until(joy, "The vehicle restarted", 20.0)
         time.sleep(0.5)
         joy.send_signal(signal.SIGINT)

@@ -39,6 +39,7 @@ def run(session: FlightSession, sim: Sim, until_s: float) -> None:
         session.run_once()
 
 
+@pytest.mark.slow
 def test_the_fence_is_centred_on_the_home_of_the_second_flight_not_the_first(sim: Sim) -> None:
     first = session_on(sim, [(0.0, StickCommand()), (8.0, StickCommand(forward=0.6)), (10.0, StickCommand()),
                              (14.0, LAND), (14.5, StickCommand())], fence_m=10.0, exit_when_landed=True)

@@ -1,7 +1,9 @@
 """`joyfly fly --control position` end to end, as a user runs it: `sitl-emu serve` and `joyfly fly` as processes over
 loopback UDP, a FIFO of js_event records as the joystick, and a ground station watching the vehicle on the GCS link
 (LOCAL_POSITION_NED at 50 Hz, HEARTBEAT). Both run at --speed 4; the test times its steps on the vehicle's clock
-(time_boot_ms), so a slow machine stretches the flight but does not change it."""
+(time_boot_ms), so a slow machine stretches the flight but does not change it. MANUAL_CONTROL goes out at 25 Hz of
+vehicle time and PX4 takes it for lost after COM_RC_LOSS_T: 3 s (PX4: 0.5 s, an eighth of a second of wall time at
+x4) keeps a busy machine from starving it into an RC-loss failsafe, as in test_fence_e2e.py."""
 
 from __future__ import annotations
 
@@ -24,7 +26,10 @@ from support.ports import free_udp_ports
 
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SPEED = 4.0
+RC_LOSS_PARAM = "COM_RC_LOSS_T=3"
 AXIS_FULL = 32767
 FORWARD, RIGHT, UP, YAW = 0, 1, 2, 3  # the `script` profile's axes
 POSCTL = 3
@@ -134,8 +139,9 @@ def _start(tmp_path: Path) -> Pair:
     gcs = GroundStation(gcs_remote)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO_ROOT), os.environ.get("PYTHONPATH", "")])}
     emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", "--speed", str(SPEED),
-                            "--port", str(emu_port), "--remote", f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port),
-                            "--gcs-remote", f"127.0.0.1:{gcs_remote}"], cwd=tmp_path, env=env,
+                            "--param", RC_LOSS_PARAM, "--port", str(emu_port), "--remote", f"127.0.0.1:{joy_port}",
+                            "--gcs-port", str(gcs_port), "--gcs-remote", f"127.0.0.1:{gcs_remote}"], cwd=tmp_path,
+                           env=env,
                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     joy = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--control", "position", "--joy", str(fifo),
                             "--profile", "script", "--fence", "5", "--speed", str(SPEED),

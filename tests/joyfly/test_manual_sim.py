@@ -60,6 +60,7 @@ def fly(sim: Sim, steps: list[tuple[float, StickCommand]], control: str = "posit
     return Flight(sim, session)
 
 
+@pytest.mark.slow
 def test_position_mode_takes_off_holds_flies_north_stops_at_the_fence_and_lands(sim: Sim) -> None:
     f = fly(sim, [(0.0, CENTRE), (5.0, stick(up=1.0)), (9.0, CENTRE), (14.0, stick(forward=0.5)),
                   (16.0, CENTRE), (20.0, stick(right=1.0))], fence_m=5.0)

@@ -143,6 +143,7 @@ def flight(vehicle: Vehicle) -> Iterator[Flight]:
         stop(f)
 
 
+@pytest.mark.slow
 def test_joy_sdl_arms_takes_off_flies_north_then_east_and_lands(flight: Flight) -> None:
     assert flight.said("--joy sdl chose sdl:0 \"Pilot Pad\" (game controller")
     assert flight.said("profile sdl-gamecontroller")
@@ -166,6 +167,7 @@ def test_joy_sdl_arms_takes_off_flies_north_then_east_and_lands(flight: Flight) 
     assert flight.said("LAND pressed: landing") and not flight.armed
 
 
+@pytest.mark.slow
 def test_unplugged_holds_plugged_back_flies_on_another_pad_is_never_taken(flight: Flight) -> None:
     flight.send("detach")
     flight.until(lambda: flight.said("Joystick lost: holding position"), 5.0, "the hold")
@@ -213,6 +215,7 @@ def test_an_unknown_plain_joystick_is_refused_before_arming(vehicle: Vehicle) ->
     assert "\"Mystery Stick 3000\"" in line and "not know as a game controller" in line
 
 
+@pytest.mark.slow
 def test_a_plain_joystick_with_a_profile_flies(vehicle: Vehicle) -> None:
     f = start(vehicle, ["--joystick", "Mystery Stick 3000"], "sdl:mystery", "--profile", "generic")
     try:
@@ -234,11 +237,13 @@ def push_into_the_fence(f: Flight) -> None:
     f.send("rumbles")
 
 
+@pytest.mark.slow
 def test_a_fence_push_rumbles_the_pad(flight: Flight) -> None:
     push_into_the_fence(flight)
     assert flight.said(FENCE_PULSE)
 
 
+@pytest.mark.slow
 def test_no_rumble_keeps_the_pad_still(vehicle: Vehicle) -> None:
     f = start(vehicle, [], "sdl", "--no-rumble")
     try:
@@ -249,6 +254,7 @@ def test_no_rumble_keeps_the_pad_still(vehicle: Vehicle) -> None:
         stop(f)
 
 
+@pytest.mark.slow
 def test_a_joystick_calibrated_by_the_wizard_then_flies(vehicle: Vehicle, tmp_path: Path) -> None:
     """The wizard, driven by a virtual joystick here, writes the profile; joyfly (in the pilot's process, where a
     virtual joystick with the same name and GUID is plugged in) flies it with that profile."""

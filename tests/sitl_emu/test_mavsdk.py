@@ -19,6 +19,8 @@ import pytest
 from support.mavsdk_waits import MAVSDK_SPEED, Session, connect
 from support.serve_process import load_mavsdk
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 
 def _dist(a: tuple[float, float, float], b: tuple[float, float, float]) -> float:
     return math.dist(a, b)

@@ -14,6 +14,8 @@ import pytest
 from support.mavsdk_waits import Session, connect
 from support.serve_process import load_mavsdk
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 HOME_LAT_DEG, HOME_LON_DEG = 47.397742, 8.545594  # SIH_LOC_LAT0 / SIH_LOC_LON0
 
 

@@ -19,6 +19,8 @@ from support.mavsdk_waits import offset as _offset
 from support.mavsdk_waits import wait as _wait
 from support.serve_process import load_mavsdk
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 ALT_M = 8.0
 
 

@@ -8,10 +8,13 @@ import asyncio
 import math
 from typing import Any
 
+import pytest
 from support.mavsdk_waits import MAVSDK_SPEED, Session, connect
 from support.serve_process import load_mavsdk
 
 from sitl_emu.geo import EARTH_RADIUS_M
+
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
 
 EARTH_M_PER_DEG = math.radians(1.0) * EARTH_RADIUS_M
 

@@ -48,6 +48,7 @@ def test_list_shows_sdl_devices_and_js_devices(pads: list[VirtualPad], tmp_path:
     assert lines[-1].startswith(f"{tmp_path / 'js0'}  ")
 
 
+@pytest.mark.slow
 def test_test_shows_a_game_controllers_live_values(pads: list[VirtualPad]) -> None:
     pads.append(VirtualPad.controller("Test Pad", product=0x44))
 

@@ -84,13 +84,15 @@ def _read_until(proc: subprocess.Popen[str], text: str, timeout_s: float) -> str
     return seen
 
 
+@pytest.mark.slow
 def test_joyfly_warns_when_serve_runs_faster_than_its_speed(tmp_path: Path) -> None:
     """sitl-emu serve --speed 4 and joyfly fly without --speed, as a user would start them."""
     joy_port, emu_port, gcs_port = free_udp_ports(3)
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     emu = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--port", str(emu_port), "--remote",
                             f"127.0.0.1:{joy_port}", "--gcs-port", str(gcs_port), "--speed", "4", "--no-console"],
-                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+                           cwd=tmp_path, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                           env=env)
     script = tmp_path / "still.txt"
     script.write_text("0 forward=0\n+60 end\n")
     joy = subprocess.Popen([sys.executable, "-m", "joyfly", "fly", "--joy", f"script:{script}", "--url",

@@ -76,6 +76,7 @@ def test_the_vehicle_state_names_px4_custom_mode() -> None:
     assert VehicleState(custom_mode=6 << 16).mode == "-"  # no heartbeat yet
 
 
+@pytest.mark.slow
 def test_over_udp_link_finds_the_vehicle_and_tracks_its_state() -> None:
     theirs = UdpTransport(("127.0.0.1", 0), None)
     ours = UdpTransport(("127.0.0.1", 0), ("127.0.0.1", theirs.local_port))

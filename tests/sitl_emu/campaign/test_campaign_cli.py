@@ -37,6 +37,7 @@ def run(*args: str) -> Result:
     return CliRunner().invoke(sitl_emu.cli.main.main, list(args), prog_name="sitl-emu")
 
 
+@pytest.mark.slow
 def test_a_campaign_file_through_the_command_line_gives_the_table_the_summary_and_the_reruns(tmp_path: Path) -> None:
     cases = tmp_path / "cases.toml"
     cases.write_text(CAMPAIGN)

@@ -12,11 +12,12 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from click.testing import CliRunner
 from support import REPO_ROOT, campaign_scenarios
 
-import sitl_emu.cli.main
 from sitl_emu.campaign.progress import ProgressLines, duration_text
+from sitl_emu.cli.main import main as sitl_emu_main
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()
 
@@ -48,13 +49,14 @@ def test_a_progress_line_says_done_of_total_passed_failed_rate_and_time_left() -
 
 
 def test_without_a_terminal_the_campaign_prints_progress_lines_not_a_bare_label(tmp_path: Path) -> None:
-    result = CliRunner().invoke(sitl_emu.cli.main.main, ["campaign", "--scenario", f"{SCENARIOS}:hover", "--seed", "1",
+    result = CliRunner().invoke(sitl_emu_main, ["campaign", "--scenario", f"{SCENARIOS}:hover", "--seed", "1",
                                                     "--seed", "2", "--out", "-", "--engine", "serial"],
                                 prog_name="sitl-emu")
     assert result.exit_code == 0, result.output
     assert result.stderr.splitlines()[-1].startswith("cases: 2 of 2 done (2 passed, 0 failed), ")
 
 
+@pytest.mark.slow
 def test_ctrl_c_prints_the_summary_so_far_and_the_command_that_resumes(tmp_path: Path) -> None:
     hold, out = tmp_path / "hold", tmp_path / "out.csv"
     hold.write_text("")
@@ -82,6 +84,6 @@ def test_ctrl_c_prints_the_summary_so_far_and_the_command_that_resumes(tmp_path:
     assert resume[resume.index("--out") + 1] == str(out) and sorted(resume[2:]) == sorted(args[1:])
     before = out.read_text()
     hold.unlink()
-    again = CliRunner().invoke(sitl_emu.cli.main.main, resume[1:], prog_name="sitl-emu")
+    again = CliRunner().invoke(sitl_emu_main, resume[1:], prog_name="sitl-emu")
     assert again.exit_code == 0 and "3 of 3 cases passed" in again.output, again.output
     assert out.read_text().startswith(before) and len(out.read_text().splitlines()) == 4  # c0000 not flown again

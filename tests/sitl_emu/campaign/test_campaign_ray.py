@@ -13,8 +13,9 @@ from support import campaign_scenarios
 
 from sitl_emu.campaign import Limits, make_cases, run_campaign
 
-pytestmark = pytest.mark.skipif(importlib.util.find_spec("ray") is None,
-                                reason="Ray is not installed here (pip install 'joyfly[ray]' runs these tests).")
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(importlib.util.find_spec("ray") is None,
+                                 reason="Ray is not installed here (pip install 'joyfly[ray]' runs these tests).")]
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()  # by path: Ray's workers do not have tests/ on sys.path
 

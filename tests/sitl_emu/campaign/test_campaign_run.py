@@ -27,6 +27,7 @@ def without_wall_time(rows: list[dict[str, str]]) -> list[dict[str, str]]:
     return sorted(({k: v for k, v in r.items() if k != "wall_s"} for r in rows), key=lambda r: r["case"])
 
 
+@pytest.mark.slow
 def test_the_process_pool_gives_the_same_table_as_running_the_cases_one_by_one(tmp_path: Path) -> None:
     cases = make_cases({**NOISY, "params.MPC_XY_CRUISE": 7.0, "faults": [[0.2, "gps_off"]]}, {"seed": [3, 4, 5, 6, 7]})
     serial = run_campaign(campaign_scenarios.hover, cases, tmp_path / "serial.csv", engine="serial")
@@ -44,6 +45,7 @@ def test_the_process_pool_gives_the_same_table_as_running_the_cases_one_by_one(t
     assert serial.total == pooled.total == 5 and serial.quantiles == pooled.quantiles
 
 
+@pytest.mark.slow
 def test_the_example_scenario_flies_pymavlink_the_same_in_the_pool_as_alone(tmp_path: Path) -> None:
     example = f"{REPO_ROOT / 'examples' / 'campaign_square.py'}:fly"
     options = {"options.side_m": 0.0, "options.alt_m": 1.5, "options.hold_s": 0.5, "options.max_error_m": 0.5,
@@ -59,6 +61,7 @@ def test_the_example_scenario_flies_pymavlink_the_same_in_the_pool_as_alone(tmp_
     assert all(8 < float(r["metric.flight_s"]) < 40 for r in rows)
 
 
+@pytest.mark.slow
 def test_a_case_that_raises_hangs_overruns_or_kills_its_worker_is_that_cases_failure(tmp_path: Path) -> None:
     behaviours = ["raise", "hang", "sim_hang", "die", "fail"]
     cases = make_cases({"options.bad_seeds": [1]}, {"options.behave": behaviours, "seed": [0, 1, 2]})
@@ -84,6 +87,7 @@ def test_a_case_that_raises_hangs_overruns_or_kills_its_worker_is_that_cases_fai
     assert list(summary.reruns) == sorted(r["case"] for r in rows.values() if r["passed"] == "false")  # case order
 
 
+@pytest.mark.slow
 def test_a_rerun_with_the_same_output_flies_only_the_cases_it_lacks(tmp_path: Path) -> None:
     out = tmp_path / "out.csv"
     flown: list[str] = []
@@ -126,6 +130,7 @@ def test_a_metric_a_failed_case_did_not_measure_is_empty_and_left_out_of_the_qua
     assert summary.worst[0]["case"] == "c0000"
 
 
+@pytest.mark.slow
 def test_the_example_scenario_cut_short_leaves_its_metrics_empty_not_zero(tmp_path: Path) -> None:
     example = f"{REPO_ROOT / 'examples' / 'campaign_square.py'}:fly"
     cases = make_cases({"options.side_m": 1000.0, "options.hold_s": 0.5}, {"seed": [1]})  # too far for 30 s

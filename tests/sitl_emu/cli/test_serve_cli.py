@@ -8,6 +8,7 @@ import socket
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 from pymavlink.dialects.v20 import development as dialect
@@ -21,8 +22,8 @@ REPO = REPO_ROOT
 
 
 
-def _serve(*args: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+def _serve(cwd: Path, *args: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=cwd,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
 
@@ -42,11 +43,12 @@ def _first_message(sock: socket.socket) -> object:
             return msg
 
 
-def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigterm():
+@pytest.mark.slow
+def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigterm(tmp_path):
     api_port, gcs_port, api_remote, gcs_remote = free_udp_ports(4)
     with _listener(api_remote) as api_sock, _listener(gcs_remote) as gcs_sock:
-        proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{api_remote}",
-                      "--gcs-remote", f"127.0.0.1:{gcs_remote}")
+        proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port),
+                      "--remote", f"127.0.0.1:{api_remote}", "--gcs-remote", f"127.0.0.1:{gcs_remote}")
         try:
             hb = _first_message(api_sock)
             assert hb.get_type() == "HEARTBEAT" and (hb.type, hb.autopilot) == (2, 12)
@@ -62,9 +64,10 @@ def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigter
     assert f"{api_port}" in lines[0] and f"{api_remote}" in lines[0] and f"{gcs_port}" in lines[0]
 
 
-def test_ctrl_c_exits_without_traceback():
+@pytest.mark.slow
+def test_ctrl_c_exits_without_traceback(tmp_path):
     api_port, gcs_port, remote = free_udp_ports(3)
-    proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}")
+    proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}")
     try:
         assert proc.stdout is not None
         proc.stdout.readline()  # up and running
@@ -77,10 +80,11 @@ def test_ctrl_c_exits_without_traceback():
     assert out.endswith("\nPX4 Exiting...\n")  # as PX4 SITL on Ctrl-C (main.cpp sig_int_handler)
 
 
-def test_instance_gives_sysid_and_offset_ports():
+@pytest.mark.slow
+def test_instance_gives_sysid_and_offset_ports(tmp_path):
     base_api, base_gcs, remote = free_udp_ports(3)
     with _listener(remote + 3) if remote + 3 < 65536 else pytest.skip("no room for the offset port") as sock:
-        proc = _serve("--instance", "3", "--port", str(base_api - 3), "--gcs-port", str(base_gcs - 3),
+        proc = _serve(tmp_path, "--instance", "3", "--port", str(base_api - 3), "--gcs-port", str(base_gcs - 3),
                       "--remote", f"127.0.0.1:{remote}")
         try:
             hb = _first_message(sock)
@@ -91,13 +95,14 @@ def test_instance_gives_sysid_and_offset_ports():
     assert f":{base_api}," in out and f":{base_gcs}," in out
 
 
-def test_port_in_use_is_one_sentence_and_status_2():
+@pytest.mark.slow
+def test_port_in_use_is_one_sentence_and_status_2(tmp_path):
     holder = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     holder.bind(("127.0.0.1", 0))
     port = holder.getsockname()[1]
     try:
         (gcs_port,) = free_udp_ports(1)
-        proc = _serve("--port", str(port), "--gcs-port", str(gcs_port))
+        proc = _serve(tmp_path, "--port", str(port), "--gcs-port", str(gcs_port))
         _out, err = proc.communicate(timeout=10)
     finally:
         holder.close()
@@ -114,9 +119,10 @@ def test_port_in_use_is_one_sentence_and_status_2():
     (("--remote", "nowhere"), "HOST:PORT"),
     (("--wind", "5"), "SPEED@FROM_DEG"),
 ])
-def test_bad_options_are_one_sentence_and_status_2(args, words):
+@pytest.mark.slow
+def test_bad_options_are_one_sentence_and_status_2(args, words, tmp_path):
     api_port, gcs_port = free_udp_ports(2)
-    proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), *args)
+    proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port), *args)
     _out, err = proc.communicate(timeout=10)
     assert proc.returncode == 2
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1 and words in err
@@ -143,13 +149,14 @@ def test_params_file_in_both_formats_sets_parameters(tmp_path):
     assert registry.get("COM_DISARM_LAND") == 3.0
 
 
-def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve():
+@pytest.mark.slow
+def test_a_plain_pymavlink_client_arms_and_takes_off_via_serve(tmp_path):
     """mavutil's own PX4 mode map and arm helper against the real process (run at 5x real time)."""
     from pymavlink import mavutil
 
     api_port, gcs_port, remote = free_udp_ports(3)
     conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{remote}", source_system=255, source_component=190)
-    proc = _serve("--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}",
+    proc = _serve(tmp_path, "--port", str(api_port), "--gcs-port", str(gcs_port), "--remote", f"127.0.0.1:{remote}",
                   "--speed", "5")
     try:
         hb = conn.wait_heartbeat(timeout=10)
@@ -183,6 +190,7 @@ def test_instance_sets_mav_sys_id_like_rcs():
     assert vehicle.sysid == 4 and vehicle.params.get("MAV_SYS_ID") == 4
 
 
+@pytest.mark.slow
 def test_real_time_runner_follows_the_wall_clock_across_a_reboot():
     import threading
 

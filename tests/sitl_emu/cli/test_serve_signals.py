@@ -16,7 +16,8 @@ import pytest
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc/PID/status (Linux)")
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc/PID/status (Linux)")]
 
 
 def _ignore_sigint() -> None:

@@ -20,6 +20,8 @@ from support.ports import free_udp_ports
 from sitl_emu.mavlink.wire.signing import signature_matches, timestamp_from_unix_us
 from sitl_emu.px4 import MavCmd
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 KEY = hashlib.sha256(b"serve signing test").digest()
 
 

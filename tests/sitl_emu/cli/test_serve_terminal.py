@@ -16,6 +16,8 @@ import pytest
 from support.ports import free_udp_ports
 from support.pty_job import PtyJob
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SHUTDOWN_LINE = "PX4 Exiting..."
 UP = "\x1b[A"
 

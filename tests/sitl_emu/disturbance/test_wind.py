@@ -54,12 +54,14 @@ def long_run() -> np.ndarray:
     return np.concatenate([turb.block(50.0, 25_000) for _ in range(100)])
 
 
+@pytest.mark.slow
 def test_variance_matches_the_dryden_intensities_within_10_percent(long_run: np.ndarray):
     s = dryden_scales(49.0 + 1.0, 15.4)  # the filters use the middle of the 2 m band
     assert long_run.var(axis=0) == pytest.approx(np.square(s.sigma), rel=0.10)
     assert abs(long_run.mean(axis=0)).max() < 0.2 * min(s.sigma)
 
 
+@pytest.mark.slow
 def test_spectrum_matches_the_dryden_spectrum(long_run: np.ndarray):
     s = dryden_scales(50.0, 15.4)
     f, p = signal.welch(long_run, fs=1.0 / DT, nperseg=2**16, axis=0)
@@ -134,6 +136,7 @@ def test_hover_in_a_5_m_s_wind_tilts_into_it_and_holds_position():
     assert s.pos_ned_m[2] == pytest.approx(-2.5, abs=0.3)
 
 
+@pytest.mark.slow
 def test_hover_in_turbulence_stays_near_and_calm_air_stays_level():
     v = _hover(WindSettings(3.0, 0.0, 7.7), 30.0)
     s = v.snapshot()
@@ -161,6 +164,7 @@ def test_with_only_the_attitude_controlled_the_wind_carries_the_vehicle_downwind
     assert s.pos_ned_m[1] - e0 > 3.0 and s.vel_ned_m_s[1] > 2.0  # blown east, towards the wind's 5 m/s
 
 
+@pytest.mark.slow
 def test_a_take_off_in_8_m_s_of_wind_drifts_as_far_and_comes_back_as_fast_as_px4_sih():
     """PX4 SIH with SIH_WIND_N = 8 and `commander takeoff` (px4-recorded-facts.md 1): blown 11.1 m downwind (11.2 m in
     a second run), the farthest ~4 s after lift-off, back within 1 m 13 s after that, 39 deg of tilt while it holds.

@@ -19,6 +19,8 @@ from support.log_flight import TAKEOFF_ALT_M, Flight, fly_takeoff_land, log_file
 from sitl_emu.log.topics import default_topics
 from sitl_emu.mavlink.protocols.log import LIST_ALL
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")
 ULog = pyulog.ULog
 

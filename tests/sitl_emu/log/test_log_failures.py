@@ -24,6 +24,7 @@ def _warnings(caplog: pytest.LogCaptureFixture) -> list[str]:
     return [r.getMessage() for r in caplog.records if r.name == LOGGER and r.levelno == logging.WARNING]
 
 
+@pytest.mark.slow
 def test_an_unwritable_log_directory_is_one_warning_and_the_flight_goes_on(tmp_path, caplog):
     blocker = tmp_path / "not-a-directory"
     blocker.write_text("a file where the log directory should be")
@@ -42,6 +43,7 @@ def test_an_unwritable_log_directory_is_one_warning_and_the_flight_goes_on(tmp_p
         flight.sim.close()
 
 
+@pytest.mark.slow
 def test_a_full_disk_ends_the_log_with_one_warning_and_the_next_flight_logs_again(tmp_path, caplog, monkeypatch):
     def full_disk(path: Path):
         path.write_bytes(b"")  # the name is taken, the data never lands (/dev/full: ENOSPC on every write)

@@ -22,6 +22,8 @@ from sitl_emu.log.summary import mode_label, read_ulog, series, summarise
 from sitl_emu.testing.client import fly_square
 from sitl_emu.testing.sim import Sim
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 pytest.importorskip("pyulog", reason="the summary reads logs with pyulog: pip install pyulog (the test extra)")
 
 SIDE_M = 4.0

@@ -19,6 +19,8 @@ from sitl_emu.px4 import MavCmd
 from sitl_emu.testing.sim import Sim
 from sitl_emu.types import VehicleCommand
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SPEED = 4.0
 CALL_TIMEOUT_S = 60.0
 NAN = math.nan

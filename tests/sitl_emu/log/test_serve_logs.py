@@ -20,6 +20,8 @@ from px4common.clock import ScaledClock
 from sitl_emu.mavlink.protocols.log import LIST_ALL
 from sitl_emu.px4 import MavCmd, MavResult
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 pyulog = pytest.importorskip("pyulog", reason="pyulog reads the logs back: pip install pyulog (the test extra)")
 
 SPEED = 5.0

@@ -126,6 +126,7 @@ def test_out_of_range_enums_are_refused_quietly(h):
     _still_serving(h)
 
 
+@pytest.mark.slow
 def test_setpoint_flood_of_10000_per_second_never_stalls_the_step_and_the_peer_is_served():
     """10,000 SET_POSITION_TARGET_LOCAL_NED a second (40 per 4 ms tick) in lockstep: every tick still runs, each
     step_io reads at most its budget (the rest waits in the socket), setpoints are handled, commands answered.

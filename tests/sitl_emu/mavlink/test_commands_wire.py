@@ -178,6 +178,7 @@ def test_request_message_sends_the_message_before_the_ack(h):
     assert (pv.version, pv.min_version, pv.max_version) == (200, 100, 203)
 
 
+@pytest.mark.slow
 def test_seed_sequence_arm_stream_offboard_climb_follow_then_loss_returns(h):
     """The seed workflow: arm, stream setpoints, OFFBOARD, climb, follow, stop streaming -> failsafe AUTO.RTL."""
     target = {"x": 0.0, "z": -5.0, "on": True}

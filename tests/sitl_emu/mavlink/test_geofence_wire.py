@@ -118,6 +118,7 @@ def north(gcs: Gcs) -> float:
     return gcs.seen.pos_ned_m[0]
 
 
+@pytest.mark.slow
 def test_fence_upload_and_breach_with_hold(sim):
     """GF_ACTION 2 (the default): the breach is reported, the failsafe holds at the breach point, arming checks fail
     (SYS_STATUS PRE_ARM unhealthy); the user's mode change (Return) takes over and is flown."""
@@ -146,6 +147,7 @@ def test_fence_upload_and_breach_with_hold(sim):
 
 
 @pytest.mark.parametrize(("action", "mode"), [(3, NavState.AUTO_RTL), (5, NavState.AUTO_LAND)])
+@pytest.mark.slow
 def test_fence_breach_return_or_land_after_the_hold(sim, action, mode):
     gcs = Gcs(sim)
     gcs.wait(lambda: gcs.healthy, 10.0, "healthy")
@@ -167,6 +169,7 @@ def test_fence_breach_return_or_land_after_the_hold(sim, action, mode):
         assert north(gcs) > 25.0
 
 
+@pytest.mark.slow
 def test_max_horizontal_distance_breach_lands(sim):
     gcs = Gcs(sim)
     fly_up(sim, gcs, {"GF_MAX_HOR_DIST": 20.0, "GF_ACTION": 5, "COM_FAIL_ACT_T": 0.0})
@@ -205,6 +208,7 @@ def test_arming_is_refused_while_breached(sim):
                                         "Arming denied: Resolve system health failures first"[:50]]  # 1st chunk
 
 
+@pytest.mark.slow
 def test_rtl_lands_at_the_closest_rally_point(sim):
     gcs = Gcs(sim)
     gcs.wait(lambda: gcs.healthy, 10.0, "healthy")
@@ -258,6 +262,7 @@ def test_a_placeholder_circle_at_0_0_is_stored_and_the_fence_refused(sim, with_c
     assert gcs.texts_after(n0) == invalid
 
 
+@pytest.mark.slow
 def test_reposition_outside_the_fence_is_refused(sim):
     """navigator_main.cpp: a DO_REPOSITION target outside the fence is not flown ("Reposition is outside geofence");
     commander acknowledges the command all the same. A target inside is flown."""

@@ -18,6 +18,9 @@ from support.fakes import Client, Harness
 from sitl_emu.px4 import MavCmd
 from sitl_emu.vehicle.vehicle import Vehicle
 
+# one vehicle flies the cases in order (the module's `pilot`), the last in the air: the module is one slow flight
+pytestmark = pytest.mark.slow
+
 # a copy of ../shared/reference/px4-manual (recorded from real PX4 SITL; see its README)
 CASES: dict[str, Any] = json.loads((Path(__file__).parents[2] / "reference" / "px4-manual" / "cases.json").read_text())
 MODES = {"POSCTL": (3, 0), "ALTCTL": (2, 0), "STABILIZED": (7, 0), "OFFBOARD": (6, 0)}

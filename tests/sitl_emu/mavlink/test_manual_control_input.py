@@ -59,6 +59,7 @@ def _system_status(c: Client) -> int:
     return c.of_type("HEARTBEAT")[-1].system_status
 
 
+@pytest.mark.slow
 def test_a_stream_for_another_system_is_ignored():
     h, c = _vehicle_in_position_mode()
     try:

@@ -24,6 +24,8 @@ from support.fakes import Client, Harness
 from sitl_emu.px4 import MavCmd
 from sitl_emu.vehicle.vehicle import Vehicle
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 REF = Path(__file__).parents[2] / "reference" / "px4-mission"
 CASES: dict[str, Any] = json.loads((REF / "cases.json").read_text())
 METRICS: dict[str, Any] = json.loads((REF / "metrics.json").read_text())["flight1"]

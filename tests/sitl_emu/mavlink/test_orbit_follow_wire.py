@@ -76,6 +76,7 @@ def _track(sim: Sim, c: Client, seconds: float) -> list[tuple[float, float, floa
     return out
 
 
+@pytest.mark.slow
 def test_orbit_around_a_point_then_the_other_way_then_hold(flying):
     sim, c = flying
     lat, lon, _ = _centre(sim)
@@ -124,6 +125,7 @@ def test_orbit_when_disarmed_is_accepted_and_then_prevents_arming():
         c.close()
 
 
+@pytest.mark.slow
 def test_bad_orbit_parameters_get_px4s_answers_and_nothing_flies_off(flying):
     sim, c = flying
     v = sim.vehicle(0)
@@ -166,6 +168,7 @@ def _walk(sim: Sim, c: Client, start: tuple[float, float], vel: tuple[float, flo
     return out
 
 
+@pytest.mark.slow
 def test_follow_a_moving_target_then_lose_its_stream(flying):
     sim, c = flying
     v = sim.vehicle(0)
@@ -185,6 +188,7 @@ def test_follow_a_moving_target_then_lose_its_stream(flying):
     assert c.custom_modes[-1] == custom_mode(NavState.AUTO_FOLLOW_TARGET) and s.armed  # PX4 stays in the mode
 
 
+@pytest.mark.slow
 def test_follow_target_garbage_flies_nowhere(flying):
     sim, c = flying
     assert c.set_mode(NavState.AUTO_FOLLOW_TARGET) == MavResult.ACCEPTED

@@ -95,6 +95,7 @@ def do(cmd: int, *params: float) -> tuple:
 TAKEOFF_ITEM = wp(0, 0, 5.0, cmd=TAKEOFF)
 
 
+@pytest.mark.slow
 def test_hold_pauses_and_auto_mission_resumes_at_the_current_item() -> None:
     f = Flight([TAKEOFF_ITEM, wp(25, 0), wp(25, 25), wp(0, 25)])
     f.start()

@@ -176,6 +176,7 @@ def _session(cwd: Path, *args: str, set_to: float | None = None) -> tuple[float,
     return value, err
 
 
+@pytest.mark.slow
 def test_serve_keeps_a_set_value_across_a_restart_and_params_reset_starts_from_the_defaults(tmp_path):
     assert _session(tmp_path, set_to=7.0)[0] == 2.5
     assert read_file(tmp_path / DEFAULT_FILE)[0][:2] == ("MIS_TAKEOFF_ALT", 7.0)
@@ -185,6 +186,7 @@ def test_serve_keeps_a_set_value_across_a_restart_and_params_reset_starts_from_t
     assert _session(tmp_path)[0] == 2.5
 
 
+@pytest.mark.slow
 def test_serve_with_a_garbage_file_warns_once_and_starts_from_the_defaults(tmp_path):
     (tmp_path / DEFAULT_FILE).write_bytes(b"\x00\x01garbage that is no parameter file\n")
     value, err = _session(tmp_path)

@@ -13,7 +13,9 @@ import signal
 import socket
 import subprocess
 import sys
+from pathlib import Path
 
+import pytest
 from support import REPO_ROOT
 
 from px4common.clock import ScaledClock
@@ -45,10 +47,10 @@ def _free_run(n: int, exclude: tuple[int, ...] = ()) -> int:
     raise RuntimeError("no run of free UDP ports")
 
 
-def _serve_count(count: int, api: int, gcs: int, sink: int) -> subprocess.Popen:
+def _serve_count(cwd: Path, count: int, api: int, gcs: int, sink: int) -> subprocess.Popen:
     args = ["--count", str(count), "--speed", str(SPEED), "--port", str(api), "--gcs-port", str(gcs),
             "--remote", f"127.0.0.1:{sink}", "--gcs-remote", f"127.0.0.1:{sink}"]
-    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+    return subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=cwd,
                             stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
 
@@ -57,11 +59,12 @@ def _east_m(a: tuple[float, float], b: tuple[float, float]) -> float:
     return (b[1] - a[1]) * math.radians(1.0) * 6371000.0 * math.cos(math.radians(a[0]))
 
 
-def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_others():
+@pytest.mark.slow
+def test_count_3_vehicles_answer_on_their_own_ports_and_flying_one_leaves_the_others(tmp_path):
     api = _free_run(3)
     gcs = _free_run(3, (api,))
     sink = _free_run(3, (api, gcs))
-    proc = _serve_count(3, api, gcs, sink)
+    proc = _serve_count(tmp_path, 3, api, gcs, sink)
     clock = ScaledClock(SPEED)
     clients = [FlightClient(("127.0.0.1", api + i), clock, target_sysid=i + 1) for i in range(3)]
     try:

@@ -143,6 +143,7 @@ def test_a_command_wakes_a_batching_runner_at_once(runner_class):
         h.close()
 
 
+@pytest.mark.slow
 def test_batched_ticks_keep_simulated_time_with_fewer_wake_ups():
     h = Harness(FakeVehicle())
     try:
@@ -180,6 +181,7 @@ class _StallingVehicle(FakeVehicle):
 
 
 @pytest.mark.parametrize("swarm", [False, True], ids=["single", "swarm"])
+@pytest.mark.slow
 def test_after_a_host_stall_the_runner_drops_the_lost_time_and_keeps_real_time_again(swarm):
     h = Harness(_StallingVehicle())
     try:

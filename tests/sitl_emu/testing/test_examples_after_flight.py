@@ -17,6 +17,8 @@ from sitl_emu.px4 import MavState, NavState
 from sitl_emu.testing.client import FlightClient, fly_square
 from sitl_emu.testing.sim import Sim
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 EXAMPLES = Path(__file__).parents[3] / "examples"
 SPEED = 8.0  # the examples read with pymavlink's small UDP buffer: faster would drop telemetry
 

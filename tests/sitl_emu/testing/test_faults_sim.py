@@ -92,6 +92,7 @@ def test_motor_off_over_mavlink_the_vehicle_falls():
         client.close()
 
 
+@pytest.mark.slow
 def test_battery_drain_ends_in_return_with_px4_texts():
     with Sim(params={"SIM_BAT_DRAIN": 40.0, "SIM_BAT_MIN_PCT": 6.0}) as sim:
         client = GcsClient(sim.ports(0).api, sim.clock)

@@ -22,6 +22,8 @@ from sitl_emu.testing.mission_client import (
 )
 from sitl_emu.testing.sim import Sim
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 EXAMPLE = Path(__file__).parents[3] / "examples" / "mission_pymavlink.py"
 
 

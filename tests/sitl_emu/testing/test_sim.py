@@ -10,6 +10,7 @@ import math
 import socket
 import time
 
+import pytest
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.px4 import MavCmd, NavState
@@ -39,6 +40,7 @@ def _fly(seed: int = 0, noise_m: float = 0.0, **params: float) -> tuple[object, 
     return result, trace, wall_s, sim
 
 
+@pytest.mark.slow
 def test_scripted_flight_over_loopback_udp_takes_a_small_fraction_of_its_simulated_time():
     result, _, wall_s, sim = _fly()
     sim.close()
@@ -52,6 +54,7 @@ def test_scripted_flight_over_loopback_udp_takes_a_small_fraction_of_its_simulat
     assert wall_s / result.sim_duration_s < 0.5  # generous: typically ~0.05
 
 
+@pytest.mark.slow
 def test_same_script_seed_and_params_give_the_same_trajectory_every_run():
     first, trace_a, _, sim_a = _fly(seed=7, noise_m=0.02)
     second, trace_b, _, sim_b = _fly(seed=7, noise_m=0.02)
@@ -68,6 +71,7 @@ def test_same_script_seed_and_params_give_the_same_trajectory_every_run():
     assert trace_c != trace_a  # the seed does reach the noise
 
 
+@pytest.mark.slow
 def test_params_change_the_flight():
     result, trace, _, sim = _fly(MIS_TAKEOFF_ALT=4.0)
     sim.close()
@@ -75,6 +79,7 @@ def test_params_change_the_flight():
     assert min(z for _, _, _, z, *_ in trace) < -3.5  # the default takeoff altitude is 2.5 m
 
 
+@pytest.mark.slow
 def test_joyfly_session_flies_a_sim_vehicle_on_the_lockstep_clock():
     from joyfly.config import FlyOptions
     from joyfly.demo import script_source

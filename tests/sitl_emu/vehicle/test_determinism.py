@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import pytest
 from support.flights import scripted_flight as _script
 
 from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.vehicle.vehicle import Vehicle
+
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
 
 
 def test_same_inputs_give_identical_runs() -> None:

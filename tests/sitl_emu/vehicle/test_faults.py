@@ -121,6 +121,7 @@ def test_motor_off_with_flight_termination_allowed_the_failure_detector_terminat
     assert (Severity.CRITICAL, "Failsafe activated") in _texts(v, seq)
 
 
+@pytest.mark.slow
 def test_battery_drain_low_critical_return_as_com_low_bat_act_3():
     v = _flying(SIM_BAT_DRAIN=60.0, SIM_BAT_MIN_PCT=6.0)  # stops at 6 %: critical (7 %), never emergency (5 %)
     seq = v.last_event_seq

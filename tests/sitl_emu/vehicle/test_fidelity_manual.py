@@ -154,6 +154,7 @@ def test_yaw_stick_rate_matches_px4(yaw_turn):
     assert max(math.dist(p, p0) for _, p, *_ in rows) < 1.0
 
 
+@pytest.mark.slow
 def test_nav_land_while_sticks_stream_matches_px4(yaw_turn):
     ref, f = PX4["land"], yaw_turn
     f.current = sticks(z=1000)

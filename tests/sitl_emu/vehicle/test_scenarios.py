@@ -226,6 +226,7 @@ def test_offboard_arming_needs_the_stream() -> None:
     assert f.cmd(MavCmd.COMPONENT_ARM_DISARM, 1.0) == MavResult.TEMPORARILY_REJECTED
 
 
+@pytest.mark.slow
 def test_return_lands_at_home_and_disarms() -> None:
     f = Flight()
     f.hover_in_offboard()

@@ -45,6 +45,7 @@ def test_without_it_the_portable_kinds_open_and_a_js_path_is_one_sentence(tmp_pa
 BLOCK = "import sys\nfor m in ('fcntl', 'termios', 'tty', 'pty'):\n    sys.modules[m] = None\n"
 
 
+@pytest.mark.slow
 def test_joyfly_runs_where_there_is_no_fcntl(tmp_path: Path) -> None:
     script = tmp_path / "s.txt"
     script.write_text("0 forward=0.5\n0.1 end\n")

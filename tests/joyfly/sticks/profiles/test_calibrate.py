@@ -47,6 +47,7 @@ def calibrate(pad: VirtualPad, spec: str, layout: dict[str, tuple[int, float, fl
         source.close()
 
 
+@pytest.mark.slow
 def test_the_wizard_learns_axes_reversals_and_buttons(pads: list[VirtualPad]) -> None:
     pads.append(VirtualPad.joystick("Wizard Stick", naxes=4, nbuttons=8, nhats=0, product=0x51))
     profile, _, _ = calibrate(pads[0], "sdl:wizard", GAMEPADISH, BUTTONS)
@@ -56,6 +57,7 @@ def test_the_wizard_learns_axes_reversals_and_buttons(pads: list[VirtualPad]) ->
     assert dict(profile.buttons) == {Action.ARM: 5, Action.TAKEOFF: 2, Action.LAND: 0, Action.OFFBOARD: 7}
 
 
+@pytest.mark.slow
 def test_a_radio_throttle_resting_at_one_end_is_a_non_centring_throttle(pads: list[VirtualPad]) -> None:
     pads.append(VirtualPad.joystick("Wizard Radio", naxes=4, nbuttons=8, nhats=0, product=0x52))
     radio = {"up": (2, 1.0, -1.0), "yaw": (3, 1.0, 0.0), "forward": (1, 1.0, 0.0), "right": (0, 1.0, 0.0)}
@@ -66,6 +68,7 @@ def test_a_radio_throttle_resting_at_one_end_is_a_non_centring_throttle(pads: li
     assert profile.axis("forward").invert is False and not profile.buttons  # type: ignore[union-attr]
 
 
+@pytest.mark.slow
 def test_the_written_profile_is_the_one_joyfly_then_flies_with(pads: list[VirtualPad], tmp_path: Path,
                                                                monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("JOYFLY_PROFILES", str(tmp_path))

@@ -17,6 +17,8 @@ from typing import Any
 import pytest
 from support.serve_process import load_mavsdk, serve
 
+pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`
+
 SPEED = 4.0
 CALL_TIMEOUT_S = 20.0
 

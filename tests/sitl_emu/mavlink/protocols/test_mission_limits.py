@@ -73,6 +73,7 @@ def _upload(sim: Sim, client: Client, count: int, stop_after: int | None = None)
         sent += 1
 
 
+@pytest.mark.slow
 def test_ten_thousand_items_are_stored_and_one_more_is_no_space(sim: Sim) -> None:
     limit = MAX_ITEMS[0]
     assert limit == 10_000

@@ -173,6 +173,7 @@ def test_at_rest_outputs_are_disarmed_and_the_escs_idle(tap):
     assert (info["count"], info["info"], info["temperature"]) == (4, 0b1111, [2000] * 4)
 
 
+@pytest.mark.slow
 def test_in_flight_outputs_follow_the_mixer_and_the_escs_the_motors(tap):
     _takeoff(tap)
     assert tap.h.vehicle.snapshot().landed_state == 2  # hovering

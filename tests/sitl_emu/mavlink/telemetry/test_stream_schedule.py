@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import random
 
+import pytest
+
 from sitl_emu.mavlink.telemetry import streams as telemetry
 from sitl_emu.mavlink.telemetry.streams import HEARTBEAT_ID, HEARTBEAT_INTERVAL_US, StreamMode, Streams
 
@@ -88,6 +90,7 @@ def _run(mode: StreamMode, seed: int, start_delay_us: int = 0) -> tuple[list[lis
     return got, expected
 
 
+@pytest.mark.slow
 def test_streams_send_what_a_table_scan_sends_through_rate_changes_and_reboots():
     for mode in StreamMode:
         for seed in range(3):

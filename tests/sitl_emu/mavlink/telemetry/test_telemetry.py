@@ -135,6 +135,7 @@ def test_landed_state_timesync_and_system_time(h):
     assert vfr.throttle == 0 and vfr.alt == pytest.approx(HOME[2], abs=0.2) and math.isnan(vfr.airspeed)
 
 
+@pytest.mark.slow
 def test_offboard_flight_reports_setpoint_and_intended_mode(h):
     n = {"i": 0}
 
