@@ -10,12 +10,11 @@ STAMP := $(VENV)/.installed-test
 
 .PHONY: demo test test-fast test-compiled compiled-check lint bench clean speedups clean-speedups
 
-# Two pytest workers (pytest-xdist) for the tests that can run side by side; the `serial` ones (tests/conftest.py)
-# run alone after them (pytest's status 5, "no test selected", is not a failure there). A module's tests stay on one
-# worker (--dist loadfile), so a module's fixture runs once. `make test TEST_WORKERS=0`: one process.
+# Two pytest workers (pytest-xdist): every test picks free ports and writes only under tmp_path, so they run side by
+# side. A module's tests stay on one worker (--dist loadfile), so a module's fixture runs once.
+# `make test TEST_WORKERS=0`: one process.
 TEST_WORKERS ?= 2
 PARALLEL = -n $(TEST_WORKERS) --dist loadfile
-NONE_SELECTED_IS_OK = || [ $$? -eq 5 ]
 
 $(DEMO_STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -33,8 +32,7 @@ demo: $(DEMO_STAMP)
 test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy sitl_emu joyfly flightview px4common
-	$(BIN)/python -m pytest -q $(PARALLEL) -m "not serial"
-	$(BIN)/python -m pytest -q -m serial $(NONE_SELECTED_IS_OK)
+	$(BIN)/python -m pytest -q $(PARALLEL)
 	$(MAKE) test-compiled
 
 # The edit-test loop: every test but the `slow` ones (subprocesses, MAVSDK, MAVProxy, the browser, SDL and long
@@ -56,8 +54,7 @@ compiled-check:
 	cp -r sitl_emu joyfly flightview px4common tests tools examples pyproject.toml README.md $(CHECK_DIR)/
 	cp setup.py MANIFEST.in $(CHECK_DIR)/  # the wheel build test (tests/sitl_emu/test_speedups_build.py)
 	cd $(CHECK_DIR) && $(abspath $(BIN))/python tools/build_speedups.py
-	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider $(PARALLEL) -m "compiled and not serial"
-	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider -m "compiled and serial" $(NONE_SELECTED_IS_OK)
+	cd $(CHECK_DIR) && $(abspath $(BIN))/python -m pytest -q -p no:cacheprovider $(PARALLEL) -m compiled
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

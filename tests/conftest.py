@@ -8,7 +8,7 @@ the flight log, the disturbances; COMPILED_FILES: the kernel's) get the `compile
 
 Two tiers: `slow` marks the tests that start processes (serve, joyfly, MAVSDK, MAVProxy, a browser, an SDL pilot)
 or fly long end-to-end flights; `make test-fast` runs the others (`pytest -m "not slow"`), `make test` all of them,
-on two xdist workers, then the `serial` ones alone (a test that cannot share the machine with another).
+on two xdist workers.
 
 Every test must leave the checkout as it found it (servers run in tmp_path): `_leaves_no_files_in_the_checkout` fails
 the one that does not.
@@ -35,7 +35,6 @@ COMPILED_FILES = (_SITL_EMU_TESTS / "test_geo.py", _SITL_EMU_TESTS / "test_physi
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "compiled: a test run again against the compiled build (make compiled-check)")
     config.addinivalue_line("markers", "slow: starts processes or flies long end-to-end: not in `make test-fast`")
-    config.addinivalue_line("markers", "serial: cannot run beside another test: `make test` runs it alone, after")
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
