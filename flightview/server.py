@@ -113,6 +113,15 @@ def _die_with_parent() -> None:
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
+def terminate_session(process: subprocess.Popen[bytes]) -> None:
+    """SIGTERM to the viewer's session (start_new_session: the viewer and anything it started) where process
+    groups exist (POSIX); elsewhere (Windows: no os.killpg, no sessions) the viewer alone is terminated."""
+    if hasattr(os, "killpg"):
+        os.killpg(process.pid, signal.SIGTERM)
+    else:
+        process.terminate()
+
+
 def display_available() -> bool:
     """Whether a browser could show a window here (no display on a headless Linux box or over plain ssh)."""
     if sys.platform in ("darwin", "win32"):
@@ -140,7 +149,7 @@ class ViewerServer:
     def stop(self) -> None:
         if self.process.poll() is None:
             with contextlib.suppress(OSError):
-                os.killpg(self.process.pid, signal.SIGTERM)  # its own session: the viewer and anything it started
+                terminate_session(self.process)
             try:
                 self.process.wait(5.0)
             except subprocess.TimeoutExpired:

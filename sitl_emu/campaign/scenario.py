@@ -57,6 +57,12 @@ class SimTimeLimit(BaseException):
     """
 
 
+class WallTimeLimit(BaseException):
+    """Raised in the case that passed its wall-time limit: by SIGALRM in the serial engine where there is one, else by
+    the Sim's next step after the deadline (engines/serial.py). A BaseException for the same reason as SimTimeLimit.
+    """
+
+
 def scenario_ref(scenario: str | Callable[..., Any]) -> str:
     """The text form of a scenario, which every worker can load: `module:function` or `path.py:function`."""
     if isinstance(scenario, str):
@@ -137,8 +143,11 @@ def sim_options(options: Mapping[str, Any], sim_class: Any) -> dict[str, Any]:
     return {k: v for k, v in options.items() if k in accepted and k not in SIM_KEYWORDS_TAKEN}
 
 
-def run_case(ref: str, case: Case, limits: Limits) -> Row:
-    """Fly `case` with the scenario `ref` in this process; never raises for the case's own failures."""
+def run_case(ref: str, case: Case, limits: Limits, wall_deadline_s: float | None = None) -> Row:
+    """Fly `case` with the scenario `ref` in this process; never raises for the case's own failures.
+
+    `wall_deadline_s` (a time.perf_counter() value): a step of the Sim after it raises WallTimeLimit, which is not
+    caught here (the serial engine's wall-time limit where there is no SIGALRM)."""
     from sitl_emu.testing import Sim
 
     start = time.perf_counter()
@@ -146,7 +155,7 @@ def run_case(ref: str, case: Case, limits: Limits) -> Row:
     try:
         scenario = load_scenario(ref)
         with Sim(params=case.params, seed=case.seed, **sim_options(case.options, Sim)) as sim:
-            _limit_sim_time(sim, limits.sim_s)
+            _limit_steps(sim, limits.sim_s, wall_deadline_s)
             try:
                 outcome = scenario(sim, case)
             finally:
@@ -160,15 +169,18 @@ def run_case(ref: str, case: Case, limits: Limits) -> Row:
     return row
 
 
-def _limit_sim_time(sim: Any, limit_s: float | None) -> None:
-    """Make every step of `sim` past `limit_s` raise SimTimeLimit (run_for, run_until and sim.clock all step here)."""
-    if limit_s is None:
+def _limit_steps(sim: Any, limit_s: float | None, wall_deadline_s: float | None = None) -> None:
+    """Make every step of `sim` past `limit_s` raise SimTimeLimit, and every step after the wall-clock deadline raise
+    WallTimeLimit (run_for, run_until and sim.clock all step here)."""
+    if limit_s is None and wall_deadline_s is None:
         return
     advance = sim.advance_to
-    limit_us = round(limit_s * 1e6)
+    limit_us = None if limit_s is None else round(limit_s * 1e6)
 
     def limited(target_us: int) -> None:
-        if target_us > limit_us:
+        if wall_deadline_s is not None and time.perf_counter() > wall_deadline_s:
+            raise WallTimeLimit
+        if limit_us is not None and target_us > limit_us:
             advance(limit_us)
             raise SimTimeLimit
         advance(target_us)

@@ -8,6 +8,10 @@ runs, SIGTTIN and SIGTTOU are ignored: a read that races with `bg` then fails wi
 foreground) instead of stopping the process. A terminal that is not the controlling one (tcgetpgrp fails) is not
 read at all.
 
+Job control and select() on a terminal are POSIX: on Windows (no os.tcgetpgrp, no SIGTTIN, select() takes sockets
+only) `posix_terminal()` is False, the console is always in the foreground and blocks in its reader thread's
+readline() instead (a daemon thread: it does not keep the process alive at the end).
+
 Readline gives line editing, history (in memory only: nothing is written to the user's home) with PX4's
 "commander takeoff" already in it (pxh.cpp Pxh::Pxh adds it "for convenience"), and Tab completion of command
 names (as pxh.cpp _tab_completion). Where readline is missing the terminal is read line by line.
@@ -40,8 +44,18 @@ POLL_S = 0.2  # how often a background console looks whether it is in the foregr
 TAKEOFF_HISTORY = "commander takeoff"  # pxh.cpp: _history.try_to_add("commander takeoff"); // for convenience
 
 
+def posix_terminal() -> bool:
+    """Whether the platform has job control on its terminals and select() on them (POSIX: Linux, macOS), the seam
+    between the two ways of reading the terminal."""
+    return (os.name == "posix" and hasattr(os, "tcgetpgrp") and hasattr(os, "getpgrp")
+            and hasattr(signal, "SIGTTIN") and hasattr(signal, "SIGTTOU"))
+
+
 def is_foreground(fd: int) -> bool:
-    """True if this process is the foreground job of the terminal `fd` (False if `fd` is not our terminal)."""
+    """True if this process is the foreground job of the terminal `fd` (False if `fd` is not our terminal); always
+    True where there is no job control."""
+    if not posix_terminal():
+        return True
     try:
         return os.tcgetpgrp(fd) == os.getpgrp()
     except OSError:
@@ -62,6 +76,8 @@ class JobControlGuard:
         self._previous: dict[int, Any] = {}
 
     def install(self) -> None:
+        if not posix_terminal():  # no background jobs to guard against
+            return
         for sig in (signal.SIGTTIN, signal.SIGTTOU):
             try:
                 self._previous[sig] = signal.signal(sig, signal.SIG_IGN)
@@ -100,7 +116,7 @@ class _TerminalWait:
         """Block until a line (or an EOF) is waiting for us in the foreground; False when the console is stopped."""
         while self.until_foreground():
             fd = self.fd
-            if fd is None or not self.tty:
+            if fd is None or not self.tty or not posix_terminal():  # Windows: block in readline() instead
                 return True
             try:
                 readable = select.select([fd], [], [], POLL_S)[0]
@@ -189,7 +205,7 @@ class ReadlineInput:
         """A line typed while a command runs (the terminal is in its normal line mode then), or None."""
         fd = self.wait.fd
         assert fd is not None
-        if not self.wait.foreground or not select.select([fd], [], [], 0)[0]:
+        if not posix_terminal() or not self.wait.foreground or not select.select([fd], [], [], 0)[0]:
             return None
         try:
             return os.read(fd, 4096).decode("utf-8", errors="replace").rstrip("\r\n")

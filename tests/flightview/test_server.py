@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+import time
 from typing import Any
 
 import pytest
@@ -53,3 +55,56 @@ def test_a_privileged_port_is_not_called_in_use(monkeypatch: pytest.MonkeyPatch)
     with pytest.raises(server.ViewError) as info:
         server.check_port_free(80)
     assert "needs administrator rights" in str(info.value) and "in use" not in str(info.value)
+
+
+CHILD_WITH_GRANDCHILD = ("import subprocess, sys, time\n"
+                         "g = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(60)'])\n"
+                         "print(g.pid, flush=True)\n"
+                         "time.sleep(60)\n")
+
+
+def _viewer_like() -> tuple[subprocess.Popen[bytes], int]:
+    process = subprocess.Popen([sys.executable, "-c", CHILD_WITH_GRANDCHILD], stdout=subprocess.PIPE,
+                               start_new_session=True)
+    assert process.stdout is not None
+    return process, int(process.stdout.readline())
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    with open(f"/proc/{pid}/stat") as stat:  # a zombie (not yet reaped by init) counts as ended
+        return stat.read().split(") ")[1][0] != "Z"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the POSIX side, checked through /proc (CI is Linux)")
+def test_stopping_the_viewer_ends_its_whole_session_where_there_are_process_groups() -> None:
+    process, grandchild = _viewer_like()
+    server.terminate_session(process)
+    assert process.wait(10) == -15
+    for _ in range(200):
+        if not _alive(grandchild):
+            break
+        time.sleep(0.02)
+    assert not _alive(grandchild)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="simulated on Linux (CI is Linux)")
+def test_without_process_groups_the_viewer_alone_is_terminated(monkeypatch: pytest.MonkeyPatch) -> None:
+    process, grandchild = _viewer_like()
+    monkeypatch.delattr(os, "killpg")  # Windows
+    try:
+        server.terminate_session(process)
+        assert process.wait(10) == -15
+    finally:
+        os.kill(grandchild, 9)
+
+
+def test_the_death_signal_is_asked_for_only_where_prctl_exists(monkeypatch: pytest.MonkeyPatch) -> None:
+    class NoPrctl:  # macOS's libc
+        def __init__(self, *args: Any, **kwargs: Any) -> None:
+            pass
+    monkeypatch.setattr(server.ctypes, "CDLL", NoPrctl)
+    server._die_with_parent()  # nothing raised in the child before exec

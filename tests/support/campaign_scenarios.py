@@ -34,6 +34,11 @@ def misbehave(sim: Any, case: Case) -> Outcome:
         if behave == "sim_hang":
             while True:
                 sim.run_for(1.0)
+        if behave == "slow_steps":  # wall time passes between the Sim's steps; gives up after 5 s
+            end = time.perf_counter() + 5.0
+            while time.perf_counter() < end:
+                sim.run_for(0.01)
+                time.sleep(0.01)
         if behave == "die":
             os._exit(3)
         if behave == "fail":

@@ -25,11 +25,13 @@ class Engine(Protocol):
 
 
 def default_workers() -> int:
-    """One worker per core this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
+    """One worker per core this process may use: its CPU affinity where the OS tells it (Linux), else
+    os.process_cpu_count (Python 3.13+, the same where it can be known), else every core (macOS, Windows)."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    if affinity is not None:
+        return max(1, len(affinity(0)))
+    counted = getattr(os, "process_cpu_count", os.cpu_count)
+    return max(1, counted() or 1)
 
 
 def make_engine(name: str, workers: int | None = None, address: str | None = None) -> Engine:

@@ -1,7 +1,9 @@
 """The serial engine: every case in this process, one after another (tracebacks and debuggers work as usual).
 
-The wall-time limit needs SIGALRM (POSIX, main thread); elsewhere only the simulated-time limit applies. A case that
-kills its process kills the campaign here: use the local engine for such cases.
+The wall-time limit is SIGALRM where there is one (POSIX, in the main thread): it interrupts the case wherever it is.
+Elsewhere (Windows, another thread) the case's Sim checks the deadline before each step (scenario.run_case), so a
+case stuck outside the Sim is not stopped there. A case that kills its process kills the campaign here: use the
+local engine for such cases.
 """
 
 from __future__ import annotations
@@ -14,13 +16,9 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 from sitl_emu.campaign.cases import Case
-from sitl_emu.campaign.scenario import Limits, Row, failure_row, run_case
+from sitl_emu.campaign.scenario import Limits, Row, WallTimeLimit, failure_row, run_case
 
 __all__ = ["SerialEngine"]
-
-
-class WallTimeLimit(BaseException):
-    """Raised by SIGALRM in the case that passed its wall-time limit."""
 
 
 class SerialEngine:
@@ -28,19 +26,28 @@ class SerialEngine:
         for case in cases:
             start = time.perf_counter()
             try:
-                with _alarm(limits.wall_s):
-                    row = run_case(ref, case, limits)
+                with _alarm(limits.wall_s) as deadline_s:
+                    row = run_case(ref, case, limits, deadline_s)
             except WallTimeLimit:
                 row = failure_row("timeout", f"the case passed its limit of {limits.wall_s:g} wall seconds.")
                 row.update(sim_s=None, wall_s=round(time.perf_counter() - start, 3))
             yield case, row
 
 
-@contextlib.contextmanager
-def _alarm(seconds: float | None) -> Iterator[None]:
+def alarm_available() -> bool:
+    """The seam: can SIGALRM end the case here (POSIX, the main thread)?"""
     main_thread = threading.current_thread() is threading.main_thread()
-    if seconds is None or not hasattr(signal, "setitimer") or not main_thread:
-        yield
+    return hasattr(signal, "setitimer") and hasattr(signal, "SIGALRM") and main_thread
+
+
+@contextlib.contextmanager
+def _alarm(seconds: float | None) -> Iterator[float | None]:
+    """SIGALRM after `seconds` (yields None); where there is none, yields the deadline for the Sim's steps."""
+    if seconds is None:
+        yield None
+        return
+    if not alarm_available():
+        yield time.perf_counter() + seconds
         return
 
     def expire(signum: int, frame: Any) -> None:
@@ -49,7 +56,7 @@ def _alarm(seconds: float | None) -> Iterator[None]:
     previous = signal.signal(signal.SIGALRM, expire)
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
-        yield
+        yield None
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
