@@ -3,6 +3,7 @@ also to a venv `make demo` made. Checked with `make -n` (what make would run) in
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -15,7 +16,9 @@ pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="make is no
 
 def planned(workdir: Path, target: str) -> str:
     """The commands `make TARGET` would run in `workdir` (a copy of the Makefile and pyproject.toml)."""
-    done = subprocess.run(["make", "-n", target], cwd=workdir, capture_output=True, text=True, timeout=30)
+    env = {k: v for k, v in os.environ.items() if k not in ("MAKELEVEL", "MAKEFLAGS", "MFLAGS")}  # run by make test
+    done = subprocess.run(["make", "-n", "--no-print-directory", target], cwd=workdir, env=env, capture_output=True,
+                          text=True, timeout=30)
     assert done.returncode == 0, done.stderr
     return done.stdout
 

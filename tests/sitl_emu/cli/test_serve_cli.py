@@ -60,7 +60,8 @@ def test_serve_sends_px4_heartbeats_to_both_remotes_then_exits_cleanly_on_sigter
     assert proc.returncode == 0
     assert "Traceback" not in err
     lines = out.strip().splitlines()
-    assert len(lines) == 3 and lines[1:] == ["", "PX4 Exiting..."]  # PX4's shutdown line (main.cpp), after "\n"
+    assert len(lines) == 4 and lines[1].startswith("sitl-emu: core: ")  # the vehicle, then which build runs
+    assert lines[2:] == ["", "PX4 Exiting..."]  # PX4's shutdown line (main.cpp), after "\n"
     assert f"{api_port}" in lines[0] and f"{api_remote}" in lines[0] and f"{gcs_port}" in lines[0]
 
 

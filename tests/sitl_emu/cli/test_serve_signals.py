@@ -75,6 +75,7 @@ def test_sigint_after_start_up_ends_serve_though_started_with_it_ignored(tmp_pat
     proc = _serve(tmp_path)
     assert proc.stdout is not None
     assert "PX4 quadrotor sysid 1" in proc.stdout.readline()  # up and running
+    assert proc.stdout.readline().startswith("sitl-emu: core: ")  # which build runs
     time.sleep(0.2)
     proc.send_signal(signal.SIGINT)
     assert _ended(proc).startswith("\nPX4 Exiting")  # what is left after the first line
