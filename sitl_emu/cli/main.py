@@ -293,9 +293,8 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     runner = RealTimeRunner(nodes, speed=speed) if count == 1 else SwarmRunner(nodes, speed=speed)
     runner.min_wake_s = wake_period_s(batch_ms, speed)
     signals.stop_with(runner.stop)  # a signal from now on (or one already received) stops the loop, or never starts it
-    for node in nodes:
-        click.echo(f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}")
-    click.echo(f"sitl-emu: {build_line()}")  # after the vehicles' lines, which scripts read first
+    up = [f"sitl-emu: PX4 quadrotor sysid {node.sysid}: {node.describe()}" for node in nodes]
+    click.echo("\n".join([*up, f"sitl-emu: {build_line()}"]))  # the build after the vehicles, which scripts read first
     sys.stdout.flush()
     runner.hooks.extend(store.autosave for store in stores)  # PX4 saves shortly after every change (param_autosave)
     live = None if runner.stopped else start_view(vehicles, nodes, view, runner)

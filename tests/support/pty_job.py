@@ -25,14 +25,15 @@ REPO = Path(__file__).resolve().parents[2]  # this file also runs as a script: n
 
 
 class PtyJob:
-    def __init__(self, serve_args: list[str], foreground: bool, readline: bool = True) -> None:
+    def __init__(self, serve_args: list[str], foreground: bool, cwd: Path, readline: bool = True) -> None:
+        """`cwd`: where serve keeps its logs and parameter file (a test's tmp_path, never the checkout)."""
         self._master, slave = os.openpty()
         control_r, self._control = os.pipe()
         pid_r, pid_w = os.pipe()
         self.helper = subprocess.Popen(
             [sys.executable, __file__, str(control_r), str(pid_w), "fg" if foreground else "bg",
              "readline" if readline else "no-readline", *serve_args],
-            stdin=slave, stdout=slave, stderr=slave, pass_fds=(control_r, pid_w), cwd=REPO,
+            stdin=slave, stdout=slave, stderr=slave, pass_fds=(control_r, pid_w), cwd=cwd,
             env={**os.environ, "PYTHONPATH": str(REPO), "TERM": "xterm"})
         os.close(slave)
         os.close(control_r)

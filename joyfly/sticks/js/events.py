@@ -146,3 +146,12 @@ class JsStreamCheck:
         if count and ev.number >= count:
             return f"{word} {ev.number}, where the joystick has {count} {word if count == 1 else words}"
         return None
+
+
+def no_such_device_error(path: str, dev_dir: str, present: list[str]) -> JoystickError:
+    """No joystick at `path`: name the ones `present` in `dev_dir`, or say how to fly without one."""
+    others = [p for p in present if p != path]
+    if others:
+        return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
+    return NoDeviceError(f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a "
+                         "virtual one with --joy script:examples/joystick_script.txt.")

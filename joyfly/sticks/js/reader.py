@@ -42,6 +42,7 @@ from joyfly.sticks.js.events import (
     JsStreamCheck,
     NoDeviceError,
     PermissionDeniedError,
+    no_such_device_error,
     not_js_events_error,
     pack_event,
     parse_events,
@@ -82,14 +83,6 @@ JSIOCGBUTTONS = _ior(0x12, 1)
 JSIOCGNAME = _ior(0x13, NAME_LEN)
 
 
-def no_such_device_error(path: str, dev_dir: str = "/dev/input") -> JoystickError:
-    others = [p for p in find_device_paths(dev_dir) if p != path]
-    if others:
-        return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
-    return NoDeviceError(f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a "
-                         "virtual one with --joy script:examples/joystick_script.txt.")
-
-
 # ---------------------------------------------------------------------------------------------------------- device
 
 
@@ -106,12 +99,12 @@ def _open_fd(path: str, dev_dir: str = "/dev/input") -> int:
     try:
         return os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except FileNotFoundError:
-        raise no_such_device_error(path, dev_dir) from None
+        raise no_such_device_error(path, dev_dir, find_device_paths(dev_dir)) from None
     except PermissionError:
         raise permission_error(path) from None
     except OSError as exc:
         if exc.errno in (errno.ENODEV, errno.ENXIO):
-            raise no_such_device_error(path, dev_dir) from None
+            raise no_such_device_error(path, dev_dir, find_device_paths(dev_dir)) from None
         raise JoystickError(f"Cannot open {path} ({exc.strerror}): check the path given with --joy.") from None
 
 
@@ -327,8 +320,12 @@ class JsDevice:
         return bool(events)
 
     def _refuse(self, why: str) -> None:
-        self.refused = self.last_error = not_js_events_error(self.path, self._check.records, why)
-        log.warning("%s", self.refused)
+        self._give_up(not_js_events_error(self.path, self._check.records, why))
+
+    def _give_up(self, error: JoystickError) -> None:
+        """Stop reading for good: what this source sends is no joystick's (`gone` says why)."""
+        self.refused = self.last_error = error
+        log.warning("%s", error)
         self._close_fd()
         self.connected = False
 
@@ -342,15 +339,9 @@ class JsDevice:
                 self.last_error = vanished_error(self.path)
                 log.warning("%s", self.last_error)
             return
-        if self.raw and self._check.records == 0:
-            # A joystick never reads empty (it blocks, or fails when unplugged): a character device that ends before
-            # its first record, such as /dev/null, carries no js_events and never will.
-            self.refused = self.last_error = JoystickError(
-                f"raw:{self.path} ended before its first js_event record (it reads empty), so it is not a joystick: "
-                f"pass {JOYSTICKS}.")
-            log.warning("%s", self.refused)
-            self._close_fd()
-            self.connected = False
+        if self.raw and self._check.records == 0:  # a joystick never reads empty (it blocks, or fails unplugged)
+            self._give_up(JoystickError(f"raw:{self.path} ended before its first js_event record (it reads empty), so "
+                                        f"it is not a joystick: pass {JOYSTICKS}."))
             return
         self._lost(OSError(errno.ENODEV, "end of device"))
 
@@ -405,5 +396,5 @@ def default_device(dev_dir: str = "/dev/input") -> str:
     """The first js device present, or a JoystickError saying none is connected."""
     paths = find_device_paths(dev_dir)
     if not paths:
-        raise no_such_device_error(os.path.join(dev_dir, "js0"), dev_dir)
+        raise no_such_device_error(os.path.join(dev_dir, "js0"), dev_dir, [])
     return paths[0]

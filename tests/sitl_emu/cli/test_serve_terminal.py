@@ -43,11 +43,11 @@ def _ctrl_z(job: PtyJob) -> None:
 
 
 @pytest.fixture()
-def jobs():
+def jobs(tmp_path):
     started: list[PtyJob] = []
 
     def start(foreground: bool, *args: str, readline: bool = True) -> PtyJob:
-        job = PtyJob([*_ports_args(), *args], foreground, readline)
+        job = PtyJob([*_ports_args(), *args], foreground, tmp_path, readline)
         started.append(job)
         assert job.wait_for("sitl-emu: PX4 quadrotor sysid"), job.output
         return job
