@@ -13,6 +13,13 @@ from pathlib import Path
 
 KEY_LEN = 32  # MAVLink 2's secret key (mavlink_signing_t.secret_key)
 PX4_KEY_FILE_LEN = KEY_LEN + 8  # PX4's file: the key, then the uint64 timestamp
+EPOCH_2015_UNIX_US = 1_420_070_400_000_000  # signing timestamps count 10 us from 2015-01-01 (MAVLink 2 signing)
+TIMESTAMP_MAX = (1 << 48) - 1  # the signature block's 48-bit timestamp
+
+
+def timestamp_from_unix_us(unix_us: int) -> int:
+    """The signing timestamp (10 us since 2015) of a Unix time in microseconds; 0 before 2015."""
+    return min(max(unix_us - EPOCH_2015_UNIX_US, 0) // 10, TIMESTAMP_MAX)
 
 
 class SigningKeyError(Exception):

@@ -14,14 +14,15 @@ from __future__ import annotations
 import time
 from typing import Any
 
-EPOCH_2015_UNIX_US = 1_420_070_400_000_000  # signing timestamps count 10 us from 2015-01-01
+from px4common.signing_key import timestamp_from_unix_us
+
 HEARTBEAT_ID = 0
 LINK_ID = 0
 
 
 def wall_timestamp() -> int:
     """Now as a signing timestamp (10 us since 2015): a vehicle refuses a new stream more than a minute behind."""
-    return max(time.time_ns() // 1000 - EPOCH_2015_UNIX_US, 0) // 10
+    return timestamp_from_unix_us(time.time_ns() // 1000)
 
 
 def sign_with(mav: Any, key: bytes) -> None:

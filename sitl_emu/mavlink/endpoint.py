@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
+from px4common.signing_key import KEY_LEN
 from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, vehicle_news
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
@@ -23,7 +24,7 @@ from sitl_emu.mavlink.receiver import Receiver
 from sitl_emu.mavlink.signing import ARMED_TEXT, MavlinkSigning, SetupResult
 from sitl_emu.mavlink.telemetry.streams import SharedBuilds, StreamMode, Streams
 from sitl_emu.mavlink.wire.fastpack import ENCODER, frame_message
-from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, KEY_LEN, is_signed
+from sitl_emu.mavlink.wire.signing import IFLAG_SIGNED, is_signed
 from sitl_emu.px4 import Severity
 
 if TYPE_CHECKING:

@@ -30,6 +30,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Final
 
+from px4common.signing_key import KEY_LEN, timestamp_from_unix_us
 from sitl_emu.mavlink.wire import signing as wire
 
 log = logging.getLogger(__name__)
@@ -41,7 +42,7 @@ UNSIGNED_ACCEPTED: Final = frozenset({0, 109, 246, 247})
 NEW_STREAM_MAX_AGE: Final = 6_000_000  # one minute in signing-timestamp units (10 us)
 MAX_STREAMS: Final = 16  # MAVLINK_MAX_SIGNING_STREAMS
 ARMED_TEXT: Final = "MAVLink signing: rejected while armed"
-NO_KEY: Final = bytes(wire.KEY_LEN)
+NO_KEY: Final = bytes(KEY_LEN)
 
 
 class SetupResult(enum.Enum):
@@ -79,10 +80,10 @@ class MavlinkSigning:
             data = self.key_file.read_bytes()
         except OSError as err:
             return f"cannot read the MAVLink signing key {self.key_file}: {err.strerror or err}"
-        if len(data) < wire.KEY_LEN + TIMESTAMP_LEN:
+        if len(data) < KEY_LEN + TIMESTAMP_LEN:
             return f"{self.key_file} is not a MAVLink signing key file (40 bytes): signing stays off"
-        stored = int.from_bytes(data[wire.KEY_LEN:wire.KEY_LEN + TIMESTAMP_LEN], "little")
-        self._apply(data[:wire.KEY_LEN], max(stored, self._wall(now_unix_us)) if _enabled(data, stored) else 0)
+        stored = int.from_bytes(data[KEY_LEN:KEY_LEN + TIMESTAMP_LEN], "little")
+        self._apply(data[:KEY_LEN], max(stored, self._wall(now_unix_us)) if _enabled(data, stored) else 0)
         return None
 
     def provision(self, key: bytes, now_unix_us: int = 0) -> None:
@@ -118,9 +119,9 @@ class MavlinkSigning:
             data = self.key_file.read_bytes() if self.key_file is not None else b""
         except OSError:
             return None
-        if len(data) < wire.KEY_LEN + TIMESTAMP_LEN:
+        if len(data) < KEY_LEN + TIMESTAMP_LEN:
             return None
-        return data[:wire.KEY_LEN], int.from_bytes(data[wire.KEY_LEN:wire.KEY_LEN + TIMESTAMP_LEN], "little")
+        return data[:KEY_LEN], int.from_bytes(data[KEY_LEN:KEY_LEN + TIMESTAMP_LEN], "little")
 
     def _store(self, state: tuple[bytes, int]) -> SetupResult:
         """Write the file (atomically, mode 600), then use the key."""
@@ -141,7 +142,7 @@ class MavlinkSigning:
 
     def _wall(self, now_unix_us: int) -> int:
         unix_us = self.wall_clock_us() if self.wall_clock_us is not None else now_unix_us
-        return wire.timestamp_from_unix_us(unix_us)
+        return timestamp_from_unix_us(unix_us)
 
     # --- messages ------------------------------------------------------------------------------------------------
     def sign(self, frame: bytes, link_id: int, now_unix_us: int) -> bytes:

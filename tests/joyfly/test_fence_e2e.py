@@ -8,7 +8,6 @@ joyfly: where it went and which mode it flew in.
 
 from __future__ import annotations
 
-import errno
 import os
 import subprocess
 import sys
@@ -21,6 +20,7 @@ from pathlib import Path
 import pytest
 from pymavlink import mavutil
 from support import REPO_ROOT
+from support.fifo import open_writer
 from support.ports import free_udp_ports
 
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
@@ -132,18 +132,6 @@ def test_wind_carries_the_vehicle_out_of_the_fence_joyfly_warns_lands_it_and_exi
     assert not gcs.modes[-1][2], gcs.modes
 
 
-def _open_writer(fifo: Path, timeout_s: float) -> int:
-    """The FIFO's writing end, once joyfly holds the reading end (until then the open fails with ENXIO)."""
-    give_up = time.monotonic() + timeout_s
-    while True:
-        try:
-            return os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
-        except OSError as err:
-            if err.errno != errno.ENXIO or time.monotonic() > give_up:
-                raise
-            time.sleep(0.05)
-
-
 def test_in_position_mode_too_the_wind_carried_vehicle_is_warned_landed_and_exits_3(tmp_path: Path) -> None:
     ports = free_udp_ports(4)
     joy_port, emu_port, _, gcs_remote = ports
@@ -160,7 +148,7 @@ def test_in_position_mode_too_the_wind_carried_vehicle_is_warned_landed_and_exit
     log = lambda: "".join(out)  # noqa: E731
     fd = -1
     try:
-        fd = _open_writer(fifo, 20.0)
+        fd = open_writer(fifo, 20.0)
         for index in range(7):
             os.write(fd, pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, index, 0))
         for index in range(4):

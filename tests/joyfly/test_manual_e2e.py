@@ -7,7 +7,6 @@ x4) keeps a busy machine from starving it into an RC-loss failsafe, as in test_f
 
 from __future__ import annotations
 
-import errno
 import os
 import re
 import signal
@@ -22,6 +21,7 @@ from pathlib import Path
 import pytest
 from pymavlink import mavutil
 from support import REPO_ROOT
+from support.fifo import open_writer
 from support.ports import free_udp_ports
 
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
@@ -120,18 +120,6 @@ class Pair:
         os.write(self.fifo_fd, pack_event(JS_EVENT_AXIS, axis, round(value * AXIS_FULL)))
 
 
-def _open_writer(fifo: Path, timeout_s: float) -> int:
-    """The FIFO's writing end, once joyfly holds the reading end (until then the open fails with ENXIO)."""
-    give_up = time.monotonic() + timeout_s
-    while True:
-        try:
-            return os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
-        except OSError as err:
-            if err.errno != errno.ENXIO or time.monotonic() > give_up:
-                raise
-            time.sleep(0.05)
-
-
 def _start(tmp_path: Path) -> Pair:
     fifo = tmp_path / "js0"
     os.mkfifo(fifo)
@@ -150,7 +138,7 @@ def _start(tmp_path: Path) -> Pair:
     out: list[str] = []
     threading.Thread(target=lambda: out.extend(iter(joy.stdout.readline, "")), daemon=True).start()  # type: ignore[union-attr]
     gcs.log = lambda: "".join(out)
-    fd = _open_writer(fifo, 20.0)
+    fd = open_writer(fifo, 20.0)
     for index in range(7):
         os.write(fd, pack_event(JS_EVENT_BUTTON | JS_EVENT_INIT, index, 0))
     for index in range(4):

@@ -14,16 +14,8 @@ from typing import Final
 
 MAGIC_V2: Final = 0xFD
 IFLAG_SIGNED: Final = 0x01
-KEY_LEN: Final = 32
 SIGNATURE_BLOCK_LEN: Final = 13  # link id, timestamp, signature
 SIGNATURE_LEN: Final = 6
-EPOCH_2015_UNIX_US: Final = 1_420_070_400_000_000
-TIMESTAMP_MAX: Final = (1 << 48) - 1
-
-
-def timestamp_from_unix_us(unix_us: int) -> int:
-    """The signing timestamp (10 us since 2015) of a Unix time in microseconds; 0 before 2015."""
-    return min(max(unix_us - EPOCH_2015_UNIX_US, 0) // 10, TIMESTAMP_MAX)
 
 
 def signature(key: bytes, signed_part: bytes | bytearray) -> bytes:

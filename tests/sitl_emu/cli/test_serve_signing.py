@@ -17,7 +17,8 @@ from pymavlink.dialects.v20 import development as dialect
 from support import REPO_ROOT
 from support.ports import free_udp_ports
 
-from sitl_emu.mavlink.wire.signing import signature_matches, timestamp_from_unix_us
+from px4common.signing_key import timestamp_from_unix_us
+from sitl_emu.mavlink.wire.signing import signature_matches
 from sitl_emu.px4 import MavCmd
 
 pytestmark = pytest.mark.slow  # processes or long flights: not in `make test-fast`

@@ -12,8 +12,9 @@ import pytest
 from pymavlink.dialects.v20 import development as dialect
 from support.fakes import HOME, Client, Harness
 
+from px4common.signing_key import timestamp_from_unix_us
 from sitl_emu.mavlink.signing import KEY_FILE, MavlinkSigning
-from sitl_emu.mavlink.wire.signing import sign_frame, signature_matches, timestamp_from_unix_us
+from sitl_emu.mavlink.wire.signing import sign_frame, signature_matches
 from sitl_emu.px4 import MavCmd, MavResult
 from sitl_emu.vehicle.vehicle import Vehicle
 
