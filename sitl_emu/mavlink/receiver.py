@@ -7,7 +7,8 @@ Command routing as mavlink_receiver.cpp evaluate_target_ok() codes it (every ver
 iff target_system is exactly our sysid and target_component is our compid or 0; only REQUEST_AUTOPILOT_CAPABILITIES
 and REQUEST_PROTOCOL_VERSION also accept target_system 0 and any component. Anything else is ignored without an ACK.
 (Reference 3.1 says target_system 0 is accepted for all commands; the code says otherwise, and PX4 is right.)
-Offboard setpoints do accept target_system 0.
+Offboard setpoints do accept target_system 0. A command that sets a param its MAV_CMD does not take is DENIED before
+anything else sees it (PX4 main's mavlink_command_params.hpp; protocols/command_params.py).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from sitl_emu.mavlink import setpoints
 from sitl_emu.mavlink.link_commands import ANY_COMPONENT, CommandHandler
+from sitl_emu.mavlink.protocols.command_params import command_carries_unused_param
 from sitl_emu.px4 import MavCmd, MavResult, Severity, decode_custom_mode
 from sitl_emu.types import FollowTargetSample, ManualControlSetpoint, VehicleCommand
 
@@ -96,7 +98,8 @@ class Receiver:
             return
         params = (msg.param1, msg.param2, msg.param3, msg.param4, msg.param5, msg.param6, msg.param7)
         cmd = _command(msg, params)
-        if _is_int32_max(msg.param5) and _is_int32_max(msg.param6):
+        int32_max_position = _is_int32_max(msg.param5) and _is_int32_max(msg.param6)
+        if int32_max_position or command_carries_unused_param(cmd.command, cmd.params):
             _ack_here(ctx, cmd, MavResult.DENIED)
             return
         self._commands.execute(cmd, ctx)
@@ -110,7 +113,11 @@ class Receiver:
                       MavResult.DENIED)
             return
         p5, p6 = _command_int_xy(x, y)
-        self._commands.execute(_command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z)), ctx)
+        cmd = _command(msg, (msg.param1, msg.param2, msg.param3, msg.param4, p5, p6, msg.z))
+        if command_carries_unused_param(cmd.command, cmd.params):
+            _ack_here(ctx, cmd, MavResult.DENIED)
+            return
+        self._commands.execute(cmd, ctx)
 
     def _set_mode(self, msg: dialect.MAVLink_set_mode_message, ctx: EndpointContext) -> None:
         """SET_MODE -> DO_SET_MODE(base_mode, main, sub); the ACK is for command 176 (reference 3.4)."""

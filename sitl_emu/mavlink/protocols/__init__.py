@@ -1,7 +1,7 @@
 """The MAVLink microservices, one module per protocol, each a Handler listed in endpoint.HANDLER_CLASSES.
 
 After PX4 src/modules/mavlink: mission.py (mavlink_mission.cpp: upload, download, clear, current, for mission,
-fence and rally) with mission_items.py (its item checks) and mission_params.py (mavlink_command_params.hpp: the
+fence and rally) with mission_items.py (its item checks) and command_params.py (mavlink_command_params.hpp: the
 params each command may carry), params.py (mavlink_parameters.cpp), ftp.py
 (mavlink_ftp.cpp) with ftp_sandbox.py (its root), log.py (mavlink_log_handler.cpp: LOG_REQUEST_*), shell.py
 (mavlink_shell.cpp: SERIAL_CONTROL to the pxh> shell), events.py (mavlink_events.cpp: EVENT, CURRENT_EVENT_SEQUENCE,

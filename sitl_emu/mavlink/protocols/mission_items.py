@@ -7,7 +7,7 @@ that frame with MAV_MISSION_UNSUPPORTED. PX4 keeps its own parsed item, not the 
 kept: the altitude reference as the INT or float variant of the global frame, and only the params the command uses
 (e.g. a waypoint's pass radius comes back as 0, its yaw wrapped into [0, 360)).
 
-Before any of that PX4 main refuses a value in a param the command does not use (mission_params.py): e.g. an RTL
+Before any of that PX4 main refuses a value in a param the command does not use (command_params.py): e.g. an RTL
 item in a global frame at x = y = 0 is MAV_MISSION_INVALID_PARAM5_X, a waypoint's pass radius (param3)
 MAV_MISSION_INVALID_PARAM3.
 """
@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from sitl_emu.mavlink.protocols.mission_params import unused_param_result
+from sitl_emu.mavlink.protocols.command_params import unused_param_result
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.px4 import MavCmd, MavFrame, NavState
 

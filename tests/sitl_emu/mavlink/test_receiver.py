@@ -104,6 +104,41 @@ def test_command_int_with_nan_pattern_xy_is_denied(h):
     assert not h.vehicle.commands and _acks(h.api) == [(MavCmd.DO_REPOSITION, MavResult.DENIED)]
 
 
+# PX4 main's mavlink_command_params.hpp: a value in a param the command does not take is DENIED at the boundary
+@pytest.mark.parametrize("command, params", [
+    (MavCmd.NAV_RETURN_TO_LAUNCH, (1.0,)),  # takes no param at all
+    (MavCmd.DO_SET_MODE, (1.0, 4.0, 3.0, 5.0)),  # params 4-7
+    (MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0, 7.0)),  # params 3-7
+    (MavCmd.NAV_TAKEOFF, (NAN, 3.0)),  # params 2 and 3 on a multicopter
+    (MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, -2.5)),
+])
+def test_command_long_with_a_value_in_an_unused_param_is_denied_before_the_vehicle(h, command, params):
+    h.api.command_long(command, *params)
+    h.io()
+    assert not h.vehicle.commands
+    assert _acks(h.api) == [(command, MavResult.DENIED)]
+
+
+@pytest.mark.parametrize("command, params", [
+    (MavCmd.COMPONENT_ARM_DISARM, (1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),  # 0 is what ground stations send: unset
+    (MavCmd.COMPONENT_ARM_DISARM, (1.0, NAN, NAN, NAN, NAN, NAN, NAN)),  # NaN is MAVSDK's unset
+    (MavCmd.NAV_TAKEOFF, (-1.0, NAN, NAN, NAN, NAN, NAN, 510.0)),  # QGroundControl's param1 = -1 on a multicopter
+    (MavCmd.DO_REPOSITION, (-1.0, 1.0, 5.0, 6.0, 47.0, 8.0, 500.0)),  # not in the table: not checked
+])
+def test_command_long_with_only_used_params_or_unset_ones_reaches_the_vehicle(h, command, params):
+    h.api.command_long(command, *params)
+    h.io()
+    assert [c.command for c in h.vehicle.commands] == [command]
+
+
+def test_command_int_with_a_value_in_an_unused_param_is_denied(h):
+    h.api.send(h.api.mav.command_int_encode(1, 1, 0, MavCmd.DO_SET_MODE, 0, 0, 1.0, 4.0, 3.0, 0.0, 0, 0, 0.0))
+    h.api.send(h.api.mav.command_int_encode(1, 1, 0, MavCmd.DO_SET_MODE, 0, 0, 1.0, 4.0, 3.0, 0.0, 5, 0, 0.0))
+    h.io()
+    assert [c.command for c in h.vehicle.commands] == [MavCmd.DO_SET_MODE]
+    assert _acks(h.api)[-1] == (MavCmd.DO_SET_MODE, MavResult.DENIED)
+
+
 def test_set_mode_becomes_do_set_mode_and_is_acked_as_176(h):
     h.api.send(h.api.mav.set_mode_encode(1, 1, (3 << 24) | (4 << 16)))
     h.api.send(h.api.mav.set_mode_encode(0, 1, 6 << 16))  # target 0: commander ignores it

@@ -10,6 +10,7 @@ import pytest
 from support import REPO_ROOT
 from support.handler_ctx import CLIENT_COMPID, CLIENT_SYSID, Client, FakeVehicle, MemoryContext
 
+from sitl_emu.mavlink.protocols.command_params import unused_param_result
 from sitl_emu.mavlink.protocols.mission import MissionProtocol
 from sitl_emu.mavlink.protocols.mission_items import (
     MAV_MISSION_ACCEPTED,
@@ -26,7 +27,8 @@ from sitl_emu.px4 import NavState, Severity
 
 LAT, LON = 473977420, 85455940
 WAYPOINT, TAKEOFF, RTL, FENCE_POLY_IN, FENCE_CIRCLE_IN, RALLY = 16, 22, 20, 5001, 5003, 5100
-MAV_MISSION_INVALID_PARAM2, MAV_MISSION_INVALID_PARAM3, MAV_MISSION_INVALID_PARAM4 = 7, 8, 9  # common.xml
+MAV_MISSION_INVALID_PARAM1, MAV_MISSION_INVALID_PARAM2 = 6, 7  # common.xml
+MAV_MISSION_INVALID_PARAM3, MAV_MISSION_INVALID_PARAM4 = 8, 9
 MAV_MISSION_INVALID_PARAM7 = 12
 INT32_MAX = 2**31 - 1  # MISSION_ITEM_INT's "no value" in x, y
 
@@ -154,6 +156,13 @@ def test_a_fence_circle_at_0_0_with_radius_0_is_stored(setup):
     circle = item(client, 0, FENCE_CIRCLE_IN, mission_type=1, x=0, y=0, params=(0, 0, 0, 0), z=0.0)
     assert upload(proto, ctx, client, [circle], 1) == MAV_MISSION_ACCEPTED
     assert [(m.command, m.x, m.y) for m in download(proto, ctx, client, 1)] == [(FENCE_CIRCLE_IN, 0, 0)]
+
+
+def test_a_land_start_marker_may_carry_a_position_but_no_other_param():
+    """mavlink_command_params.hpp: DO_LAND_START takes params 5-7 (an optional marker position, which QGroundControl
+    sets) and none of 1-4."""
+    assert unused_param_result(189, (0, 0, 0, 0), LAT, LON, 10.0, int_position=True) is None
+    assert unused_param_result(189, (3.0, 0, 0, 0), LAT, LON, 10.0, int_position=True) == MAV_MISSION_INVALID_PARAM1
 
 
 def test_too_many_items_is_no_space(setup):
