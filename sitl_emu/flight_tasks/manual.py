@@ -6,7 +6,11 @@ FlightTaskManualAcceleration (src/modules/flight_mode_manager/tasks/...), motion
 and mc_att_control's generate_attitude_setpoint (Stabilized). Per cycle (FlightModeManager, 50 Hz):
 - vertical: the throttle around its centre commands a climb rate (deadzone, expo; MPC_Z_VEL_MAX_UP/DN), slowed near
   the ground (MPC_TKO_SPEED up and MPC_LAND_SPEED down below MPC_LAND_ALT2, blended up to MPC_LAND_ALT1), smoothed
-  with jerk and acceleration limits; the altitude locks once the climb rate has stopped;
+  with jerk and acceleration limits; with the throttle centred the altitude locks where the vehicle is once it climbs
+  slower than MPC_HOLD_MAX_Z (or the smoothing has come to rest), and the mode starts locked at the altitude it was
+  entered at (FlightTaskManualAltitude::_updateAltitudeLock, activate);
+- activation: from the previous task's last setpoint (FlightModeManager::switchTask hands it over), the vehicle's
+  state where there is none;
 - heading: the yaw stick commands a yaw rate (flight_tasks/sticks.py StickYaw);
 - horizontal: Position mode's acceleration sticks with a position lock, or Altitude mode's tilt sticks;
 - takeoff: the throttle above 0.3 asks for it (vehicle_constraints.want_takeoff); until the controller's takeoff
@@ -57,6 +61,7 @@ class ManualSettings:
     land_speed: float  # MPC_LAND_SPEED
     land_alt1: float  # MPC_LAND_ALT1
     land_alt2: float  # MPC_LAND_ALT2
+    hold_max_z: float  # MPC_HOLD_MAX_Z
     yaw_rate_rad_s: float  # MPC_MAN_Y_MAX
     yaw_tau_s: float  # MPC_MAN_Y_TAU
     tilt_max_rad: float  # MPC_MAN_TILT_MAX
@@ -73,7 +78,8 @@ class ManualSettings:
             deadzone=f("MAN_DEADZONE"), vel_up=f("MPC_Z_VEL_MAX_UP"), vel_dn=f("MPC_Z_VEL_MAX_DN"),
             acc_up=f("MPC_ACC_UP_MAX"), acc_down=f("MPC_ACC_DOWN_MAX"), jerk=f("MPC_JERK_MAX"),
             tko_speed=f("MPC_TKO_SPEED"), land_speed=f("MPC_LAND_SPEED"), land_alt1=f("MPC_LAND_ALT1"),
-            land_alt2=f("MPC_LAND_ALT2"), yaw_rate_rad_s=math.radians(f("MPC_MAN_Y_MAX")), yaw_tau_s=f("MPC_MAN_Y_TAU"),
+            land_alt2=f("MPC_LAND_ALT2"), hold_max_z=f("MPC_HOLD_MAX_Z"),
+            yaw_rate_rad_s=math.radians(f("MPC_MAN_Y_MAX")), yaw_tau_s=f("MPC_MAN_Y_TAU"),
             tilt_max_rad=math.radians(f("MPC_MAN_TILT_MAX")), tilt_air_rad=math.radians(f("MPC_TILTMAX_AIR")),
             tilt_lnd_rad=math.radians(f("MPC_TILTMAX_LND")),
             xy=StickXYSettings(vel_manual=f("MPC_VEL_MANUAL"), vel_side=f("MPC_VEL_MAN_SIDE"),
@@ -91,7 +97,7 @@ def _interp(x: float, x_lo: float, x_hi: float, y_lo: float, y_hi: float) -> flo
 
 
 class VerticalSmoothing:
-    """ManualVelocitySmoothingZ: a jerk-limited climb rate towards the stick's, and the altitude lock."""
+    """ManualVelocitySmoothingZ: a jerk-limited climb rate towards the stick's, and its own altitude lock."""
 
     def __init__(self, acc: float, vel: float, pos: float) -> None:
         self.axis = AxisSmoother(acc, vel, pos)
@@ -114,6 +120,21 @@ class VerticalSmoothing:
         axis.update_durations(target_vz)
 
 
+def altitude_lock(locked_z: float, throttle_centred: bool, stopped: bool, z: float) -> float:
+    """FlightTaskManualAltitude::_updateAltitudeLock (heights from the local origin, MPC_ALT_MODE 0): with the throttle
+    centred the altitude locks where the vehicle is once it climbs or sinks slower than MPC_HOLD_MAX_Z (`stopped`), and
+    a lock (also the one the mode starts with) holds while the throttle stays centred; any throttle frees it (NaN)."""
+    if not throttle_centred:
+        return NAN
+    if isfinite(locked_z):
+        return locked_z
+    return z if stopped else NAN
+
+
+def _last_or(value: float, fallback: float) -> float:
+    return value if isfinite(value) else fallback
+
+
 class ManualAltitudeTask:
     """ALTCTL (FlightTaskManualAltitudeSmoothVel): climb rate from the throttle, tilt from the right stick."""
 
@@ -125,33 +146,52 @@ class ManualAltitudeTask:
         """A position-controlled setpoint (not a navigator takeoff or land item)."""
         return SetpointType.POSITION
 
-    def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
+    def __init__(self, nav: NavInput, params: ParamRegistry, last: TrajectorySetpoint | None = None) -> None:
+        """`last`: the setpoint of the task that ran before (FlightModeManager hands it to activate()); None (or NaN
+        components) after a mode without one, when the vehicle's state stands in."""
         self._params, self._version = params, params.version
         self.s = ManualSettings.from_params(params)
         self.sticks: ManualControlSetpoint = CENTRED
         self.want_takeoff = False
         self._yaw = StickYaw(self.s.yaw_rate_rad_s, self.s.yaw_tau_s)
         self._z: VerticalSmoothing
-        self._activate(nav, nav.vel_ned_m_s[2])
+        self._locked_z = NAN
+        self._activate(nav, last if last is not None else TrajectorySetpoint())
 
-    def _activate(self, nav: NavInput, vz: float) -> None:
-        """activate(): start from the vehicle (before the takeoff ramp: every cycle, keeping the climb request)."""
+    def _activate(self, nav: NavInput, last: TrajectorySetpoint) -> None:
+        """activate(last_setpoint): the altitude locked where the vehicle is (FlightTaskManualAltitude), the vertical
+        smoothing from the last setpoint's height, climb rate and acceleration (FlightTaskManualAltitudeSmoothVel)."""
         self._yaw.reset()
-        self._z = VerticalSmoothing(0.0, vz if isfinite(vz) else nav.vel_ned_m_s[2], nav.pos_ned_m[2])
+        z = nav.pos_ned_m[2]
+        self._locked_z = z
+        self._z = VerticalSmoothing(_last_or(last.acceleration_ned_m_s2[2], 0.0),
+                                    _last_or(last.velocity_ned_m_s[2], nav.vel_ned_m_s[2]),
+                                    _last_or(last.position_ned_m[2], z))
 
     def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
         if self._params.version != self._version:
             self._version, self.s = self._params.version, ManualSettings.from_params(self._params)
         sticks, s = self.sticks, self.s
         yaw_sp, yawspeed = self._yaw.update(stick_expo(sticks.yaw, s.deadzone), nav.yaw_rad, dt_s)
+        locked_z = self._update_altitude_lock(nav)
         target_vz = self._ground_slowdown(nav, self._climb_rate(sticks.throttle))
         self._z.update(s, target_vz, nav.pos_ned_m[2], nav.vel_sp_ned_m_s[2], dt_s)
+        if not isfinite(locked_z):  # _setOutputState: the smoothing's own lock, if it has one
+            locked_z = self._locked_z = self._z.locked_z
         self.want_takeoff = sticks.throttle > WANT_TAKEOFF_THROTTLE
         axis = self._z.axis
-        sp = self._horizontal(nav, yaw_sp, dt_s, (self._z.locked_z, axis.v, axis.a), yawspeed)
+        sp = self._horizontal(nav, yaw_sp, dt_s, (locked_z, axis.v, axis.a), yawspeed)
         if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager re-activates the task until the ramp
-            self._activate(nav, axis.v)
+            self._activate(nav, TrajectorySetpoint(velocity_ned_m_s=(NAN, NAN, axis.v),
+                                                   acceleration_ned_m_s2=(0.0, 0.0, 0.0)))  # FlightTask::reActivate
         return sp
+
+    def _update_altitude_lock(self, nav: NavInput) -> float:
+        s = self.s
+        centred = abs(stick_expo(self.sticks.throttle, s.deadzone)) <= FLT_EPSILON
+        stopped = s.hold_max_z < FLT_EPSILON or abs(nav.vel_ned_m_s[2]) < s.hold_max_z
+        self._locked_z = altitude_lock(self._locked_z, centred, stopped, nav.pos_ned_m[2])
+        return self._locked_z
 
     def _horizontal(self, nav: NavInput, yaw_sp: float, dt_s: float, z: tuple[float, float, float],
                     yawspeed: float) -> TrajectorySetpoint:
@@ -182,10 +222,13 @@ class ManualPositionTask(ManualAltitudeTask):
 
     _xy: StickAccelerationXY
 
-    def _activate(self, nav: NavInput, vz: float) -> None:
-        """FlightTaskManualAcceleration::activate: the horizontal velocity from the vehicle's."""
-        super()._activate(nav, vz)
-        self._xy = StickAccelerationXY(self.s.xy, (nav.vel_ned_m_s[0], nav.vel_ned_m_s[1]), (0.0, 0.0))
+    def _activate(self, nav: NavInput, last: TrajectorySetpoint) -> None:
+        """FlightTaskManualAcceleration::activate: the horizontal velocity and acceleration from the last setpoint
+        (the vehicle's velocity and no acceleration where it has none); no position lock yet."""
+        super()._activate(nav, last)
+        (vx, vy, _), (ax, ay, _) = last.velocity_ned_m_s, last.acceleration_ned_m_s2
+        vel = (vx, vy) if isfinite(vx) and isfinite(vy) else (nav.vel_ned_m_s[0], nav.vel_ned_m_s[1])
+        self._xy = StickAccelerationXY(self.s.xy, vel, (ax, ay) if isfinite(ax) and isfinite(ay) else (0.0, 0.0))
 
     def _horizontal(self, nav: NavInput, yaw_sp: float, dt_s: float, z: tuple[float, float, float],
                     yawspeed: float) -> TrajectorySetpoint:

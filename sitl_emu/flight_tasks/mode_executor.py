@@ -238,9 +238,9 @@ class ModeExecutor:
         elif nav_state is NavState.AUTO_MISSION:
             self.task = self._make_mission(nav, ref)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
-            self.task = ManualPositionTask(nav, self.params)
+            self.task = ManualPositionTask(nav, self.params, self._last_setpoint())
         elif nav_state is NavState.ALTCTL:
-            self.task = ManualAltitudeTask(nav, self.params)
+            self.task = ManualAltitudeTask(nav, self.params, self._last_setpoint())
         elif nav_state is NavState.ORBIT:
             self.task = self._orbit(nav, command, ref)
         elif nav_state is NavState.AUTO_FOLLOW_TARGET:
@@ -248,6 +248,11 @@ class ModeExecutor:
             follow.fix = self._target_fix
         else:
             self.task = auto.make_land(nav, self.params)
+
+    def _last_setpoint(self) -> TrajectorySetpoint | None:
+        """The setpoint the previous task gave last (FlightModeManager::switchTask hands it to the new task's
+        activate()); None after a mode without a flight task."""
+        return self._held.trajectory if self._held is not None else None
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus
