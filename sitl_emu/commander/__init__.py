@@ -11,5 +11,6 @@ failure_injection.py (src/systemcmds/failure and the FailureDetector rules), hea
 (the PX4 events the commander sends without a text).
 
 May import: the kernel (px4, types, geo), params/, control/ (plain maths), navigator/ (the stored plans, the fence
-result, navigator requests), events/ (PX4's event definitions). Never vehicle/, flight_tasks/, mavlink/, runtime/, the faces, or a clock.
+result, navigator requests), events/ (PX4's event definitions). Never vehicle/, flight_tasks/, mavlink/, runtime/,
+the faces, or a clock.
 """

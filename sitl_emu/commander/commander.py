@@ -93,8 +93,7 @@ class Commander:
 
     # ---- inputs -------------------------------------------------------------------------------------------------
     def observe(self, now_us: int, *, estimator_ready: bool, task_finished: bool = False) -> None:
-        """What the commander sees of the vehicle at the start of a cycle: the time, whether the estimator is ready,
-        and whether the navigator's current task says it is done (takeoff reached)."""
+        """The vehicle at a cycle's start: the time, the estimator ready, the navigator's task done (takeoff)."""
         self.now_us = now_us
         self.estimator_ready = estimator_ready
         self._task_finished = task_finished
@@ -298,8 +297,7 @@ class Commander:
         return ok
 
     def _apply_mode(self, now_us: int) -> arming.CheckInputs:
-        """The mode in force: the user's mode, or the failsafe's fallback while it cannot run; an armed vehicle never
-        leaves termination. Returns what the checks saw."""
+        """The mode in force (the user's, or the failsafe's while it cannot run; termination sticks while armed)."""
         st = self.settings
         inputs = self._check_inputs(now_us, st)
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
@@ -318,12 +316,14 @@ class Commander:
         return inputs
 
     def report_health(self, now_us: int, inputs: arming.CheckInputs | None = None, force: bool = False) -> None:
-        """HealthAndArmingChecks::update: the report's events when one is due (`force`: RUN_PREARM_CHECKS)."""
-        st = self.settings
-        report = ReportInputs.of(self.nav_state, self.armed, inputs or self._check_inputs(now_us, st), self.geofence,
-                                 self.fault_flags.gcs_connection_lost, st.rc_in_mode == 4, st.faults.dll.rcl_act > 0)
-        for event in self._health.update(now_us, report, force):
-            self._send_event(event)
+        """HealthAndArmingChecks::update (10 Hz, on a status change, forced by RUN_PREARM_CHECKS): a report if due."""
+        if self._health.due(now_us, (self.nav_state, self.armed), force):
+            st = self.settings
+            checked, lost = inputs or self._check_inputs(now_us, st), self.fault_flags.gcs_connection_lost
+            report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, lost, st.rc_in_mode == 4,
+                                     st.faults.dll.rcl_act > 0)
+            for event in self._health.update(now_us, report, force):
+                self._send_event(event)
 
     # ---- the periodic update ------------------------------------------------------------------------------------
     def update(self, now_us: int) -> None:

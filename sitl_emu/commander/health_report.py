@@ -7,8 +7,9 @@ can_arm / can_run as one bit per nav_state (Report::getModeGroup: group == mode)
 of the modes it requires (armingCheckFailure -> clearArmingBits, the mode checks' clearCanRunBits), with the modes
 the emulator's own requirement table gives (commander/arming.py), so the report says what the commander does.
 
-`HealthReporter` decides when a report goes out (Report::report): when it differs from the one before, at most once
-per 2 s (a change inside that window goes out when it ends), and at once when forced (MAV_CMD_RUN_PREARM_CHECKS).
+`HealthReporter` decides when the checks run (Commander::run: every 100 ms, and at once when the mode or the arming
+state changed) and when a report goes out (Report::report): when it differs from the one before, at most once per
+2 s (a change inside that window goes out when it ends), and at once when forced (MAV_CMD_RUN_PREARM_CHECKS).
 Health: the components PX4 SIH has are present (as SYS_STATUS reports them, mavlink/telemetry/health.py), the
 remote control while manual control is valid, the communication links while the ground station is not lost.
 """
@@ -29,6 +30,7 @@ from sitl_emu.px4 import NavState
 ALL_MODES: Final = 0xFFFFFFFF
 NO_MODES: Final = 0
 MIN_REPORTING_INTERVAL_US: Final = 2_000_000
+CHECK_INTERVAL_US: Final = 100_000
 SYSTEM: Final = health_component_index("system")
 REMOTE_CONTROL: Final = health_component_index("remote_control")
 COMMUNICATION_LINKS: Final = health_component_index("communication_links")
@@ -161,6 +163,16 @@ class HealthReporter:
         self.report: HealthReport | None = None
         self._last_report_us = 0
         self._unreported = False
+        self._last_check_us: int | None = None
+        self._status: object = None
+
+    def due(self, now_us: int, status: object, force: bool = False) -> bool:
+        """Whether the checks run now: 100 ms after the last run, when `status` (mode, arming) changed, or forced."""
+        if force or status != self._status or self._last_check_us is None \
+                or now_us >= self._last_check_us + CHECK_INTERVAL_US:
+            self._last_check_us, self._status = now_us, status
+            return True
+        return False
 
     def update(self, now_us: int, inputs: ReportInputs, force: bool = False) -> list[Px4Event]:
         """Run the checks (again only if their inputs changed); the events to send now, if a report is due."""
