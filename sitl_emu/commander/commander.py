@@ -319,9 +319,9 @@ class Commander:
         """HealthAndArmingChecks::update (10 Hz, on a status change, forced by RUN_PREARM_CHECKS): a report if due."""
         if self._health.due(now_us, (self.nav_state, self.armed), force):
             st = self.settings
-            checked, lost = inputs or self._check_inputs(now_us, st), self.fault_flags.gcs_connection_lost
-            report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, lost, st.rc_in_mode == 4,
-                                     st.faults.dll.rcl_act > 0)
+            checked = inputs or self._check_inputs(now_us, st)
+            report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, self.fault_flags,
+                                     st.rc_in_mode == 4, st.faults.dll.rcl_act > 0)
             for event in self._health.update(now_us, report, force):
                 self._send_event(event)
 

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.commander.arming import CheckInputs, Req, modes_requiring
+from sitl_emu.commander.battery import WARNING_CRITICAL, WARNING_EMERGENCY, WARNING_LOW, WARNING_NONE
+from sitl_emu.commander.fault_failsafes import FaultFlags
 from sitl_emu.events import health_events as ev
 from sitl_emu.events.definition import EventDefinition, Px4Event, px4_event
 from sitl_emu.events.enums import health_component_index
@@ -33,6 +35,7 @@ MIN_REPORTING_INTERVAL_US: Final = 2_000_000
 CHECK_INTERVAL_US: Final = 100_000
 SYSTEM: Final = health_component_index("system")
 REMOTE_CONTROL: Final = health_component_index("remote_control")
+BATTERY: Final = health_component_index("battery")
 COMMUNICATION_LINKS: Final = health_component_index("communication_links")
 _SIH_PRESENT: Final = sum(1 << health_component_index(n) for n in (
     "gyro", "accel", "magnetometer", "absolute_pressure", "gps", "local_position_estimate", "motors_escs", "logging",
@@ -73,16 +76,18 @@ class ReportInputs:
     missing: int  # the Req bits the commander's CheckInputs do not satisfy
     geofence: GeofenceResult
     gcs_lost: bool
+    battery_warning: int  # battery_status WARNING_*
     manual_control: bool
     stick_input_disabled: bool  # COM_RC_IN_MODE 4
     datalink_required: bool  # NAV_DLL_ACT > 0
 
     @classmethod
-    def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, gcs_lost: bool,
+    def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
            stick_input_disabled: bool, datalink_required: bool) -> ReportInputs:
         missing = ~c.available() & (Req.ATTITUDE | Req.POSITION | Req.HOME | Req.MISSION | Req.OFFBOARD | Req.MANUAL)
-        return cls(nav_state, armed, c.estimator_ready, c.position_lost, missing, geofence, gcs_lost,
-                   c.manual_control, stick_input_disabled, datalink_required)
+        return cls(nav_state, armed, c.estimator_ready, c.position_lost, missing, geofence,
+                   faults.gcs_connection_lost, faults.battery_warning, c.manual_control, stick_input_disabled,
+                   datalink_required)
 
 
 class _Builder:
@@ -109,6 +114,7 @@ class _Builder:
 
 def health_report(i: ReportInputs) -> HealthReport:
     b = _Builder()
+    _battery_check(b, i.battery_warning)
     _geofence_checks(b, i.geofence)
     if i.gcs_lost:  # rcAndDataLinkCheck.cpp
         b.fail(ev.NO_DATALINK, ALL_MODES if i.datalink_required else NO_MODES, COMMUNICATION_LINKS,
@@ -118,6 +124,20 @@ def health_report(i: ReportInputs) -> HealthReport:
     if i.manual_control:
         present |= 1 << REMOTE_CONTROL
     return HealthReport(tuple(b.checks), b.error, b.warning, b.can_arm & ALL_MODES, b.can_run & ALL_MODES, present)
+
+
+_BATTERY_CHECKS: Final = {WARNING_LOW: ev.BATTERY_LOW, WARNING_CRITICAL: ev.BATTERY_CRITICAL,
+                           WARNING_EMERGENCY: ev.BATTERY_EMERGENCY}
+
+
+def _battery_check(b: _Builder, warning: int) -> None:
+    """batteryCheck.cpp: a warning level fails arming in every mode from critical on (COM_ARM_BAT_MIN at its
+    default -1 adds no threshold of its own); a low level is a warning only. Disarmed the simulated battery is full."""
+    if warning == WARNING_NONE or warning not in _BATTERY_CHECKS:
+        return
+    critical = warning >= WARNING_CRITICAL
+    b.fail(_BATTERY_CHECKS[warning], ALL_MODES if critical else NO_MODES, BATTERY,
+           Log.CRITICAL if critical else Log.WARNING, clear_run=False)
 
 
 def _geofence_checks(b: _Builder, g: GeofenceResult) -> None:

@@ -6,8 +6,9 @@ components; can_arm and can_run, one bit per nav_state), one event per failing c
 (chunk 0; the components present, in error, in warning). A check event's first two arguments are the modes it
 affects (navigation_mode_group_t; all modes when the check blocks none) and its health component's bit number, as
 Report::armingCheckFailure adds them; its log level decides whether it counts as an error (up to Error) or a warning.
-The checks the emulator models: modeCheck.cpp (the mode requirements), geofenceCheck.cpp and rcAndDataLinkCheck.cpp
-(the ground-station link); their messages are PX4's (the geofence ones as PX4 main words its legacy texts).
+The checks the emulator models: batteryCheck.cpp (the warning level), geofenceCheck.cpp, rcAndDataLinkCheck.cpp (the
+ground-station link) and modeCheck.cpp (the mode requirements); their messages are PX4's (the geofence ones as PX4
+main words its legacy texts).
 """
 
 from __future__ import annotations
@@ -48,9 +49,14 @@ GEOFENCE_MAX_DISTANCE = _check("check_gf_violation_max_hor_dist", "Geofence: exc
 GEOFENCE_MAX_ALTITUDE = _check("check_gf_violation_max_alt", "Geofence: exceeding maximum altitude above Home",
                                Log.ERROR)
 GEOFENCE_CUSTOM = _check("check_gf_violation_custom_gf", "Geofence: approaching or outside geofence", Log.ERROR)
+# Critical from the critical level on (or below COM_ARM_BAT_MIN), else Warning
+BATTERY_LOW = _check("check_battery_low", "Low battery", Log.WARNING)
+BATTERY_CRITICAL = _check("check_battery_critical", "Critical battery", Log.CRITICAL)
+BATTERY_EMERGENCY = _check("check_battery_emergency", "Emergency battery level", Log.CRITICAL)
 # Error when NAV_DLL_ACT requires the link, else Info
 NO_DATALINK = _check("check_rc_dl_no_dllink", "No connection to the ground control station", Log.INFO)
 
 DEFINITIONS: Final = (ARMING_CHECK_SUMMARY, HEALTH_SUMMARY, CANNOT_TAKEOFF, ATTITUDE, LOCAL_POSITION,
                       GLOBAL_POSITION, LOCAL_ALTITUDE, MISSION, OFFBOARD_SIGNAL, HOME_POSITION, MANUAL_CONTROL,
-                      GEOFENCE_MAX_DISTANCE, GEOFENCE_MAX_ALTITUDE, GEOFENCE_CUSTOM, NO_DATALINK)
+                      GEOFENCE_MAX_DISTANCE, GEOFENCE_MAX_ALTITUDE, GEOFENCE_CUSTOM, NO_DATALINK, BATTERY_LOW,
+                      BATTERY_CRITICAL, BATTERY_EMERGENCY)

@@ -9,8 +9,10 @@ import struct
 import pytest
 
 from sitl_emu.commander import arming
+from sitl_emu.commander.fault_failsafes import FaultFlags
 from sitl_emu.commander.health_report import (
     ALL_MODES,
+    BATTERY,
     COMMUNICATION_LINKS,
     REMOTE_CONTROL,
     SYSTEM,
@@ -29,8 +31,9 @@ BOOTING = arming.CheckInputs(estimator_ready=False, home_valid=False, offboard_s
 
 def _inputs(c: arming.CheckInputs = READY, nav: NavState = NavState.AUTO_LOITER, armed: bool = False,
             geofence: GeofenceResult = NO_BREACH, gcs_lost: bool = False, sticks_disabled: bool = False,
-            dll_required: bool = False) -> ReportInputs:
-    return ReportInputs.of(nav, armed, c, geofence, gcs_lost, sticks_disabled, dll_required)
+            dll_required: bool = False, battery_warning: int = 0) -> ReportInputs:
+    faults = FaultFlags(gcs_connection_lost=gcs_lost, battery_warning=battery_warning)
+    return ReportInputs.of(nav, armed, c, geofence, faults, sticks_disabled, dll_required)
 
 
 def _names(report) -> list[str]:
@@ -129,3 +132,14 @@ def test_the_checks_run_at_10_hz_and_at_once_when_the_mode_or_arming_changes():
     assert reporter.due(0, hold) and not reporter.due(50_000, hold)
     assert reporter.due(60_000, armed) and not reporter.due(100_000, armed)
     assert reporter.due(160_000, armed) and reporter.due(170_000, armed, force=True)
+
+
+@pytest.mark.parametrize(("warning", "name", "level", "modes"), [
+    (1, "check_battery_low", Log.WARNING, ALL_MODES), (2, "check_battery_critical", Log.CRITICAL, ALL_MODES),
+    (3, "check_battery_emergency", Log.CRITICAL, ALL_MODES)])
+def test_a_battery_warning_is_reported_on_the_battery_component(warning, name, level, modes):
+    r = health_report(_inputs(armed=True, battery_warning=warning))
+    (battery,) = [c for c in r.checks if c.component == BATTERY]
+    assert (battery.event.name, battery.level, battery.modes) == (name, level, modes)
+    assert (r.arming_error if level <= Log.ERROR else r.arming_warning) >> BATTERY & 1
+    assert r.can_arm == (0 if warning > 1 else r.can_arm) and r.can_run >> NavState.AUTO_LOITER & 1
