@@ -163,3 +163,25 @@ def _qgc_hash(values: dict, described: dict) -> int:
 def test_the_events_and_ftp_protocols_are_on_every_nodes_default_list():
     names = {cls.__name__ for cls in load_handler_classes()}
     assert {"EventsProtocol", "FtpProtocol"} <= names
+
+
+def test_a_failsafe_notice_decodes_with_the_downloaded_metadata(h):
+    """framework.cpp notifyUser: offboard setpoints stop, Position cannot run without sticks, the fallback is
+    NAV_RCL_ACT's Return; QGC shows the event's message, made from the metadata it downloaded."""
+    qgc = Qgc(h)
+    h.run(2.5)
+    (meta,) = [f for x in map(extra_of, qgc.request(MSG_COMPONENT_METADATA)) if x and x[0] == 397 for f in [x[1]]]
+    general = json.loads(qgc.download(meta["uri"].rstrip(b"\0").decode()))
+    (events_uri,) = [e["uri"] for e in general["metadataTypes"] if e["type"] == COMP_METADATA_TYPE_EVENTS]
+    decoder = EventsDecoder(json.loads(qgc.download(events_uri)))
+    h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 1)
+    h.gcs.command_long(MavCmd.NAV_TAKEOFF)
+    h.run(8.0)
+    start = len(h.gcs.received)
+    h.gcs.send(h.gcs.mav.set_position_target_local_ned_encode(0, 1, 1, 1, 0b110111111000, 0, 0, -2.5, *[0] * 8))
+    h.gcs.command_long(MavCmd.DO_SET_MODE, 1, 6, 0)  # OFFBOARD, then no more setpoints
+    h.run(3.0)
+    notices = [decoder.decode(f["id"], f["arguments"]) for msg_id, f in filter(None, map(extra_of,
+               h.gcs.received[start:])) if msg_id == 410]
+    assert ("commander_failsafe_enter_generic", "Failsafe activated: Autopilot disengaged, switching to RTL") \
+        in notices
