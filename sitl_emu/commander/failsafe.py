@@ -25,6 +25,7 @@ from sitl_emu.commander.arming import CheckInputs, Req, can_run
 from sitl_emu.commander.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
 from sitl_emu.commander.geofence_failsafe import GeofenceFailsafe
 from sitl_emu.commander.manual_control import ManualLossFailsafe, ManualLossSettings
+from sitl_emu.events.failsafe_notices import CAUSE_GCS_CONNECTION_LOSS, CAUSE_GENERIC, CAUSE_MANUAL_CONTROL_LOSS
 from sitl_emu.navigator.geofence import GeofenceResult
 from sitl_emu.px4 import NavState
 
@@ -116,8 +117,6 @@ _RANK: dict[NavState, int] = {
 _DISARM_RANK = 9
 _HOLD_RANK = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT = "Failsafe activated"
-# framework.h Cause (failsafe_cause_t)
-CAUSE_GENERIC, CAUSE_MANUAL_CONTROL_LOSS, CAUSE_GCS_CONNECTION_LOSS = 0, 1, 2
 
 # an action in force: (rank, mode, disarm, cause); rank 0: none, the user's mode. The rank is framework.h's Action.
 _Action = tuple[int, NavState, bool, int]

@@ -18,17 +18,13 @@ from typing import Final
 
 from sitl_emu.commander.battery import WARNING_NONE, battery_action
 from sitl_emu.commander.manual_control import ManualLossFailsafe, ManualLossSettings
+from sitl_emu.events.failsafe_notices import CAUSE_BATTERY_OFFSET, CAUSE_GCS_CONNECTION_LOSS, CAUSE_GENERIC
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState
 
 CBRK_FLIGHTTERM_KEY: Final = 121212
 EARLY_TAKEOFF_US: Final = 3_000_000  # failsafe.cpp: the early takeoff phase, spool-up + 3 s
 _DELAYABLE: Final = frozenset({NavState.AUTO_RTL, NavState.AUTO_LAND, NavState.DESCEND})
-# framework.h Cause (failsafe_cause_t): GCS connection loss; the battery's low / critical / emergency level is
-# battery_status's warning + 2
-CAUSE_GENERIC: Final = 0
-CAUSE_GCS_CONNECTION_LOSS: Final = 2
-_BATTERY_CAUSE_OFFSET: Final = 2
 
 
 @dataclass(slots=True)
@@ -85,7 +81,7 @@ class BatteryFailsafe:
         if action is not None and action is not self.action:
             if not self._held and action in _DELAYABLE and s.fail_act_us > 100_000:
                 self._hold_until_us, self._held = now_us + s.fail_act_us, True  # the Hold comes once
-            self.action, self.cause = action, flags.battery_warning + _BATTERY_CAUSE_OFFSET
+            self.action, self.cause = action, flags.battery_warning + CAUSE_BATTERY_OFFSET
         if self.action is None:
             return None
         return NavState.AUTO_LOITER if now_us < self._hold_until_us else self.action

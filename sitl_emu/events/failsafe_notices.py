@@ -23,7 +23,11 @@ _CAUSE = enums.qualified(enums.FAILSAFE_CAUSE)
 
 ACTION_NONE: Final = 0
 ACTION_HOLD: Final = 5
+# failsafe_cause_t (framework.h Cause); the battery's: battery_status's warning level + CAUSE_BATTERY_OFFSET
 CAUSE_GENERIC: Final = 0
+CAUSE_MANUAL_CONTROL_LOSS: Final = 1
+CAUSE_GCS_CONNECTION_LOSS: Final = 2
+CAUSE_BATTERY_OFFSET: Final = 2
 
 
 def _notice(name: str, message: str, arguments: tuple[str, ...]) -> EventDefinition:
