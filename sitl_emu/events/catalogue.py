@@ -6,7 +6,9 @@ the event PX4 sends with it: its name, message, argument types and levels as PX4
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
 navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter),
-commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover), navigator/takeoff.cpp
+commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover from a failsafe, an event only; without
+a failsafe Commander::manualControlCheck's commander_rc_override with its STATUSTEXT), Commander::dataLinkCheck
+(commander_gcs_lost, commander_dl_regained), navigator/takeoff.cpp
 (navigator_takeoff_default_alt, whose altitude is read back from the text's one decimal;
 navigator_takeoff_already_higher).
 
@@ -38,6 +40,7 @@ class _Entry:
     definition: EventDefinition
     text: re.Pattern[str]
     values: Callable[[re.Match[str]], Values | None] = lambda m: ()
+    statustext: bool | None = None  # matches only a text that does (True) / does not (False) go out as STATUSTEXT
 
 
 def _reason(m: re.Match[str]) -> Values | None:
@@ -95,8 +98,13 @@ ENTRIES: tuple[_Entry, ...] = (
            re.compile(r"Using default takeoff altitude: (-?[\d.]+) m"), lambda m: (float(m.group(1)),)),
     _Entry(EventDefinition("navigator_takeoff_already_higher", "Already higher than takeoff altitude (not descending)",
                            external=Log.ERROR, internal=Log.INFO), _exact("Already higher than takeoff altitude")),
+    _Entry(EventDefinition("commander_rc_override", "Pilot took over using sticks"),
+           _exact("Pilot took over using sticks"), statustext=True),
     _Entry(EventDefinition("failsafe_rc_override", "Pilot took over using sticks"),
-           _exact("Pilot took over using sticks")),
+           _exact("Pilot took over using sticks"), statustext=False),
+    _Entry(EventDefinition("commander_gcs_lost", "Connection to ground control station lost", (), Log.WARNING,
+                           Log.INFO), _exact("Connection to ground station lost")),
+    _Entry(EventDefinition("commander_dl_regained", "GCS connection regained"), _exact("GCS connection regained")),
     _Entry(EventDefinition("commander_failsafe_enter_low_bat", "Low battery level, return advised", (),
                            Log.WARNING, Log.INFO), _exact("Low battery level, return advised")),
     _Entry(EventDefinition("commander_failsafe_enter_crit_bat_warn", "Critical battery level, land now", (),
@@ -117,7 +125,7 @@ def to_px4_event(event: VehicleEvent) -> Px4Event | None:
         return None
     for entry in ENTRIES:
         match = entry.text.fullmatch(event.text)
-        if match is None:
+        if match is None or entry.statustext not in (None, event.statustext):
             continue
         values = entry.values(match)
         if values is None:

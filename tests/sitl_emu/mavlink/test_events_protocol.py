@@ -152,7 +152,8 @@ def test_an_event_without_arguments_goes_with_its_statustext(entry):
 
     text = re.sub(r"\\(.)", r"\1", entry.text.pattern)  # the exact text the entry matches
     definition = entry.definition
-    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", text))
+    statustext = entry.statustext is not False  # the takeover's two events: with and without a STATUSTEXT
+    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", text, statustext=statustext))
     assert event is not None and event.id == definition.id and event.time_ms == 2000
     assert EventsDecoder(events_metadata()).decode(event.id, event.arguments) == (definition.name, definition.message)
     assert to_px4_event(VehicleEvent(1, 0, Severity.INFO, "commander", text, is_event=False)) is None

@@ -75,6 +75,13 @@ def test_data_link_loss_tells_its_cause_and_the_return_the_hold_delays():
     assert act[1:3] == ("commander_failsafe_enter", "GCS connection loss: switching to RTL")
     assert act[0] == pytest.approx(hold[0] + 5.0, abs=0.05)
     assert act[0] == pytest.approx(_text_time(v, "Failsafe activated", text_seq), abs=0.001)
+    decoded = [DECODER.decode(e.id, e.arguments) for _, e in v.px4_events_after(seq)]
+    assert decoded[0] == ("commander_gcs_lost", "Connection to ground control station lost")  # dataLinkCheck
+    seq = _px4_seq(v)
+    v.gcs_heartbeat()
+    v.run_for(0.1)
+    assert ("commander_dl_regained", "GCS connection regained") in [
+        DECODER.decode(e.id, e.arguments) for _, e in v.px4_events_after(seq)]
 
 
 def test_a_critical_battery_names_its_level():
