@@ -140,3 +140,8 @@ def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> 
 
 def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
     return arming_failure(nav_state, c, armed) is None
+
+
+def modes_requiring(req: int) -> int:
+    """The nav_states (one bit each, as failsafe_flags.mode_req_* hold them) whose requirements include `req`."""
+    return sum(1 << int(nav) for nav, r in _REQUIREMENTS.items() if r & req)

@@ -14,8 +14,10 @@ from collections.abc import Callable
 from sitl_emu.commander import arming
 from sitl_emu.commander.failsafe import Failsafe
 from sitl_emu.commander.fault_failsafes import FaultFlags
+from sitl_emu.commander.health_report import HealthReporter, ReportInputs
 from sitl_emu.commander.manual_control import ManualControlSignal
 from sitl_emu.commander.mode_intention import ModeIntention
+from sitl_emu.commander.notices import SendEvent, drop, failsafe_notice_event
 from sitl_emu.commander.offboard import OffboardSignal
 from sitl_emu.commander.settings import CommanderSettings
 from sitl_emu.commander.stick_gestures import Gesture, GestureDetector, StickMotion
@@ -31,8 +33,7 @@ from sitl_emu.types import HomePosition, ManualControlSetpoint, OffboardControlM
 Emit = Callable[[Severity, str, str, bool, bool], None]
 # geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
 NedOf = Callable[[float, float, float], Vec3]
-# the current position as a home candidate, None while the estimator is not ready (called only when home is set:
-# at arming, when first ready, on DO_SET_HOME)
+# the current position as a home candidate, None while the estimator is not ready (asked when home is set)
 Here = Callable[[], HomePosition | None]
 
 
@@ -43,11 +44,13 @@ def _nowhere() -> HomePosition | None:
 class Commander:
     """The vehicle's brain; see the module docstring."""
 
-    def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None, here: Here = _nowhere) -> None:
+    def __init__(self, params: ParamRegistry, emit: Emit, ned_of: NedOf | None = None, here: Here = _nowhere,
+                 send_event: SendEvent = drop) -> None:
         self.params = params
         self._settings = CommanderSettings.from_params(params)
         self._settings_version = params.version
-        self._emit = emit
+        self._emit, self._send_event = emit, send_event  # texts; PX4 events no text tells (commander/notices.py)
+        self._health = HealthReporter()
         self._ned_of = ned_of
         self._here = here
         self.intention = ModeIntention(NavState.AUTO_LOITER)
@@ -90,8 +93,7 @@ class Commander:
 
     # ---- inputs -------------------------------------------------------------------------------------------------
     def observe(self, now_us: int, *, estimator_ready: bool, task_finished: bool = False) -> None:
-        """What the commander sees of the vehicle at the start of a cycle: the time, whether the estimator is ready,
-        and whether the navigator's current task says it is done (takeoff reached)."""
+        """The vehicle at a cycle's start: the time, the estimator ready, the navigator's task done (takeoff)."""
         self.now_us = now_us
         self.estimator_ready = estimator_ready
         self._task_finished = task_finished
@@ -294,9 +296,8 @@ class Commander:
             self._apply_mode(self.now_us)
         return ok
 
-    def _apply_mode(self, now_us: int) -> None:
-        """The mode in force: the user's mode, or the failsafe's fallback while it cannot run; an armed vehicle never
-        leaves termination."""
+    def _apply_mode(self, now_us: int) -> arming.CheckInputs:
+        """The mode in force (the user's, or the failsafe's while it cannot run; termination sticks while armed)."""
         st = self.settings
         inputs = self._check_inputs(now_us, st)
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
@@ -308,9 +309,21 @@ class Commander:
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
         if decision.activated:
+            self._send_event(failsafe_notice_event(self.intention.user_intended, decision, now_us))
             self.say(Severity.CRITICAL, decision.text)
         if decision.disarm:
             self.disarm("failsafe", forced=True)
+        return inputs
+
+    def report_health(self, now_us: int, inputs: arming.CheckInputs | None = None, force: bool = False) -> None:
+        """HealthAndArmingChecks::update (10 Hz, on a status change, forced by RUN_PREARM_CHECKS): a report if due."""
+        if self._health.due(now_us, (self.nav_state, self.armed), force):
+            st = self.settings
+            checked = inputs or self._check_inputs(now_us, st)
+            report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, self.fault_flags,
+                                     st.rc_in_mode == 4, st.faults.dll.rcl_act > 0)
+            for event in self._health.update(now_us, report, force):
+                self._send_event(event)
 
     # ---- the periodic update ------------------------------------------------------------------------------------
     def update(self, now_us: int) -> None:
@@ -318,7 +331,7 @@ class Commander:
         self._update_ready()
         self._auto_disarm(now_us)
         self._takeoff_completion()
-        self._apply_mode(now_us)
+        self.report_health(now_us, self._apply_mode(now_us))
 
     def _update_ready(self) -> None:
         if not self.estimator_ready:

@@ -247,6 +247,8 @@ def _reboot(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
 
 
 def _prearm_checks(c: Commander, cmd: VehicleCommand, now_us: int) -> CommandAck:
+    """RUN_PREARM_CHECKS: the health and arming check report goes out now (HealthAndArmingChecks::update(true))."""
+    c.report_health(now_us, force=True)
     return _ack(cmd, MavResult.ACCEPTED)
 
 

@@ -12,6 +12,9 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
   by the user ends it (the new mode can run, or the change was refused);
 - flight termination (DO_FLIGHTTERMINATION) holds TERMINATION while armed;
 - a geofence breach acts as GF_ACTION says (commander/geofence_failsafe.py), ranked with the others.
+Each action keeps its cause (failsafe.cpp causedBy: manual-control loss, GCS connection loss, the battery level;
+everything else is generic), and a Hold before a delayed action knows the action it waits for: the Decision carries
+both, for notifyUser's event (events/failsafe_notices.py).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from sitl_emu.commander.arming import CheckInputs, Req, can_run
 from sitl_emu.commander.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
 from sitl_emu.commander.geofence_failsafe import GeofenceFailsafe
 from sitl_emu.commander.manual_control import ManualLossFailsafe, ManualLossSettings
+from sitl_emu.events.failsafe_notices import CAUSE_GCS_CONNECTION_LOSS, CAUSE_GENERIC, CAUSE_MANUAL_CONTROL_LOSS
 from sitl_emu.navigator.geofence import GeofenceResult
 from sitl_emu.px4 import NavState
 
@@ -36,14 +40,20 @@ class Decision:
     disarm: bool = False
     activated: bool = False  # the action got worse at this update: tell the user `text`
     text: str = ""
+    # what notifyUser tells with it: failsafe_action_t, the delayed action (during its Hold), failsafe_cause_t
+    action: int = 0
+    delayed_action: int = 0
+    cause: int = 0
+    delay_s: int = 0
 
     def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False,
-                 text: str = "") -> None:
+                 text: str = "", notice: tuple[int, int, int, int] = (0, 0, 0, 0)) -> None:
         self.nav_state = nav_state
         self.failsafe = failsafe
         self.disarm = disarm
         self.activated = activated
         self.text = text
+        self.action, self.delayed_action, self.cause, self.delay_s = notice
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
@@ -108,17 +118,18 @@ _DISARM_RANK = 9
 _HOLD_RANK = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT = "Failsafe activated"
 
-# an action in force: (rank, mode, disarm); rank 0: none, the user's mode
-_Action = tuple[int, NavState, bool]
+# an action in force: (rank, mode, disarm, cause); rank 0: none, the user's mode. The rank is framework.h's Action.
+_Action = tuple[int, NavState, bool, int]
 
 
-def _worse(current: _Action, user: NavState, wanted: NavState | None, disarm: bool) -> _Action:
+def _worse(current: _Action, user: NavState, wanted: NavState | None, disarm: bool,
+           cause: int = CAUSE_GENERIC) -> _Action:
     """Combine one source's want with the action so far: disarming beats every mode (keeping the user's mode),
     otherwise the higher-ranked mode wins; a source that wants nothing (None, no disarm) changes nothing."""
     if disarm:
-        return (_DISARM_RANK, user, True) if current[0] < _DISARM_RANK else current
+        return (_DISARM_RANK, user, True, cause) if current[0] < _DISARM_RANK else current
     if wanted is not None and _RANK[wanted] > current[0]:
-        return _RANK[wanted], wanted, False
+        return _RANK[wanted], wanted, False, cause
     return current
 
 
@@ -158,7 +169,7 @@ class Failsafe:
             return Decision(user, False)
         if terminated:
             return self._decide(NavState.TERMINATION, False, "")
-        action: _Action = (0, user, False)
+        action: _Action = (0, user, False, CAUSE_GENERIC)
         # framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with
         # its Hold first): for the user's own mode, missing sticks are not a reason to fall back at once
         if not can_run(user, inputs, ignoring=Req.MANUAL):
@@ -166,23 +177,36 @@ class Failsafe:
             action = _worse(action, user, fallback, fallback is None)
         if manual_loss is not None:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
-            action = _worse(action, user, wanted, self.manual_loss.disarm)
+            action = _worse(action, user, wanted, self.manual_loss.disarm, CAUSE_MANUAL_CONTROL_LOSS)
         if faults is not None:
             for want in self.faults.wanted(now_us, user, *faults):
-                action = _worse(action, user, want.mode, want.disarm)
+                action = _worse(action, user, want.mode, want.disarm, want.cause)
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)
-        rank, mode, disarm = action
+        rank, mode, disarm, cause = action
         if rank == 0:
             self.active, self._rank = False, 0
             return Decision(user, False)
-        hold_s = 0
+        hold_s, delayed = 0, 0
         if mode is NavState.AUTO_LOITER:
-            hold_s = max(self.manual_loss.hold_s(now_us), self.faults.hold_s(now_us), self.geofence.hold_s(now_us))
+            hold_s, delayed, cause = self._delayed(now_us, cause)
         text = f"{FAILSAFE_TEXT}: entering Hold for {hold_s} seconds" if hold_s > 0 else FAILSAFE_TEXT
-        decision = self._decide(mode, disarm, text if rank > self._rank else "")
+        decision = self._decide(mode, disarm, text if rank > self._rank else "", (rank, delayed, cause, hold_s))
         self._rank = rank
         return decision
+
+    def _delayed(self, now_us: int, cause: int) -> tuple[int, int, int]:
+        """(seconds of Hold left, the action it delays, that action's cause) for the Hold before a delayed action;
+        (0, 0, cause) for a Hold that is the action itself. The worst delayed action wins, as its cause."""
+        holds = ((self.manual_loss, CAUSE_MANUAL_CONTROL_LOSS), (self.faults.dll, CAUSE_GCS_CONNECTION_LOSS),
+                 (self.faults.battery, self.faults.battery.cause), (self.geofence, CAUSE_GENERIC))
+        hold_s, delayed = 0, 0
+        for source, source_cause in holds:
+            left = source.hold_s(now_us)
+            hold_s = max(hold_s, left)
+            if left > 0 and source.action is not None and _RANK[source.action] > delayed:
+                delayed, cause = _RANK[source.action], source_cause
+        return hold_s, (delayed if hold_s > 0 else 0), cause
 
     def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
                   current: _Action) -> _Action:
@@ -191,6 +215,7 @@ class Failsafe:
         wanted = self.geofence.update(now_us, result, user, fail_act_us, worse_than_hold)
         return _worse(current, user, wanted, False)
 
-    def _decide(self, nav_state: NavState, disarm: bool, text: str) -> Decision:
+    def _decide(self, nav_state: NavState, disarm: bool, text: str,
+                notice: tuple[int, int, int, int] = (0, 0, 0, 0)) -> Decision:
         self.active = True
-        return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text)
+        return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text, notice=notice)

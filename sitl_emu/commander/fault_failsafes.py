@@ -18,6 +18,7 @@ from typing import Final
 
 from sitl_emu.commander.battery import WARNING_NONE, battery_action
 from sitl_emu.commander.manual_control import ManualLossFailsafe, ManualLossSettings
+from sitl_emu.events.failsafe_notices import CAUSE_BATTERY_OFFSET, CAUSE_GCS_CONNECTION_LOSS, CAUSE_GENERIC
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState
 
@@ -60,6 +61,7 @@ class Want:
 
     mode: NavState | None
     disarm: bool = False
+    cause: int = CAUSE_GENERIC
 
 
 class BatteryFailsafe:
@@ -70,6 +72,7 @@ class BatteryFailsafe:
 
     def reset(self) -> None:
         self.action: NavState | None = None
+        self.cause = CAUSE_GENERIC
         self._hold_until_us = 0
         self._held = False
 
@@ -78,7 +81,7 @@ class BatteryFailsafe:
         if action is not None and action is not self.action:
             if not self._held and action in _DELAYABLE and s.fail_act_us > 100_000:
                 self._hold_until_us, self._held = now_us + s.fail_act_us, True  # the Hold comes once
-            self.action = action
+            self.action, self.cause = action, flags.battery_warning + CAUSE_BATTERY_OFFSET
         if self.action is None:
             return None
         return NavState.AUTO_LOITER if now_us < self._hold_until_us else self.action
@@ -103,12 +106,12 @@ class FaultFailsafes:
         lost = flags.gcs_connection_lost and user not in (NavState.AUTO_LAND, NavState.AUTO_PRECLAND)
         dll = self.dll.update(now_us, lost, user, s.dll)
         if self.dll.disarm:
-            wants.append(Want(None, disarm=True))
+            wants.append(Want(None, disarm=True, cause=CAUSE_GCS_CONNECTION_LOSS))
         elif dll is not None:
-            wants.append(Want(dll))
+            wants.append(Want(dll, cause=CAUSE_GCS_CONNECTION_LOSS))
         bat = self.battery.update(now_us, flags, s)
         if bat is not None:
-            wants.append(Want(bat))
+            wants.append(Want(bat, cause=self.battery.cause))
         if flags.fd_critical_failure:
             if now_us < flags.armed_at_us + s.spoolup_us + EARLY_TAKEOFF_US:
                 wants.append(Want(None, disarm=True))

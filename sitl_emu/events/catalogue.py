@@ -6,12 +6,18 @@ the event PX4 sends with it: its name, message, argument types and levels as PX4
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
 navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter),
-commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover), navigator/takeoff.cpp
+commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover from a failsafe, an event only; without
+a failsafe Commander::manualControlCheck's commander_rc_override with its STATUSTEXT), Commander::dataLinkCheck
+(commander_gcs_lost, commander_dl_regained), navigator/takeoff.cpp
 (navigator_takeoff_default_alt, whose altitude is read back from the text's one decimal;
 navigator_takeoff_already_higher).
 
-A text no entry matches has no event here yet (the failsafe notices, which need the failsafe's cause and action);
-its STATUSTEXT goes out as before.
+framework.cpp's warning-only battery failsafes (commander_failsafe_enter_low_bat, _crit_bat_warn,
+_crit_low_bat_warn: events only, no STATUSTEXT) go with the texts commander/battery.py says for them.
+
+The events no text tells are sent by the commander directly: the failsafe notices with their action and cause
+(failsafe_notices.py) and the health and arming check report (health_events.py); DEFINITIONS lists all of them, so
+the served metadata describes every event the emulator sends. A text no entry matches has no event.
 """
 
 from __future__ import annotations
@@ -20,45 +26,13 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from sitl_emu.events import enums
-from sitl_emu.events.library import Log, event_id, log_levels, pack_arguments
+from sitl_emu.events import enums, failsafe_notices, health_events
+from sitl_emu.events.definition import EventDefinition, Px4Event, Values, critical, px4_event
+from sitl_emu.events.library import Log
 from sitl_emu.px4 import UI_NAMES, custom_mode
 from sitl_emu.types import VehicleEvent
 
-Values = tuple[float, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class EventDefinition:
-    name: str  # events::ID("name")
-    message: str  # libevents format: {1} is the first argument
-    arguments: tuple[str, ...] = ()  # metadata types: a base type or "px4::<enum>"
-    external: Log = Log.INFO
-    internal: Log | None = None  # None: the same as external (events::send with one level)
-    group: str = "default"
-
-    @property
-    def id(self) -> int:
-        return event_id(self.name)
-
-    @property
-    def levels(self) -> int:
-        return log_levels(self.external, self.internal)
-
-    @property
-    def base_types(self) -> tuple[str, ...]:
-        by_name = {f"{enums.NAMESPACE}::{e.name}": e.base_type for e in enums.ENUMS}
-        return tuple(by_name.get(t, t) for t in self.arguments)
-
-
-@dataclass(frozen=True, slots=True)
-class Px4Event:
-    """One event as PX4's event_s holds it (what mavlink_events.cpp puts in an EVENT)."""
-
-    id: int
-    log_levels: int
-    time_ms: int
-    arguments: bytes  # 40 bytes
+__all__ = ["DEFINITIONS", "ENTRIES", "EventDefinition", "Px4Event", "to_px4_event"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,6 +40,7 @@ class _Entry:
     definition: EventDefinition
     text: re.Pattern[str]
     values: Callable[[re.Match[str]], Values | None] = lambda m: ()
+    statustext: bool | None = None  # matches only a text that does (True) / does not (False) go out as STATUSTEXT
 
 
 def _reason(m: re.Match[str]) -> Values | None:
@@ -85,13 +60,9 @@ def _rejected_mode(m: re.Match[str]) -> Values | None:
     return None if nav is None else (custom_mode(nav), enums.navigation_mode(nav))
 
 
-_REASON = f"{enums.NAMESPACE}::{enums.ARM_DISARM_REASON.name}"
-_NAV_MODE = f"{enums.NAMESPACE}::{enums.NAVIGATION_MODE.name}"
-
-
-def _critical(name: str, message: str, arguments: tuple[str, ...] = ()) -> EventDefinition:
-    """{events::Log::Critical, events::LogInternal::Info}: PX4's refusals."""
-    return EventDefinition(name, message, arguments, Log.CRITICAL, Log.INFO)
+_REASON = enums.qualified(enums.ARM_DISARM_REASON)
+_NAV_MODE = enums.qualified(enums.NAVIGATION_MODE)
+_critical = critical
 
 
 def _exact(text: str) -> re.Pattern[str]:
@@ -127,13 +98,25 @@ ENTRIES: tuple[_Entry, ...] = (
            re.compile(r"Using default takeoff altitude: (-?[\d.]+) m"), lambda m: (float(m.group(1)),)),
     _Entry(EventDefinition("navigator_takeoff_already_higher", "Already higher than takeoff altitude (not descending)",
                            external=Log.ERROR, internal=Log.INFO), _exact("Already higher than takeoff altitude")),
+    _Entry(EventDefinition("commander_rc_override", "Pilot took over using sticks"),
+           _exact("Pilot took over using sticks"), statustext=True),
     _Entry(EventDefinition("failsafe_rc_override", "Pilot took over using sticks"),
-           _exact("Pilot took over using sticks")),
+           _exact("Pilot took over using sticks"), statustext=False),
+    _Entry(EventDefinition("commander_gcs_lost", "Connection to ground control station lost", (), Log.WARNING,
+                           Log.INFO), _exact("Connection to ground station lost")),
+    _Entry(EventDefinition("commander_dl_regained", "GCS connection regained"), _exact("GCS connection regained")),
+    _Entry(EventDefinition("commander_failsafe_enter_low_bat", "Low battery level, return advised", (),
+                           Log.WARNING, Log.INFO), _exact("Low battery level, return advised")),
+    _Entry(EventDefinition("commander_failsafe_enter_crit_bat_warn", "Critical battery level, land now", (),
+                           Log.CRITICAL, Log.INFO), _exact("Critical battery level, land now")),
+    _Entry(EventDefinition("commander_failsafe_enter_crit_low_bat_warn", "Emergency battery level, land immediately",
+                           (), Log.EMERGENCY, Log.INFO), _exact("Emergency battery level, land immediately")),
     _Entry(EventDefinition("rtl_land_at_destination", "RTL: land at destination"), _exact("RTL: land at destination")),
     _Entry(EventDefinition("rtl_completed_loiter", "RTL: completed, loitering"), _exact("RTL: completed, loitering")),
 )
 
-DEFINITIONS: tuple[EventDefinition, ...] = tuple(e.definition for e in ENTRIES)
+DEFINITIONS: tuple[EventDefinition, ...] = (tuple(e.definition for e in ENTRIES) + failsafe_notices.DEFINITIONS
+                                             + health_events.DEFINITIONS)
 
 
 def to_px4_event(event: VehicleEvent) -> Px4Event | None:
@@ -142,11 +125,10 @@ def to_px4_event(event: VehicleEvent) -> Px4Event | None:
         return None
     for entry in ENTRIES:
         match = entry.text.fullmatch(event.text)
-        if match is None:
+        if match is None or entry.statustext not in (None, event.statustext):
             continue
         values = entry.values(match)
         if values is None:
             return None
-        d = entry.definition
-        return Px4Event(d.id, d.levels, event.time_us // 1000, pack_arguments(d.base_types, values))
+        return px4_event(entry.definition, values, event.time_us)
     return None

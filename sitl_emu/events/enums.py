@@ -1,6 +1,10 @@
 """The PX4 event enums the emulator's events carry (PX4 src/lib/events/enums.json, namespace "px4"): their base
 type and entries (value -> name, the description a ground station shows), and the maps from the emulator's terms.
 
+failsafe_action_t / failsafe_cause_t are failsafe/framework.h's Action and Cause (notifyUser casts one to the other);
+health_component_t and navigation_mode_group_t are bitfields (one bit per component; bit n = nav_state n, as
+Report::getModeGroup maps them), carried by the health and arming check report (HealthAndArmingChecks/Common.cpp).
+
 navigation_mode_t follows mode_util::navigation_mode (commander/ModeUtil/conversions.hpp): one entry per nav_state a
 user can select, `unknown` (255) for the others (Descend, Termination). arm_disarm_reason_t's descriptions are
 what Commander.cpp's arm_disarm_reason_str prints after "Armed by".
@@ -21,6 +25,7 @@ class EventEnum:
     base_type: str
     description: str
     entries: tuple[tuple[int, str, str], ...]  # (value, name, description)
+    is_bitfield: bool = False
 
     def value_of(self, description: str) -> int | None:
         return next((v for v, _, d in self.entries if d == description), None)
@@ -42,7 +47,55 @@ NAVIGATION_MODE = EventEnum("navigation_mode_t", "uint8_t", "Flight mode", (
     (13, "auto_precland", "Precision Landing"), (14, "orbit", "Orbit"), (15, "auto_vtol_takeoff", "Vtol Takeoff"),
     (255, "unknown", "[Unknown]")))
 
-ENUMS: tuple[EventEnum, ...] = (ARM_DISARM_REASON, NAVIGATION_MODE)
+FAILSAFE_ACTION = EventEnum("failsafe_action_t", "uint8_t", "failsafe action", (
+    (0, "none", ""), (1, "warn", "warning"), (2, "fallback_posctrl", "fallback to position control"),
+    (3, "fallback_altctrl", "fallback to altitude control"), (4, "fallback_stabilized", "fallback to stabilized"),
+    (5, "hold", "hold"), (6, "rtl", "RTL"), (7, "land", "land"), (8, "descend", "descend"), (9, "disarm", "disarm"),
+    (10, "terminate", "terminate")))
+
+FAILSAFE_CAUSE = EventEnum("failsafe_cause_t", "uint8_t", "Cause for entering failsafe", (
+    (0, "generic", ""), (1, "manual_control_loss", "manual control loss"),
+    (2, "gcs_connection_loss", "GCS connection loss"), (3, "low_battery_level", "low battery level"),
+    (4, "critical_battery_level", "critical battery level"),
+    (5, "emergency_battery_level", "emergency battery level")))
+
+HEALTH_COMPONENT = EventEnum("health_component_t", "uint32_t", "Bitfield for subsystems & components", tuple(
+    (1 << i, name, text) for i, (name, text) in enumerate((
+        ("none", "None"), ("absolute_pressure", "Absolute pressure"),
+        ("differential_pressure", "Differential pressure"), ("gps", "GPS"), ("optical_flow", "Optical flow"),
+        ("vision_position", "Vision position estimate"), ("distance_sensor", "Distance sensor"),
+        ("remote_control", "Remote Control (RC or Joystick)"), ("motors_escs", "Motors/ESCs"), ("utm", "UTM"),
+        ("logging", "Logging"), ("battery", "Battery"), ("communication_links", "Communication links"),
+        ("rate_controller", "Rate controller"), ("attitude_controller", "Attitude controller"),
+        ("position_controller", "Position controller"), ("attitude_estimate", "Attitude estimate"),
+        ("local_position_estimate", "Local position estimate"), ("mission", "Mission"), ("avoidance", "Avoidance"),
+        ("system", "System"), ("camera", "Camera"), ("gimbal", "Gimbal"), ("payload", "Payload"),
+        ("global_position_estimate", "Global position estimate"), ("storage", "Storage"),
+        ("parachute", "Parachute"), ("magnetometer", "Magnetometer"), ("accel", "Accelerometer"),
+        ("gyro", "Gyroscope"), ("open_drone_id", "Open Drone ID system")))), is_bitfield=True)
+
+NAVIGATION_MODE_GROUP = EventEnum(
+    "navigation_mode_group_t", "uint32_t", "Navigation/flight mode group bits. All modes within a group share the "
+    "same arming checks. For now we directly map group == mode.", tuple((1 << bit, name, text) for bit, name, text in (
+        (0, "manual", "Fully manual mode (w/o any controller support)"), (1, "altctl", "Altitude mode"),
+        (2, "posctl", "Position mode"), (3, "mission", "Mission mode"), (4, "loiter", "Loiter"), (5, "rtl", "RTL"),
+        (10, "acro", "Acro"), (14, "offboard", "Offboard"), (15, "stab", "Stabilized"), (17, "takeoff", "Takeoff"),
+        (18, "land", "Land"), (19, "follow_target", "Follow Target"), (20, "precland", "Precision Land"),
+        (21, "orbit", "Orbit"), (22, "vtol_takeoff", "VTOL Takeoff"))) + tuple(
+        (1 << (22 + n), f"external{n}", f"External {n}") for n in range(1, 9)), is_bitfield=True)
+
+ENUMS: tuple[EventEnum, ...] = (ARM_DISARM_REASON, NAVIGATION_MODE, FAILSAFE_ACTION, FAILSAFE_CAUSE, HEALTH_COMPONENT,
+                                NAVIGATION_MODE_GROUP)
+
+
+def qualified(e: EventEnum) -> str:
+    """The enum as an argument type names it: "px4::failsafe_action_t"."""
+    return f"{NAMESPACE}::{e.name}"
+
+
+def health_component_index(name: str) -> int:
+    """HealthComponentIndex: the bit number of a health component (what a check event carries)."""
+    return next(v for v, n, _ in HEALTH_COMPONENT.entries if n == name).bit_length() - 1
 
 NAVIGATION_MODE_UNKNOWN = 255
 _NAVIGATION_MODE_OF: dict[NavState, int] = {

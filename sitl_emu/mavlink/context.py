@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
     from pymavlink.dialects.v20.development import MAVLink_message
 
+    from sitl_emu.events.definition import Px4Event
     from sitl_emu.mavlink.wire.encoding import MessageEncoder
     from sitl_emu.mavlink.wire.fastpack import Packed
     from sitl_emu.navigator.mission_store import MissionStore
@@ -98,6 +99,10 @@ class LinkVehicle(Protocol):
         ...
 
     def events_after(self, seq: int) -> list[VehicleEvent]: ...
+
+    def px4_events_after(self, seq: int) -> list[tuple[int, Px4Event]]:
+        """PX4's events (sitl_emu/events) after `seq`, each with its own seq, in the order sent."""
+        ...
 
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None: ...
 

@@ -26,6 +26,7 @@ from sitl_emu.commander.commands import handle_command
 from sitl_emu.control.qmath import euler_from_q, yaw_from_q
 from sitl_emu.disturbance.estimate import EstimateNoiseSettings
 from sitl_emu.disturbance.wind import WindSettings
+from sitl_emu.events.catalogue import Px4Event, to_px4_event
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.geo import SIH_HOME, GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.mission_store import MissionStore
@@ -83,6 +84,8 @@ class Vehicle:
         self._estimate_noise = estimate_noise
         self._events: deque[VehicleEvent] = deque(maxlen=EVENT_HISTORY)
         self._seq = 0
+        self._px4_events: deque[tuple[int, Px4Event]] = deque(maxlen=EVENT_HISTORY)
+        self._px4_seq = 0
         self._boot()
 
     def _boot(self) -> None:
@@ -94,7 +97,7 @@ class Vehicle:
         self._motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the mixer's output of the last tick
         self._sih_version = -1
         self._sih = sih_config(self.params)
-        self.commander = Commander(self.params, self._emit, self._ned_of, self._here)
+        self.commander = Commander(self.params, self._emit, self._ned_of, self._here, self._send_px4_event)
         self.chain = ControlChain(self.params)
         self._setpoint_type = SetpointType.NONE
         self._task_finished = False
@@ -232,9 +235,25 @@ class Vehicle:
     def last_event_seq(self) -> int:
         return self._seq
 
+    def px4_events_after(self, seq: int) -> list[tuple[int, Px4Event]]:
+        """PX4's events (events/) with their own seq > `seq`, in the order sent: the one each text goes with and
+        those the commander sends without a text (the failsafe notices' arguments, the health report)."""
+        if seq >= self._px4_seq or not self._px4_events:
+            return []
+        start = max(0, seq + 1 - self._px4_events[0][0])
+        return list(itertools.islice(self._px4_events, start, None))
+
     def _emit(self, severity: Severity, module: str, text: str, is_event: bool, statustext: bool) -> None:
         self._seq += 1
-        self._events.append(VehicleEvent(self._seq, self._time_us, severity, module, text, is_event, statustext))
+        event = VehicleEvent(self._seq, self._time_us, severity, module, text, is_event, statustext)
+        self._events.append(event)
+        px4 = to_px4_event(event)
+        if px4 is not None:
+            self._send_px4_event(px4)
+
+    def _send_px4_event(self, event: Px4Event) -> None:
+        self._px4_seq += 1
+        self._px4_events.append((self._px4_seq, event))
 
     def _ned_of(self, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> Vec3:
         return global_to_ned(self.ref, lat_deg, lon_deg, alt_amsl_m)

@@ -1,12 +1,15 @@
 """A ground station's side of PX4's events: libevents' ReceiveProtocol (libs/cpp/protocol/receive.h: follow the
-sequence, ask for what was missed) and its Parser (libs/python/libevents_parse/parser.py: find an event by component
-and sub id in the metadata, unpack its arguments, fill the message), written small for the tests.
+sequence, ask for what was missed), its Parser (libs/python/libevents_parse/parser.py: find an event by component
+and sub id in the metadata, unpack its arguments, fill the message) and its health and arming check report parser
+(libs/python/libevents_parse/health_and_arming_checks.py, what QGroundControl's arming-check panel is built on),
+written small for the tests.
 """
 
 from __future__ import annotations
 
 import re
 import struct
+from dataclasses import dataclass, field
 from typing import Any
 
 from sitl_emu.mavlink.wire import extra_messages as xm
@@ -35,31 +38,57 @@ class EventsDecoder:
         assert metadata["version"] >= 1
         self.components = metadata["components"]
 
-    def _find(self, event_id: int) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    def _find(self, event_id: int) -> tuple[dict[str, Any], tuple[str, dict[str, Any]]] | None:
         comp = self.components.get(str(event_id >> 24))
         if comp is None:
             return None
-        for group in comp.get("event_groups", {}).values():
+        for name, group in comp.get("event_groups", {}).items():
             event = group.get("events", {}).get(str(event_id & 0xFFFFFF))
             if event is not None:
-                return comp, event
+                return comp, (name, event)
         return None
 
     def decode(self, event_id: int, arguments: bytes | list[int]) -> tuple[str, str] | None:
         """(name, message with its arguments filled in), or None for an event the metadata lacks."""
+        parsed = self.parse(event_id, arguments)
+        return None if parsed is None else (parsed.name, parsed.message)
+
+    def parse(self, event_id: int, arguments: bytes | list[int], log_levels: int = 0) -> ParsedEvent | None:
         found = self._find(event_id)
         if found is None:
             return None
-        comp, event = found
-        data, offset, shown = bytes(arguments), 0, []
+        comp, (group, event) = found[0], found[1]
+        data, offset, values, kinds = bytes(arguments), 0, [], []
         for arg in event.get("arguments", []):
             enum = comp.get("enums", {}).get(arg["type"].split("::")[-1]) if "::" in arg["type"] else None
             code = _BASE[enum["type"] if enum else arg["type"]]
             (value,) = struct.unpack_from("<" + code, data, offset)
             offset += struct.calcsize(code)
-            shown.append(enum["entries"].get(str(value), {}).get("description", f"(unknown: {value})") if enum
-                         else value)
-        return event["name"], _ARGUMENT.sub(lambda m: _shown(m, shown), event["message"])
+            values.append(value)
+            kinds.append(enum)
+        shown = [_display(v, e) for v, e in zip(values, kinds, strict=True)]
+        message = _ARGUMENT.sub(lambda m: _shown(m, shown), event["message"])
+        return ParsedEvent(event_id, event["name"], message, group, event.get("type", ""), values, kinds, log_levels)
+
+
+def _display(value: Any, enum: dict[str, Any] | None) -> Any:
+    if enum is None:
+        return value
+    if enum.get("is_bitfield"):
+        return ", ".join(e["description"] for k, e in enum["entries"].items() if value & int(k))
+    return enum["entries"].get(str(value), {}).get("description", f"(unknown: {value})")
+
+
+@dataclass
+class ParsedEvent:
+    id: int
+    name: str
+    message: str
+    group: str
+    type: str
+    values: list[Any]
+    enums: list[dict[str, Any] | None]
+    log_levels: int = 0
 
 
 # libevents' argument syntax: {N[:.DIGITS][UNIT]}, UNIT one of m, m_v (vertical metres: shown as m), m/s, m^2, C
@@ -134,3 +163,56 @@ class EventReceiver:
         self.client.send_raw(frame_message(msg, self.client.mav.seq, self.client.mav.srcSystem,
                                            self.client.mav.srcComponent))
         self.client.mav.seq = (self.client.mav.seq + 1) % 256
+
+
+@dataclass
+class HealthResults:
+    """libevents' HealthAndArmingChecks.Results: per mode group (bit index) can_arm / can_run, per health component
+    its flags, and the checks (message, affected modes, health component index, external log level)."""
+
+    can_arm: dict[int, bool] = field(default_factory=dict)
+    can_run: dict[int, bool] = field(default_factory=dict)
+    components: dict[str, dict[str, bool]] = field(default_factory=dict)
+    checks: list[tuple[str, int, int, int]] = field(default_factory=list)
+
+    def checks_for(self, group: int) -> list[str]:
+        """The messages of the checks that affect a mode group (what QGC lists for the current mode)."""
+        return [message for message, modes, _, _ in self.checks if modes >> group & 1]
+
+
+class HealthAndArmingChecks:
+    """libevents' parser: an arming_check summary, the checks, then the health summary of the same chunk."""
+
+    def __init__(self) -> None:
+        self.results: HealthResults | None = None
+        self._current: HealthResults | None = None
+
+    def handle(self, e: ParsedEvent) -> bool:
+        """Feed one event; True when a whole report was read (self.results)."""
+        if e.group == "arming_check" and e.type == "summary" and len(e.values) >= 5:
+            self._current = self._summary(e)
+        elif e.group in ("arming_check", "health") and e.type == "" and self._current is not None:
+            self._current.checks.append((e.message, e.values[0], e.values[1], e.log_levels & 0xF))
+        elif e.group == "health" and e.type == "summary" and self._current is not None and e.values[0] == 0:
+            for _name, bit, flags in self._entries(e.enums[1]):
+                flags.update(present=bool(e.values[1] & bit), error=bool(e.values[2] & bit),
+                             warning=bool(e.values[3] & bit))
+            self.results, self._current = self._current, None
+            return True
+        return False
+
+    def _summary(self, e: ParsedEvent) -> HealthResults:
+        r = HealthResults()
+        assert e.enums[3] is not None and e.enums[1] is not None
+        for key in e.enums[3]["entries"]:
+            index = int(key).bit_length() - 1
+            r.can_arm[index], r.can_run[index] = bool(e.values[3] & int(key)), bool(e.values[4] & int(key))
+        for key, entry in e.enums[1]["entries"].items():
+            r.components[entry["name"]] = {"arm_error": bool(e.values[1] & int(key)),
+                                           "arm_warning": bool(e.values[2] & int(key))}
+        return r
+
+    def _entries(self, enum: dict[str, Any] | None) -> list[tuple[str, int, dict[str, bool]]]:
+        assert enum is not None and self._current is not None
+        return [(entry["name"], int(key), self._current.components.setdefault(entry["name"], {}))
+                for key, entry in enum["entries"].items()]

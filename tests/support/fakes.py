@@ -15,6 +15,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.events.catalogue import Px4Event, to_px4_event
 from sitl_emu.px4 import LandedState, MavResult, NavState, Severity
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
 from sitl_emu.types import (
@@ -83,6 +84,10 @@ class FakeVehicle:
 
     def events_after(self, seq: int) -> list[VehicleEvent]:
         return [e for e in self.events if e.seq > seq]
+
+    def px4_events_after(self, seq: int) -> list[tuple[int, Px4Event]]:
+        """The PX4 event each text goes with (as the Vehicle's stream has them), numbered by the text's seq."""
+        return [(e.seq, px4) for e in self.events if e.seq > seq and (px4 := to_px4_event(e)) is not None]
 
     def report(self, severity: Severity, module: str, text: str, is_event: bool = True) -> None:
         self.events.append(VehicleEvent(len(self.events) + 1, self.time_us, severity, module, text, is_event))

@@ -12,6 +12,7 @@ from typing import Any
 
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.events.catalogue import Px4Event, to_px4_event
 from sitl_emu.mavlink.wire.fastpack import ENCODER, Packed, frame_message
 from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.params import ParamRegistry, default_registry
@@ -140,6 +141,10 @@ class FakeVehicle:
 
     def events_after(self, seq: int) -> list[VehicleEvent]:
         return [e for e in self._events if e.seq > seq]
+
+    def px4_events_after(self, seq: int) -> list[tuple[int, Px4Event]]:
+        """The PX4 event each text goes with (as the Vehicle's stream has them), numbered by the text's seq."""
+        return [(e.seq, px4) for e in self._events if e.seq > seq and (px4 := to_px4_event(e)) is not None]
 
     @property
     def events(self) -> list[VehicleEvent]:

@@ -1,6 +1,7 @@
 """PX4's events interface on one link (src/modules/mavlink/mavlink_events.cpp/.h, as libevents' receive.h expects it).
 
-- Events (sitl_emu/events/catalogue.py: the PX4 event beside each '\\t'-terminated text of the vehicle) get PX4's
+- Events (the vehicle's px4_events_after: the PX4 event beside each '\\t'-terminated text, sitl_emu/events/
+  catalogue.py, and those the commander sends alone: failsafe notices, the health and arming check report) get PX4's
   global sequence, which starts at events::initial_event_sequence (65535 - 10, so it wraps soon) and counts one per
   event, and go into a ring buffer of the last 20 (EventBuffer's default capacity).
 - Each new event goes out at once as EVENT (destination 0/0 = everyone, event_time_boot_ms, id, sequence,
@@ -23,7 +24,7 @@ from __future__ import annotations
 from collections import deque
 from typing import TYPE_CHECKING, ClassVar
 
-from sitl_emu.events.catalogue import Px4Event, to_px4_event
+from sitl_emu.events.catalogue import Px4Event
 from sitl_emu.mavlink.wire.extra_messages import EXTRA, decode, payload_of_unknown, source_of_unknown
 
 if TYPE_CHECKING:
@@ -111,11 +112,9 @@ class EventsProtocol:
             self._sent_any = False
             self._last_current_sequence_us = 0
         self._last_now_us = now_us
-        for vehicle_event in ctx.vehicle.events_after(self._vehicle_seq):
-            self._vehicle_seq = vehicle_event.seq
-            event = to_px4_event(vehicle_event)
-            if event is not None:
-                self._publish(event, ctx)
+        for seq, event in ctx.vehicle.px4_events_after(self._vehicle_seq):
+            self._vehicle_seq = seq
+            self._publish(event, ctx)
         if now_us - self._last_current_sequence_us > CURRENT_SEQUENCE_INTERVAL_US:
             self._send_current_sequence(ctx)
         return True

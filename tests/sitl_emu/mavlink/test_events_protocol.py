@@ -10,6 +10,7 @@ import pytest
 from support.events_client import EventReceiver, EventsDecoder, extra_of
 from support.fakes import Harness
 
+from sitl_emu.events import health_events
 from sitl_emu.events.catalogue import DEFINITIONS, ENTRIES
 from sitl_emu.events.library import event_id, hash_32_fnv1a, sub_id
 from sitl_emu.events.metadata import events_metadata
@@ -40,6 +41,14 @@ def _events(client):
     return [f for msg_id, f in filter(None, map(extra_of, client.received)) if msg_id == 410]
 
 
+_REPORT_IDS = {d.id for d in health_events.DEFINITIONS}
+
+
+def _text_events(client):
+    """The events beside the vehicle's texts, without the health and arming check reports (tested on their own)."""
+    return [e for e in _events(client) if e["id"] not in _REPORT_IDS]
+
+
 def _current(client):
     return [f for msg_id, f in filter(None, map(extra_of, client.received)) if msg_id == 411]
 
@@ -50,21 +59,22 @@ def _command(h, command, *params, wait_s=0.1):
     h.run(wait_s)
 
 
-def test_arming_sends_the_sequence_with_reset_then_commander_armed_by(h):
-    h.run(2.5)
-    before = len(h.gcs.received)
-    _command(h, MavCmd.COMPONENT_ARM_DISARM, 1)
-    new = [extra_of(m) for m in h.gcs.received[before:]]
+def test_the_first_event_comes_after_the_sequence_with_reset_then_commander_armed_by(h):
+    h.run(2.5)  # the first health report (2 s after boot) is the first event
+    new = [extra_of(m) for m in h.gcs.received]
     seq_reset = [f for m in new if m and m[0] == 411 for f in [m[1]]]
     assert seq_reset[0] == {"sequence": FIRST_SEQUENCE, "flags": 1}
-    (armed,) = _events(h.gcs)
-    assert armed["id"] == event_id("commander_armed_by") and armed["sequence"] == FIRST_SEQUENCE
+    assert _events(h.gcs)[0]["sequence"] == FIRST_SEQUENCE
+    latest = _events(h.gcs)[-1]["sequence"]
+    _command(h, MavCmd.COMPONENT_ARM_DISARM, 1)
+    (armed,) = _text_events(h.gcs)
+    assert armed["id"] == event_id("commander_armed_by") and armed["sequence"] == latest + 1
     assert armed["log_levels"] == 0x66 and armed["arguments"][0] == 4  # Info/Info, command_external
     assert (armed["destination_system"], armed["destination_component"]) == (0, 0)
     assert abs(armed["event_time_boot_ms"] - h.vehicle.time_us // 1000) < 200
     assert EventsDecoder(events_metadata()).decode(armed["id"], armed["arguments"]) == \
         ("commander_armed_by", "Armed by external command")
-    assert _events(h.api) == [armed]  # every link sends it, with the same sequence
+    assert _text_events(h.api) == [armed]  # every link sends it, with the same sequence
 
 
 def test_refusals_carry_their_arguments(h):
@@ -73,20 +83,23 @@ def test_refusals_carry_their_arguments(h):
     _command(h, MavCmd.COMPONENT_ARM_DISARM, 1)
     _command(h, MavCmd.DO_SET_MODE, 1, 6, 0)  # armed, OFFBOARD without setpoints, from QGC's component
     decoder = EventsDecoder(events_metadata())
-    decoded = [decoder.decode(e["id"], e["arguments"]) for e in _events(h.gcs)]
+    decoded = [decoder.decode(e["id"], e["arguments"]) for e in _text_events(h.gcs)]
     assert decoded == [("commander_arm_denied_resolve_failures", "Arming denied: Resolve system health failures first"),
                        ("commander_armed_by", "Armed by external command"),
                        ("commander_modeswitch_not_avail", "Switching to mode 'Offboard' is currently not possible")]
-    refused = _events(h.gcs)[2]
+    refused = _text_events(h.gcs)[2]
     assert refused["log_levels"] == 0x62  # {Critical, LogInternal::Info}
     assert bytes(refused["arguments"][:5]) == (6 << 16).to_bytes(4, "little") + bytes([7])  # custom_mode, offboard
 
 
-def test_current_sequence_every_3_s_with_reset_while_nothing_was_sent():
+def test_current_sequence_with_reset_before_the_first_event_then_every_3_s():
     h = Harness(Vehicle(), handler_classes=[EventsProtocol])
     try:
-        h.run(10.0)
-        assert _current(h.gcs) == [{"sequence": FIRST_SEQUENCE - 1, "flags": 1}] * 3  # at 3, 6 and 9 s
+        h.run(1.9)
+        assert _current(h.gcs) == [] and _events(h.gcs) == []
+        h.run(8.1)  # the first event (the health report at 2 s) after a RESET; then every 3 s, at 5 and 8 s
+        latest = _events(h.gcs)[-1]["sequence"]
+        assert _current(h.gcs) == [{"sequence": FIRST_SEQUENCE, "flags": 1}] + [{"sequence": latest, "flags": 0}] * 2
         h.gcs.heartbeat()
         h.run(0.1)
         assert len(_current(h.gcs)) == 3  # a GCS appearing changes nothing (PX4 SIH: 0.33 Hz, nothing more)
@@ -99,8 +112,9 @@ def test_request_event_answers_from_the_last_20_and_an_error_for_older(h):
     for _ in range(11):  # 22 events: the sequence wraps past 65535 and the buffer drops the first 2
         _command(h, MavCmd.COMPONENT_ARM_DISARM, 1)
         _command(h, MavCmd.COMPONENT_ARM_DISARM, 0)
-    sent = _events(h.gcs)
-    assert [e["sequence"] for e in sent] == [(FIRST_SEQUENCE + i) & 0xFFFF for i in range(22)]
+    sent = _events(h.gcs)  # the health report at 2 s, then the 22
+    assert len(_text_events(h.gcs)) == 22 and len(sent) > 22
+    assert [e["sequence"] for e in sent] == [(FIRST_SEQUENCE + i) & 0xFFFF for i in range(len(sent))]
     h.run(3.0)  # a CURRENT_EVENT_SEQUENCE announces the newest
     announced = [m for m in h.gcs.received if (extra_of(m) or (0,))[0] == 411][-1]
     receiver = EventReceiver(h.gcs)
@@ -111,9 +125,9 @@ def test_request_event_answers_from_the_last_20_and_an_error_for_older(h):
         h.run(0.02)
         receiver.feed(h.gcs.received[start:])
         start = len(h.gcs.received)
-    assert receiver.lost == 2  # one RESPONSE_EVENT_ERROR named the oldest still held
-    assert [e["sequence"] for e in receiver.events] == [e["sequence"] for e in sent[2:]]
-    assert [(e["id"], e["arguments"]) for e in receiver.events] == [(e["id"], e["arguments"]) for e in sent[2:]]
+    assert receiver.lost == len(sent) - 20  # one RESPONSE_EVENT_ERROR named the oldest still held
+    assert [e["sequence"] for e in receiver.events] == [e["sequence"] for e in sent[-20:]]
+    assert [(e["id"], e["arguments"]) for e in receiver.events] == [(e["id"], e["arguments"]) for e in sent[-20:]]
 
 
 def test_a_request_for_a_missing_event_gets_response_event_error(h):
@@ -138,7 +152,8 @@ def test_an_event_without_arguments_goes_with_its_statustext(entry):
 
     text = re.sub(r"\\(.)", r"\1", entry.text.pattern)  # the exact text the entry matches
     definition = entry.definition
-    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", text))
+    statustext = entry.statustext is not False  # the takeover's two events: with and without a STATUSTEXT
+    event = to_px4_event(VehicleEvent(1, 2_000_000, Severity.INFO, "commander", text, statustext=statustext))
     assert event is not None and event.id == definition.id and event.time_ms == 2000
     assert EventsDecoder(events_metadata()).decode(event.id, event.arguments) == (definition.name, definition.message)
     assert to_px4_event(VehicleEvent(1, 0, Severity.INFO, "commander", text, is_event=False)) is None
@@ -158,7 +173,7 @@ def test_a_flight_sends_takeoff_landing_and_the_disarm_by_landing(h):
     _command(h, MavCmd.NAV_LAND)
     _fly(h, 12.0)
     decoder = EventsDecoder(events_metadata())
-    messages = [decoder.decode(e["id"], e["arguments"])[1] for e in _events(h.gcs)]
+    messages = [decoder.decode(e["id"], e["arguments"])[1] for e in _text_events(h.gcs)]
     assert messages == ["Armed by external command", "Using default takeoff altitude: 2.50 m", "Takeoff detected",
                         "Landing at current position", "Landing detected", "Disarmed by landing"]
     messages.remove("Using default takeoff altitude: 2.50 m")  # PX4's text says 2.5 m, the event {1:.2m}

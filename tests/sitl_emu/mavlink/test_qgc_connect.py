@@ -4,7 +4,10 @@ ParameterManager's hash check) run by a pymavlink client against a real vehicle 
 AUTOPILOT_VERSION; COMPONENT_METADATA and the general metadata over MAVLink FTP (xz, CRC checked), then each file it
 lists (parameters, events); AVAILABLE_MODES; the parameter list checked against the parameter metadata and the
 _HASH_CHECK value recomputed as QGC does (its cache in name order, the parameters the metadata marks volatile left
-out); mission, fence and rally download; and every EVENT received decoded with the served events metadata.
+out); mission, fence and rally download; and every EVENT received decoded with the served events metadata. With the
+events metadata declaring the health_and_arming_check protocol, QGC asks for the report (MAV_CMD_RUN_PREARM_CHECKS,
+as its own vehicle tests do) and reads it as libevents' parser does: can_arm of the mode group its HEARTBEAT's custom
+mode maps to (navigation_mode_groups), the checks that affect that group, the health components' flags.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import struct
 import zlib
 
 import pytest
-from support.events_client import EventsDecoder, extra_of
+from support.events_client import EventsDecoder, HealthAndArmingChecks, extra_of
 from support.fakes import HOME, Harness
 from support.ftp_client import FtpClient
 
@@ -105,17 +108,44 @@ def test_qgc_connects_downloads_the_metadata_and_decodes_every_event(h):
     assert _qgc_hash(values, described) == struct.unpack("<I", struct.pack("<f", hash_check.param_value))[0]
     # 5. mission, fence and rally download
     assert [qgc.plan_count(t) for t in (0, 1, 2)] == [0, 0, 0]
+    # 6. the health and arming check report, read as QGC does
+    metadata = files[COMP_METADATA_TYPE_EVENTS]
+    px4 = metadata["components"]["1"]
+    assert "health_and_arming_check" in px4["supported_protocols"]
+    report = _report_after(h, qgc, MavCmd.RUN_PREARM_CHECKS, EventsDecoder(metadata))
+    (heartbeat,) = h.gcs.of_type("HEARTBEAT")[-1:]
+    (group,) = [int(g) for g, modes in px4["navigation_mode_groups"]["groups"].items()
+                if heartbeat.custom_mode in modes]
+    assert group == 4  # Hold (nav_state 4)
+    assert report.can_arm[group] and report.checks_for(group) == ["No manual control input"]
+    assert report.components["remote_control"] == {"arm_error": False, "arm_warning": True, "present": False,
+                                                   "error": False, "warning": False}
+    assert report.components["gyro"]["present"] and not report.components["gyro"]["arm_error"]
+    assert not report.can_arm[3] and "No valid mission available" in report.checks_for(3)  # Mission: none uploaded
     # events: each one received decodes with the served metadata
     h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 1)
     h.run(0.1)
     h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 0)
     h.run(0.1)
-    decoder = EventsDecoder(files[COMP_METADATA_TYPE_EVENTS])
+    decoder = EventsDecoder(metadata)
     events = [fields for msg_id, fields in filter(None, map(extra_of, h.gcs.received)) if msg_id == 410]
-    decoded = [decoder.decode(e["id"], e["arguments"]) for e in events]
+    decoded = [decoder.parse(e["id"], e["arguments"]) for e in events]
     assert None not in decoded
-    assert [message for _, message in decoded] == ["Arming denied: Resolve system health failures first",
-                                                    "Armed by external command", "Disarmed by external command"]
+    assert [e.message for e in decoded if e is not None and e.group == "default"] == [
+        "Arming denied: Resolve system health failures first", "Armed by external command",
+        "Disarmed by external command"]
+
+
+def _report_after(h, qgc, command, decoder) -> object:
+    """Send `command`, read the events that follow with libevents' health and arming checks parser."""
+    start = len(h.gcs.received)
+    h.gcs.command_long(command)
+    h.run(0.05)
+    parser = HealthAndArmingChecks()
+    done = [parser.handle(decoder.parse(f["id"], f["arguments"], f["log_levels"]))
+            for msg_id, f in filter(None, map(extra_of, h.gcs.received[start:])) if msg_id == 410]
+    assert done and done[-1] and parser.results is not None
+    return parser.results
 
 
 def _qgc_hash(values: dict, described: dict) -> int:
@@ -133,3 +163,25 @@ def _qgc_hash(values: dict, described: dict) -> int:
 def test_the_events_and_ftp_protocols_are_on_every_nodes_default_list():
     names = {cls.__name__ for cls in load_handler_classes()}
     assert {"EventsProtocol", "FtpProtocol"} <= names
+
+
+def test_a_failsafe_notice_decodes_with_the_downloaded_metadata(h):
+    """framework.cpp notifyUser: offboard setpoints stop, Position cannot run without sticks, the fallback is
+    NAV_RCL_ACT's Return; QGC shows the event's message, made from the metadata it downloaded."""
+    qgc = Qgc(h)
+    h.run(2.5)
+    (meta,) = [f for x in map(extra_of, qgc.request(MSG_COMPONENT_METADATA)) if x and x[0] == 397 for f in [x[1]]]
+    general = json.loads(qgc.download(meta["uri"].rstrip(b"\0").decode()))
+    (events_uri,) = [e["uri"] for e in general["metadataTypes"] if e["type"] == COMP_METADATA_TYPE_EVENTS]
+    decoder = EventsDecoder(json.loads(qgc.download(events_uri)))
+    h.gcs.command_long(MavCmd.COMPONENT_ARM_DISARM, 1)
+    h.gcs.command_long(MavCmd.NAV_TAKEOFF)
+    h.run(8.0)
+    start = len(h.gcs.received)
+    h.gcs.send(h.gcs.mav.set_position_target_local_ned_encode(0, 1, 1, 1, 0b110111111000, 0, 0, -2.5, *[0] * 8))
+    h.gcs.command_long(MavCmd.DO_SET_MODE, 1, 6, 0)  # OFFBOARD, then no more setpoints
+    h.run(3.0)
+    notices = [decoder.decode(f["id"], f["arguments"]) for msg_id, f in filter(None, map(extra_of,
+               h.gcs.received[start:])) if msg_id == 410]
+    assert ("commander_failsafe_enter_generic", "Failsafe activated: Autopilot disengaged, switching to RTL") \
+        in notices
