@@ -26,6 +26,7 @@ from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight_tasks.mission import MissionFlight, MissionTask
+from sitl_emu.flight_tasks.rtl_mission import RtlMissionTask, returns_backwards
 from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
@@ -233,8 +234,7 @@ class ModeExecutor:
         elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
-            destination = self.rtl_destination(nav) if self.rtl_destination else None
-            self.task = auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
+            self.task = self._make_rtl(nav, ref)
         elif nav_state is NavState.AUTO_MISSION:
             self.task = self._make_mission(nav, ref)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
@@ -248,6 +248,17 @@ class ModeExecutor:
             follow.fix = self._target_fix
         else:
             self.task = auto.make_land(nav, self.params)
+
+    def _make_rtl(self, nav: auto.NavInput, ref: GeoRef) -> auto.Task:
+        """Return as RTL_TYPE says (flight_tasks/rtl_mission.py): along the mission backwards, else directly to home
+        or the destination the vehicle chose. Read before self.task is replaced: the mission's current item when
+        AUTO.MISSION ran just before (RtlMissionFastReverse::on_inactive)."""
+        missions = self.missions
+        if missions is not None and returns_backwards(int(self.params.get("RTL_TYPE")), missions.store):
+            prior_seq = missions.store.current_seq if isinstance(self.task, MissionTask) else -1
+            return RtlMissionTask(nav, self.params, missions.store, ref, ref.alt_amsl_m - nav.home_ned_m[2], prior_seq)
+        destination = self.rtl_destination(nav) if self.rtl_destination else None
+        return auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus
