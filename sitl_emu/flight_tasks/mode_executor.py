@@ -97,6 +97,8 @@ class ModeExecutor:
         self._last_us = 0  # when the task last ran
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[auto.NavInput], tuple[Vec3, float] | None] | None = None
+        # the geofence avoidance waypoints (north, east) from the vehicle to a return destination; the vehicle sets it
+        self.rtl_avoid_path: Callable[[auto.NavInput, Vec3], list[tuple[float, float]]] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
@@ -258,7 +260,9 @@ class ModeExecutor:
             prior_seq = missions.store.current_seq if isinstance(self.task, MissionTask) else -1
             return RtlMissionTask(nav, self.params, missions.store, ref, ref.alt_amsl_m - nav.home_ned_m[2], prior_seq)
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        return auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
+        target = destination[0] if destination is not None else nav.home_ned_m
+        path = self.rtl_avoid_path(nav, target) if self.rtl_avoid_path else []
+        return auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav), path)
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus

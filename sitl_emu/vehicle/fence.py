@@ -5,7 +5,8 @@ Vehicle.step calls `FenceChecks.check_commands` on the navigator's new requests 
 DO_CHANGE_ALTITUDE targets outside the fence are refused, navigator_main.cpp geofence_allows_position) and
 `FenceChecks.step` before each commander cycle (PX4: the navigator's geofence_breach_check
 publishes geofence_result, the commander's health check and failsafe act on it); the mode executor asks
-`rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation).
+`rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation), and `FenceChecks.rtl_avoidance`
+for the way around the fence to it (RtlDirect::on_activation: the geofence avoidance planner's path).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from sitl_emu.navigator.geofence import (
     mission_fence_violation,
     point_allowed,
 )
+from sitl_emu.navigator.geofence_avoidance import GeofenceAvoidancePlanner, local_areas
 from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
 from sitl_emu.navigator.rally import choose_destination
@@ -58,6 +60,8 @@ class FenceChecks:
         # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
         # changes)
         self._mission_inputs: tuple[object, ...] = (None, None, None, -1)
+        self._planner: GeofenceAvoidancePlanner | None = None  # Return's avoidance graph: the fence and margin it
+        self._planner_inputs: tuple[object, float] = (None, 0.0)  # was built from (rebuilt when either changes)
 
     @property
     def settings(self) -> GeofenceSettings:
@@ -74,6 +78,18 @@ class FenceChecks:
             self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
         if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
             self._check_mission(store, c, emit)
+
+    def rtl_avoidance(self, nav: NavInput, destination_ned_m: Vec3, ref: GeoRef) -> list[tuple[float, float]]:
+        """The geofence avoidance path (north, east) from the vehicle to Return's destination, empty to fly there
+        directly. The graph is the fence in force with navigator_main.cpp's margin for a multicopter (2 x
+        NAV_ACC_RAD), built again when the fence or the margin changes (navigator_main.cpp run loop)."""
+        areas = self.monitor.fence.areas
+        margin_m = 2.0 * float(self.params["NAV_ACC_RAD"])
+        if self._planner is None or self._planner_inputs[0] is not areas or self._planner_inputs[1] != margin_m:
+            self._planner = GeofenceAvoidancePlanner(local_areas(areas, ref), margin_m)
+            self._planner_inputs = (areas, margin_m)
+        self._planner.set_destination((destination_ned_m[0], destination_ned_m[1]))
+        return self._planner.path_from((nav.pos_ned_m[0], nav.pos_ned_m[1]))
 
     def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
                       truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:

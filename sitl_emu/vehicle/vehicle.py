@@ -106,6 +106,7 @@ class Vehicle:
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
         self._fence = FenceChecks(self.params)  # the navigator's geofence check (fence.py)
         self.chain.executor.rtl_destination = self._rtl_destination
+        self.chain.executor.rtl_avoid_path = self._rtl_avoid_path
         self.commander.mission_store = self._missions
         self.chain.executor.attach_missions(self._missions)
 
@@ -172,6 +173,9 @@ class Vehicle:
 
     def _rtl_destination(self, nav: NavInput) -> tuple[Vec3, float] | None:
         return rtl_destination(nav, self.params, self._missions, self.commander, self.ref)
+
+    def _rtl_avoid_path(self, nav: NavInput, destination_ned_m: Vec3) -> list[tuple[float, float]]:
+        return self._fence.rtl_avoidance(nav, destination_ned_m, self.ref)
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:
