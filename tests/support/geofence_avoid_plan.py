@@ -1,8 +1,8 @@
 """The case "Return direct with geofence obstruction" of PX4's own SITL suite (PX4-Autopilot
-test/mavsdk_tests/test_multicopter_rtl_with_geofence.cpp): its plan, test/mavsdk_tests/multicopter_mission_geofence_avoid.plan
-(the coordinates as that file gives them), moved to the vehicle's position as AutopilotTesterRtl::
-load_qgc_mission_and_geofence_here does, and the breach test of its monitor (point_breaches_shape on local
-north/east)."""
+test/mavsdk_tests/test_multicopter_rtl_with_geofence.cpp): its plan,
+test/mavsdk_tests/multicopter_mission_geofence_avoid.plan (the coordinates as that file gives them), moved to the
+vehicle's position as AutopilotTesterRtl:: load_qgc_mission_and_geofence_here does, and the breach test of its
+monitor (point_breaches_shape on local north/east)."""
 
 from __future__ import annotations
 

@@ -8,12 +8,12 @@ from __future__ import annotations
 import math
 
 import pytest
+from support.geofence_avoid_plan import RTL_AT_SEQ, BreachMonitor, plan_here
 
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION
 from sitl_emu.px4 import MavCmd, MavResult, NavState
 from sitl_emu.types import VehicleCommand
 from sitl_emu.vehicle.vehicle import Vehicle
-from support.geofence_avoid_plan import RTL_AT_SEQ, BreachMonitor, plan_here
 
 pytestmark = pytest.mark.slow  # about 4 simulated minutes
 
