@@ -6,9 +6,12 @@ monitor (point_breaches_shape on local north/east)."""
 
 from __future__ import annotations
 
+import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Final
+from pathlib import Path
+from typing import Any, Final
 
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.mission_store import MissionItem
@@ -75,14 +78,15 @@ class BreachMonitor:
     """start_monitoring_geofence_breach: the uploaded shapes in the local frame of `ref`; `check` latches a breach
     (entering an exclusion shape or leaving an inclusion one)."""
 
-    def __init__(self, plan: Plan, ref: GeoRef) -> None:
-        def local(item: MissionItem) -> tuple[float, float]:
+    def __init__(self, fence: Sequence[Any], ref: GeoRef) -> None:
+        """`fence`: the uploaded fence items (anything with command, param1, x, y: ours or MAVSDK's)."""
+        def local(item: Any) -> tuple[float, float]:
             n, e, _ = global_to_ned(ref, item.x * 1e-7, item.y * 1e-7, ref.alt_amsl_m)
             return n, e
 
-        self.exclusion = [local(it) for it in plan.fence if it.command == MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION]
-        self.inclusion = [local(it) for it in plan.fence if it.command == MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION]
-        circle = next(it for it in plan.fence if it.command == MavCmd.NAV_FENCE_CIRCLE_EXCLUSION)
+        self.exclusion = [local(it) for it in fence if it.command == MavCmd.NAV_FENCE_POLYGON_VERTEX_EXCLUSION]
+        self.inclusion = [local(it) for it in fence if it.command == MavCmd.NAV_FENCE_POLYGON_VERTEX_INCLUSION]
+        circle = next(it for it in fence if it.command == MavCmd.NAV_FENCE_CIRCLE_EXCLUSION)
         self.circle_centre, self.circle_radius_m = local(circle), circle.param1
         self.breach: tuple[float, float] | None = None
 
@@ -91,3 +95,27 @@ class BreachMonitor:
         breached = _inside(north, east, self.exclusion) or not _inside(north, east, self.inclusion) or in_circle
         if breached and self.breach is None:
             self.breach = (north, east)
+
+
+def write_qgc_plan(path: Path) -> Path:
+    """The plan as a QGroundControl .plan file (what the case hands MAVSDK's import_qgroundcontrol_mission)."""
+    items: list[dict[str, Any]] = [
+        {"type": "SimpleItem", "command": int(cmd), "frame": REL_ALT_FRAME, "autoContinue": True, "doJumpId": i + 1,
+         "params": [0, 0, 0, None, lat, lon, alt]} for i, (cmd, lat, lon, alt) in enumerate(MISSION)]
+    items.append({"type": "SimpleItem", "command": int(MavCmd.NAV_RETURN_TO_LAUNCH), "frame": MISSION_FRAME,
+                  "autoContinue": True, "doJumpId": len(items) + 1, "params": [0, 0, 0, 0, 0, 0, 0]})
+    (c_lat, c_lon), radius = EXCLUSION_CIRCLE
+    plan = {
+        "fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
+        "mission": {"version": 2, "firmwareType": 12, "vehicleType": 2, "cruiseSpeed": 15, "hoverSpeed": 5,
+                    "globalPlanAltitudeMode": 1, "plannedHomePosition": [47.3977444, 8.5455918, 489.338],
+                    "items": items},
+        "geoFence": {"version": 2,
+                     "polygons": [{"version": 1, "inclusion": False, "polygon": [list(v) for v in EXCLUSION_POLYGON]},
+                                  {"version": 1, "inclusion": True, "polygon": [list(v) for v in INCLUSION_POLYGON]}],
+                     "circles": [{"version": 1, "inclusion": False,
+                                  "circle": {"center": [c_lat, c_lon], "radius": radius}}]},
+        "rallyPoints": {"version": 2, "points": []},
+    }
+    path.write_text(json.dumps(plan, indent=1))
+    return path

@@ -32,7 +32,7 @@ def test_return_goes_around_the_exclusion_polygon_and_lands_home() -> None:
     store = v.mission_store()
     store.replace(PLAN_MISSION, plan.mission)
     store.replace(PLAN_FENCE, plan.fence)
-    monitor = BreachMonitor(plan, v.ref)
+    monitor = BreachMonitor(plan.fence, v.ref)
     v.run_for(3.0)
     assert _command(v, MavCmd.COMPONENT_ARM_DISARM, 1, 0) == MavResult.ACCEPTED
     v.run_for(1.0)
