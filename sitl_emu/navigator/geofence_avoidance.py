@@ -79,22 +79,30 @@ def dijkstra_backward(costs: Sequence[Sequence[float]], destination: int) -> tup
     return best, following
 
 
+# GeofenceAvoidancePlanner::Status, the codes navigator_main.cpp reports ("Geofence data invalid (code %d)")
+STATUS_OK, STATUS_NO_FENCE, STATUS_DESTINATION_BREACHES = 0, 1, 4
+_ADD_STATUS = {AddResult.BUDGET_EXCEEDED: 5, AddResult.OUT_OF_RANGE: 6, AddResult.DEGENERATE: 7}
+
+
 class GeofenceAvoidancePlanner:
-    """The graph of one fence and margin, solved for one destination; `path_from` plans from a start."""
+    """The graph of one fence and margin, solved for one destination; `path_from` plans from a start. `status`:
+    why the graph could not be built (a STATUS_* or a refused area's code), else STATUS_OK."""
 
     def __init__(self, areas: Sequence[LocalArea], margin_m: float) -> None:
-        self.polygons: PlannerPolygons | None = self._build(areas, margin_m)
+        self.polygons, self.status = self._build(areas, margin_m)
         self._best: list[float] = []
         self._following: list[int] = []
         self._saved_start: XY | None = None
         self._destination: XY | None = None
 
     @staticmethod
-    def _build(areas: Sequence[LocalArea], margin_m: float) -> PlannerPolygons | None:
-        """updateGraphFromGeofence: None when there is no fence, it has too many nodes or an area is refused."""
+    def _build(areas: Sequence[LocalArea], margin_m: float) -> tuple[PlannerPolygons | None, int]:
+        """updateGraphFromGeofence: no graph when there is no fence, it has too many nodes or an area is refused."""
         needed = sum(CIRCLE_VERTICES if a.circle else max_vertices_after_splitting(len(a.vertices)) for a in areas)
-        if needed == 0 or needed > MAX_NODES - 1:
-            return None
+        if needed == 0:
+            return None, STATUS_NO_FENCE
+        if needed > MAX_NODES - 1:
+            return None, _ADD_STATUS[AddResult.BUDGET_EXCEEDED]
         polygons = PlannerPolygons()
         for area in areas:
             if area.circle:
@@ -102,17 +110,18 @@ class GeofenceAvoidancePlanner:
             else:
                 result = polygons.add_polygon(area.vertices, area.inclusion, margin_m)
             if result is not AddResult.SUCCESS:
-                return None
-        return polygons
+                return None, _ADD_STATUS[result]
+        return polygons, STATUS_OK
 
-    def set_destination(self, destination: XY) -> None:
-        """updateDestination: the costs and the solution for a new destination."""
+    def set_destination(self, destination: XY) -> bool:
+        """updateDestination: the costs and the solution for a new destination; True when it is new and inside a
+        forbidden area (PlannerPolygons::setDestination: kept, but the planner's status says it breaches)."""
         polygons = self.polygons
         if polygons is None or not all(math.isfinite(c) for c in destination):
             self._destination = None
-            return
+            return False
         if self._destination is not None and math.dist(destination, polygons.node(0)) < 0.1:
-            return
+            return False
         polygons.set_destination(destination)
         self._destination = destination
         n = polygons.num_nodes
@@ -121,6 +130,7 @@ class GeofenceAvoidancePlanner:
             for j in range(i + 1, n):
                 costs[i][j] = costs[j][i] = polygons.edge_cost(i, j)
         self._best, self._following = dijkstra_backward(costs, 0)
+        return polygons.crosses_any(polygons.x_cm[0], polygons.y_cm[0], polygons.x_cm[0], polygons.y_cm[0])
 
     def _best_node(self, start: XY) -> tuple[int, bool]:
         """findBestStartingNode: the node in sight with the shortest way on, and whether the destination is in sight."""
