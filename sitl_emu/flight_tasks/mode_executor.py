@@ -26,7 +26,7 @@ from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight_tasks.mission import MissionFlight, MissionTask
-from sitl_emu.flight_tasks.rtl_mission import RtlMissionTask, returns_backwards
+from sitl_emu.flight_tasks.rtl_mission import RtlMissionTask, mission_return
 from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
@@ -252,13 +252,15 @@ class ModeExecutor:
             self.task = auto.make_land(nav, self.params)
 
     def _make_rtl(self, nav: auto.NavInput, ref: GeoRef) -> auto.Task:
-        """Return as RTL_TYPE says (flight_tasks/rtl_mission.py): along the mission backwards, else directly to home
+        """Return as RTL_TYPE says (flight_tasks/rtl_mission.py): along the mission, else directly to home
         or the destination the vehicle chose. Read before self.task is replaced: the mission's current item when
         AUTO.MISSION ran just before (RtlMissionFastReverse::on_inactive)."""
         missions = self.missions
-        if missions is not None and returns_backwards(int(self.params.get("RTL_TYPE")), missions.store):
+        way = mission_return(int(self.params.get("RTL_TYPE")), missions.store) if missions is not None else None
+        if missions is not None and way is not None:
             prior_seq = missions.store.current_seq if isinstance(self.task, MissionTask) else -1
-            return RtlMissionTask(nav, self.params, missions.store, ref, ref.alt_amsl_m - nav.home_ned_m[2], prior_seq)
+            home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
+            return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, way, prior_seq)
         destination = self.rtl_destination(nav) if self.rtl_destination else None
         target = destination[0] if destination is not None else nav.home_ned_m
         path = self.rtl_avoid_path(nav, target) if self.rtl_avoid_path else []

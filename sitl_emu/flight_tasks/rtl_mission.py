@@ -1,22 +1,29 @@
 """AUTO.RTL along the mission path (RTL_TYPE 2 and 4): which return RTL_TYPE asks for, and the task that flies the
-mission backwards (navigator/mission_reverse.py) with FlightTaskAuto's core.
+mission back or on to its landing (navigator/mission_return.py) with FlightTaskAuto's core.
 
 rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing pattern (DO_LAND_START followed
 by a land item) returns along it forwards (RtlMissionFast), any other valid mission backwards
 (RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4: forwards only when the landing
-pattern is nearer than the start (reverseIsFurther), else as 2. Not modelled: the forward return (RtlMissionFast)
-and the mission landing of RTL_TYPE 1 and 3; those returns fly RtlDirect home.
+pattern is nearer than the start (reverseIsFurther), else as 2. Not modelled: the mission landing of RTL_TYPE 1 and
+3 (RtlDirectMissionLand); those returns fly RtlDirect home.
 """
 
 from __future__ import annotations
 
+from enum import Enum
 from typing import Final
 
 from sitl_emu.flight_tasks.core import Task, Waypoint
 from sitl_emu.flight_tasks.mission import mission_settings, mission_waypoint
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.mission_items import nav_items
-from sitl_emu.navigator.mission_reverse import ReverseMissionNavigator, reverse_start_index
+from sitl_emu.navigator.mission_return import (
+    ForwardMissionNavigator,
+    ReturnNavigator,
+    ReverseMissionNavigator,
+    forward_start_index,
+    reverse_start_index,
+)
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
@@ -35,33 +42,43 @@ def land_start_index(items: tuple[MissionItem, ...]) -> int:
     return -1
 
 
-def returns_backwards(rtl_type: int, store: MissionStore) -> bool:
-    """True when RTL_TYPE picks RtlMissionFastReverse for the stored mission (RTL::setRtlTypeAndDestination)."""
+class MissionReturn(Enum):
+    """The returns along the mission (rtl.h RtlType)."""
+
+    FORWARD = "forward"  # RTL_MISSION_FAST
+    REVERSE = "reverse"  # RTL_MISSION_FAST_REVERSE
+
+
+def mission_return(rtl_type: int, store: MissionStore) -> MissionReturn | None:
+    """The return RTL_TYPE picks for the stored mission (RTL::setRtlTypeAndDestination), None: RtlDirect."""
     if rtl_type not in (RTL_TYPE_MISSION_FAST, RTL_TYPE_MISSION_FAST_SHORTEST) or not store.mission_valid:
-        return False
+        return None
     land_start = land_start_index(store.plan(PLAN_MISSION).items)
-    if land_start < 0:
-        return True
-    if rtl_type == RTL_TYPE_MISSION_FAST:
-        return False  # RtlMissionFast (not modelled): RtlDirect
     reverse_is_further = land_start - store.current_seq < store.current_seq
-    return not reverse_is_further
+    if land_start >= 0 and (rtl_type == RTL_TYPE_MISSION_FAST or reverse_is_further):
+        return MissionReturn.FORWARD
+    return MissionReturn.REVERSE
 
 
 class RtlMissionTask(Task):
-    """One activation of AUTO.RTL flying the mission backwards; the texts, MISSION_CURRENT and MISSION_ITEM_REACHED
-    follow the reverse navigator (its mission_result goes to the store as the mission's does)."""
+    """One activation of AUTO.RTL flying along the mission; the texts, MISSION_CURRENT and MISSION_ITEM_REACHED
+    follow its navigator (the mission_result goes to the store as the mission's does)."""
 
     def __init__(self, nav: NavInput, params: ParamRegistry, store: MissionStore, ref: GeoRef,
-                 home_alt_amsl_m: float, mission_seq_prior_rtl: int) -> None:
+                 home_alt_amsl_m: float, way: MissionReturn, mission_seq_prior_rtl: int) -> None:
         """`mission_seq_prior_rtl`: the mission's current item if AUTO.MISSION ran just before, else -1."""
         super().__init__(nav, params)
         self._store = store
         self._mission_settings = mission_settings(params)
         items = nav_items(store.plan(PLAN_MISSION).items, ref, home_alt_amsl_m)
-        self._navigator = navigator = ReverseMissionNavigator()
+        navigator: ReturnNavigator
+        if way is MissionReturn.FORWARD:
+            navigator, first = ForwardMissionNavigator(), forward_start_index(items, mission_seq_prior_rtl, nav)
+        else:
+            navigator, first = ReverseMissionNavigator(), reverse_start_index(items, mission_seq_prior_rtl, nav)
+        self._navigator = navigator
         navigator.load(items, 0)
-        navigator.start(nav, self._mission_settings, reverse_start_index(items, mission_seq_prior_rtl, nav))
+        navigator.start(nav, self._mission_settings, first)
         self._publish()
 
     def _publish(self) -> None:

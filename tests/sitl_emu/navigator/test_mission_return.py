@@ -11,12 +11,17 @@ from typing import Any
 import pytest
 from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, wp
 
-from sitl_emu.flight_tasks.rtl_mission import land_start_index, returns_backwards
+from sitl_emu.flight_tasks.rtl_mission import MissionReturn, land_start_index, mission_return
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.mission_items import nav_items
-from sitl_emu.navigator.mission_reverse import closest_position_item, previous_position_index, reverse_start_index
+from sitl_emu.navigator.mission_return import (
+    closest_position_item,
+    forward_start_index,
+    previous_position_index,
+    reverse_start_index,
+)
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
-from sitl_emu.px4 import MavCmd, NavState
+from sitl_emu.px4 import MavCmd, MavResult, NavState
 
 RTL_ITEM = do(MavCmd.NAV_RETURN_TO_LAUNCH)
 
@@ -36,17 +41,18 @@ def _store(commands: list[int], current_seq: int = 0) -> MissionStore:
 WP, TKO, LAND, LAND_START = MavCmd.NAV_WAYPOINT, MavCmd.NAV_TAKEOFF, MavCmd.NAV_LAND, MavCmd.DO_LAND_START
 
 
-def test_rtl_type_picks_the_reverse_return_as_rtl_cpp_does() -> None:
+def test_rtl_type_picks_the_return_as_rtl_cpp_does() -> None:
     plain = [TKO, WP, WP, WP]
     landing = [TKO, WP, WP, LAND_START, WP, LAND]
-    assert not returns_backwards(2, MissionStore())  # no valid mission: RtlDirect
-    assert returns_backwards(2, _store(plain)) and returns_backwards(4, _store(plain))
-    assert not returns_backwards(0, _store(plain)) and not returns_backwards(1, _store(plain))
+    back, on = MissionReturn.REVERSE, MissionReturn.FORWARD
+    assert mission_return(2, MissionStore()) is None  # no valid mission: RtlDirect
+    assert mission_return(2, _store(plain)) is back and mission_return(4, _store(plain)) is back
+    assert mission_return(0, _store(plain)) is None and mission_return(1, _store(plain)) is None
     assert land_start_index(_stored(landing)) == 3 and land_start_index(_stored([TKO, LAND_START, WP])) == -1
-    assert not returns_backwards(2, _store(landing))  # a landing pattern: forwards (RtlMissionFast)
-    # RTL_TYPE 4: backwards while the start is nearer than the landing pattern (reverseIsFurther false)
-    assert returns_backwards(4, _store(landing, current_seq=1))
-    assert not returns_backwards(4, _store(landing, current_seq=2))
+    assert mission_return(2, _store(landing)) is on  # a landing pattern: forwards (RtlMissionFast)
+    # RTL_TYPE 4: forwards once the landing pattern is nearer than the start (reverseIsFurther)
+    assert mission_return(4, _store(landing, current_seq=1)) is back
+    assert mission_return(4, _store(landing, current_seq=2)) is on
 
 
 def _nav(n: float, e: float, alt_m: float) -> Any:
@@ -61,6 +67,8 @@ def test_the_first_item_is_the_one_before_the_mission_s_or_the_closest() -> None
     assert closest_position_item(items, _nav(north[3] + 0.2, 0.0, 5.0)) == 3  # not the DO item at 2
     assert reverse_start_index(items, -1, _nav(north[1], 0.0, 5.0)) == 1
     assert previous_position_index(items, 3) == 1 and previous_position_index(items, 0) is None
+    assert forward_start_index(items, 2, _nav(0, 0, 5)) == 3  # from AUTO.MISSION: the next position item
+    assert forward_start_index(items, 5, _nav(0, 0, 5)) == -1  # none left, no land item: nothing to fly
 
 
 def _fly_to_rtl(rtl_type: int, items: list[tuple]) -> Flight:
@@ -108,3 +116,23 @@ def test_rtl_type_0_still_returns_directly() -> None:
     currents, _, path = _flight_after_rtl(f)
     assert currents == [4] and any(t.startswith("RTL: start return") for t in f.texts[rtl_texts - 1:])
     assert min(math.hypot(p[0] - 30, p[1] - 30) for p in path) > 20.0
+
+
+@pytest.mark.slow
+def test_rtl_type_2_with_a_landing_pattern_flies_on_to_the_mission_s_landing() -> None:
+    items = [TAKEOFF_ITEM, wp(30, 0), wp(30, 30), do(MavCmd.DO_LAND_START), wp(0, 30),
+             wp(0, 45, 0.0, cmd=MavCmd.NAV_LAND)]
+    f = Flight(items)
+    f.v.params.set("RTL_TYPE", 2)
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2, 120.0)
+    f.v.run_for(2.0)
+    assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
+    rtl_texts = len(f.texts)
+    currents, reached, path = _flight_after_rtl(f)
+    # on from the item flown, DO_LAND_START skipped, the land item: moved to at the current altitude, landed on
+    assert currents == [2, 4, 5] and reached == [2, 4, 5]
+    texts = f.texts[rtl_texts:]
+    assert "Executing Mission" in texts and "Mission finished, landed" in texts
+    assert not any(t.startswith("RTL: start return") for t in texts)
+    assert math.hypot(path[-1][0], path[-1][1] - 45.0) < 1.0  # on the mission's landing, not home

@@ -1,15 +1,19 @@
-"""Return along the mission path, backwards (RTL_TYPE 2 or 4 without a usable landing pattern): the mission's position
-items flown in reverse order as plain waypoints, then home. Pure: no MAVLink, simulated time comes with the NavInput.
+"""Return along the mission path (RTL_TYPE 2 and 4): the mission's position items flown as plain waypoints, backwards
+to the start then home, or forwards to its landing. Pure: no MAVLink, simulated time comes with the NavInput.
 
-Written from PX4 main's src/modules/navigator/rtl_mission_fast_reverse.cpp (on_activation, setNextMissionItem,
-setActiveMissionItems, handleLanding) on top of mission_base.cpp (goToPreviousPositionItem, setMissionToClosestItem,
-set_mission_result), for a multicopter that is not a VTOL:
-- the first item: the one before the item the mission was flying when Return began (from AUTO.MISSION), else the
-  position item closest to the vehicle (3D distance);
-- each position item is flown as a waypoint (LOITER_TO_ALT kept), no hold time, the triplet's previous setpoint the
-  item flown before, its next the position item before this one; DO_* items are skipped on the way back;
-- at the takeoff item (or the first position item): a climb work item to its position and altitude (not reported as
-  reached), then the landing at home: a move there at the current altitude if farther than NAV_ACC_RAD, then land;
+Written from PX4 main's src/modules/navigator/rtl_mission_fast_reverse.cpp and rtl_mission_fast.cpp (on_activation,
+setNextMissionItem, setActiveMissionItems, handleLanding) on top of mission_base.cpp (goToPreviousPositionItem,
+goToNextPositionItem, setMissionToClosestItem, set_mission_result, handleLanding), for a multicopter that is not a
+VTOL:
+- the first item: from AUTO.MISSION, backwards the item before the one the mission was flying, forwards the first
+  position item from it on (none left: the land item); from another mode, the position item closest to the vehicle
+  (3D distance);
+- each position item is flown as a waypoint (LOITER_TO_ALT kept), no hold time, continuing; the triplet's next is
+  the following position item the way the return goes; DO_* items in between are skipped; no climb is inserted;
+- backwards, at the takeoff item (or the first position item): a climb work item to its position and altitude (not
+  reported as reached), then the landing at home: a move there at the current altitude if farther than
+  NAV_ACC_RAD, then land;
+- forwards, the mission's land item: a move to it at the current altitude if farther than NAV_ACC_RAD, then land;
 - once landed: "Mission finished, landed" and idle. MISSION_CURRENT shows the item flown (set_mission_result), and the
   mission's current item stays where the return left it (setMissionIndex publishes the mission topic).
 """
@@ -48,6 +52,14 @@ def previous_position_index(items: tuple[NavItem, ...], seq: int) -> int | None:
     return None
 
 
+def next_position_index(items: tuple[NavItem, ...], seq: int) -> int | None:
+    """findNextPositionIndex: the first position item from `seq` on, None if there is none."""
+    for index in range(max(seq, 0), len(items)):
+        if items[index].has_position:
+            return index
+    return None
+
+
 def reverse_start_index(items: tuple[NavItem, ...], mission_seq_prior_rtl: int, nav: NavInput) -> int:
     """RtlMissionFastReverse::on_activation: the item before the one the mission flew, or the closest one."""
     if mission_seq_prior_rtl < 0:
@@ -55,13 +67,25 @@ def reverse_start_index(items: tuple[NavItem, ...], mission_seq_prior_rtl: int, 
     return max(mission_seq_prior_rtl - 1, 0)
 
 
+def forward_start_index(items: tuple[NavItem, ...], mission_seq_prior_rtl: int, nav: NavInput) -> int:
+    """RtlMissionFast::on_activation: the first position item from the one the mission flew (none left: the land
+    item), or the closest one; -1 when there is nothing to fly."""
+    if mission_seq_prior_rtl < 0:
+        return closest_position_item(items, nav)
+    index = next_position_index(items, mission_seq_prior_rtl)
+    if index is not None:
+        return index
+    land = next((i for i, it in enumerate(items) if it.kind is Kind.LAND), -1)
+    return land if land > 0 else -1
+
+
 @dataclass(slots=True)
-class ReverseMissionNavigator(MissionNavigator):
-    """MissionBase flown backwards (RtlMissionFastReverse): the parent's reach rules, jumps and texts; another way to
-    the next item and another set of active items."""
+class ReturnNavigator(MissionNavigator):
+    """MissionBase as RtlBase uses it: the parent's reach rules, jumps, texts and landing; the subclasses choose the
+    next item (and the reverse one the active items)."""
 
     def start(self, nav: NavInput, s: MissionSettings, start_seq: int) -> None:
-        """on_activation: from `start_seq`; already landed: nothing to fly (the planned item is invalid)."""
+        """on_activation: from `start_seq`; already landed, or nothing to fly: the planned item is invalid."""
         if start_seq < 0 or nav.landed:
             self._planned_valid = False
             self._say("No valid mission available, refusing takeoff" if nav.landed
@@ -69,18 +93,46 @@ class ReverseMissionNavigator(MissionNavigator):
             self.result.seq_current = max(start_seq, 0)
             self._end_of_mission(nav, s)
             return
-        self.activate(nav, s, start_seq)  # "Executing Mission"; no climb is inserted (_set_items has no handleTakeoff)
+        self.activate(nav, s, start_seq)  # "Executing Mission"
+
+    def _climb_needed(self, nav: NavInput, s: MissionSettings, seq: int) -> float:
+        return NAN  # the return types' setActiveMissionItems have no handleTakeoff
+
+    def _next_index(self, seq: int) -> int | None:
+        raise NotImplementedError
 
     def _advance(self, nav: NavInput) -> None:
-        """setNextMissionItem: the previous position item; none left: the mission (the return) is over."""
+        """setNextMissionItem: the next position item the way the return goes; none left: the return is over."""
         if self._work is not Work.DEFAULT:
             return
-        previous = previous_position_index(self.items, self.result.seq_current)
-        if previous is None:
+        following = self._next_index(self.result.seq_current)
+        if following is None:
             self._say("Mission finished, landed" if nav.landed else "Mission finished, loitering")
             self._active = self._planned_valid = False
             return
-        self.result.seq_current = previous
+        self.result.seq_current = following
+
+
+@dataclass(slots=True)
+class ForwardMissionNavigator(ReturnNavigator):
+    """RtlMissionFast: on to the mission's landing, every position item a plain waypoint (the parent's triplet, its
+    move to the land item and its landing)."""
+
+    def load(self, items: tuple[NavItem, ...], current_seq: int, nav: NavInput | None = None,
+             s: MissionSettings | None = None) -> None:
+        super(ForwardMissionNavigator, self).load(tuple(_as_waypoint(it) if it.has_position and it.kind is not Kind.LAND
+                                                        else it for it in items), current_seq, nav, s)
+
+    def _next_index(self, seq: int) -> int | None:
+        return next_position_index(self.items, seq + 1)
+
+
+@dataclass(slots=True)
+class ReverseMissionNavigator(ReturnNavigator):
+    """RtlMissionFastReverse: back to the start, then home."""
+
+    def _next_index(self, seq: int) -> int | None:
+        return previous_position_index(self.items, seq)
 
     def _set_items(self, nav: NavInput, s: MissionSettings) -> None:
         """RtlMissionFastReverse::setActiveMissionItems."""
