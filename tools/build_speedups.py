@@ -78,6 +78,7 @@ DEFAULT_MODULES = (
     "sitl_emu/flight_tasks/auto.py",
     "sitl_emu/flight_tasks/mission.py",
     "sitl_emu/flight_tasks/rtl.py",
+    "sitl_emu/flight_tasks/rtl_mission.py",
     # the enums and the message types every module above reads each tick (0.5 %, 0.5 % of their own): a compiled module
     # reads a member of a compiled enum as a constant, but one of a pure module through Python 3.11's
     # EnumType.__getattr__ hook (~750 instructions a read)

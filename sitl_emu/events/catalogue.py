@@ -5,7 +5,8 @@ the emulator's commander and navigator say the text (a VehicleEvent with is_even
 the event PX4 sends with it: its name, message, argument types and levels as PX4's source states them, and the
 argument values read back from the text. Sources: commander/Commander.cpp (arm, disarm, printRejectMode,
 handle_command, landDetectorUpdate), navigator/mission_base.cpp (mission_execute, mission_finished*),
-navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter),
+navigator/rtl_direct.cpp (vrtl_return_at, so spelled in PX4; rtl_land_at_destination, rtl_completed_loiter,
+rtl_avoiding_geofence), navigator/navigator_main.cpp (rtl_avoidance_build_failed, rtl_destination_breaches),
 commander/failsafe/framework.cpp (failsafe_rc_override: a pilot's takeover from a failsafe, an event only; without
 a failsafe Commander::manualControlCheck's commander_rc_override with its STATUSTEXT), Commander::dataLinkCheck
 (commander_gcs_lost, commander_dl_regained), navigator/takeoff.cpp
@@ -113,6 +114,13 @@ ENTRIES: tuple[_Entry, ...] = (
                            (), Log.EMERGENCY, Log.INFO), _exact("Emergency battery level, land immediately")),
     _Entry(EventDefinition("rtl_land_at_destination", "RTL: land at destination"), _exact("RTL: land at destination")),
     _Entry(EventDefinition("rtl_completed_loiter", "RTL: completed, loitering"), _exact("RTL: completed, loitering")),
+    _Entry(EventDefinition("rtl_avoiding_geofence", "RTL: avoiding geofence"), _exact("RTL: avoiding geofence")),
+    _Entry(EventDefinition("rtl_avoidance_build_failed", "Geofence data invalid (code {1}), RTL will fly directly",
+                           ("uint8_t",), external=Log.WARNING, internal=Log.INFO),
+           re.compile(r"Geofence data invalid \(code (\d+)\), RTL will fly directly"), _integers),
+    _Entry(EventDefinition("rtl_destination_breaches", "RTL destination breaches geofence, will fly directly",
+                           external=Log.WARNING, internal=Log.INFO),
+           _exact("RTL destination breaches geofence, will fly directly")),
 )
 
 DEFINITIONS: tuple[EventDefinition, ...] = (tuple(e.definition for e in ENTRIES) + failsafe_notices.DEFINITIONS

@@ -8,6 +8,7 @@ cycle and hands the `TrajectorySetpoint` to the controller. Behaviour after PX4'
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight_tasks.core import AutoSettings, Task, Waypoint
@@ -152,11 +153,11 @@ def make_land(nav: NavInput, params: ParamRegistry) -> Task:
 
 
 def make_rtl(nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
-             loiter_at_ned_m: Vec3 | None = None) -> Task:
+             loiter_at_ned_m: Vec3 | None = None, avoid_path: Sequence[tuple[float, float]] = ()) -> Task:
     """Return: climb to the return altitude, fly home (or to `destination`: NED position and yaw, a rally point
     navigator/rally.py chose) at MPC_XY_CRUISE, land (RTL_LAND_DELAY: wait first); `loiter_at_ned_m`: climb there (the
-    loiter a finished mission left)."""
-    return RtlTask(nav, params, destination, loiter_at_ned_m)
+    loiter a finished mission left); `avoid_path`: the geofence avoidance waypoints (north, east) flown before home."""
+    return RtlTask(nav, params, destination, loiter_at_ned_m, avoid_path)
 
 
 def make_reposition(nav: NavInput, params: ParamRegistry, target_ned_m: Vec3, yaw_rad: float,

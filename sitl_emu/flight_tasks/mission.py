@@ -115,10 +115,11 @@ class MissionTask(Task):
         for severity, text in navigator.messages:
             self._say(severity, text)
         navigator.messages.clear()
-        return _waypoint(navigator.previous, navigator.current, navigator.next, nav)
+        return mission_waypoint(navigator.previous, navigator.current, navigator.next, nav)
 
 
-def _waypoint(previous: Setpoint | None, current: Setpoint | None, nxt: Setpoint | None, nav: NavInput) -> Waypoint:
+def mission_waypoint(previous: Setpoint | None, current: Setpoint | None, nxt: Setpoint | None,
+                     nav: NavInput) -> Waypoint:
     """FlightTaskAuto::_evaluatePositionSetpointTriplet: no previous -> the current one; no next (or a loiter) -> the
     current one."""
     if current is None:

@@ -26,6 +26,7 @@ from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight_tasks.mission import MissionFlight, MissionTask
+from sitl_emu.flight_tasks.rtl_mission import RtlMissionTask, mission_return
 from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
@@ -96,6 +97,8 @@ class ModeExecutor:
         self._last_us = 0  # when the task last ran
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[auto.NavInput], tuple[Vec3, float] | None] | None = None
+        # the geofence avoidance waypoints (north, east) from the vehicle to a return destination; the vehicle sets it
+        self.rtl_avoid_path: Callable[[auto.NavInput, Vec3], list[tuple[float, float]]] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
 
@@ -233,8 +236,7 @@ class ModeExecutor:
         elif nav_state is NavState.AUTO_LOITER:
             self.task = self._make_loiter(nav, command, ref, takeoff_target)
         elif nav_state is NavState.AUTO_RTL:
-            destination = self.rtl_destination(nav) if self.rtl_destination else None
-            self.task = auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav))
+            self.task = self._make_rtl(nav, ref)
         elif nav_state is NavState.AUTO_MISSION:
             self.task = self._make_mission(nav, ref)
         elif nav_state in (NavState.POSCTL, NavState.POSITION_SLOW):
@@ -253,6 +255,21 @@ class ModeExecutor:
         """The setpoint the previous task gave last (FlightModeManager::switchTask hands it to the new task's
         activate()); None after a mode without a flight task."""
         return self._held.trajectory if self._held is not None else None
+
+    def _make_rtl(self, nav: auto.NavInput, ref: GeoRef) -> auto.Task:
+        """Return as RTL_TYPE says (flight_tasks/rtl_mission.py): along the mission, else directly to home
+        or the destination the vehicle chose. Read before self.task is replaced: the mission's current item when
+        AUTO.MISSION ran just before (RtlMissionFastReverse::on_inactive)."""
+        missions = self.missions
+        way = mission_return(int(self.params.get("RTL_TYPE")), missions.store) if missions is not None else None
+        if missions is not None and way is not None:
+            prior_seq = missions.store.current_seq if isinstance(self.task, MissionTask) else -1
+            home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
+            return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, way, prior_seq)
+        destination = self.rtl_destination(nav) if self.rtl_destination else None
+        target = destination[0] if destination is not None else nav.home_ned_m
+        path = self.rtl_avoid_path(nav, target) if self.rtl_avoid_path else []
+        return auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav), path)
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus

@@ -1,16 +1,20 @@
 """AUTO.RTL for a multicopter returning to home (PX4 navigator rtl.cpp + rtl_direct.cpp, RTL_TYPE 0).
 
-States as RtlDirect: CLIMBING (to the return altitude above the current position) -> MOVE_TO_LOITER (home at the
-return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise LOITER_DOWN (to RTL_DESCEND_ALT) ->
-LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER -> LAND. The destination is home or the rally
-point RTL_TYPE selects (navigator/rally.py; "home" below means that destination). The return altitude follows
-RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT, RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
+States as RtlDirect: CLIMBING (to the return altitude above the current position) -> AVOID_GEOFENCE (the waypoints of
+the geofence avoidance planner, navigator/geofence_avoidance.py, if the straight way crosses the fence: each at the
+return altitude, facing it from where the vehicle was when it became current, the next one or home as the triplet's
+next) -> MOVE_TO_LOITER (home at the return altitude) -> LAND when RTL_LAND_DELAY is 0 (the MC default); otherwise
+LOITER_DOWN (to RTL_DESCEND_ALT) -> LOITER_HOLD (RTL_LAND_DELAY seconds, forever if < 0) -> MOVE_TO_LAND_HOVER ->
+LAND. The destination is home or the rally point RTL_TYPE selects (navigator/rally.py; "home" below means that
+destination). The return altitude follows RTL::calculate_return_alt_from_cone_half_angle (RTL_RETURN_ALT,
+RTL_CONE_ANG, RTL_MIN_DIST, NAV_ACC_RAD).
 """
 
 from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Sequence
 from enum import Enum
 from typing import Final
 
@@ -27,6 +31,7 @@ class RtlState(Enum):
     """RtlDirect's states (rtl_direct.h RTLState), named for what the vehicle does."""
 
     CLIMB = "climb"  # CLIMBING
+    AVOID = "avoid"  # AVOID_GEOFENCE
     RETURN = "return"  # MOVE_TO_LOITER
     DESCEND = "descend"  # LOITER_DOWN
     HOLD = "hold"  # LOITER_HOLD
@@ -50,11 +55,12 @@ def _f32(x: float) -> float:
 
 class RtlTask(Task):
     def __init__(self, nav: NavInput, params: ParamRegistry, destination: tuple[Vec3, float] | None = None,
-                 loiter_at_ned_m: Vec3 | None = None) -> None:
+                 loiter_at_ned_m: Vec3 | None = None, avoid_path: Sequence[tuple[float, float]] = ()) -> None:
         """`destination`: where to return (rtl.cpp findRtlDestination: home, or a rally point chosen by
         navigator/rally.py), NED position and yaw. `loiter_at_ned_m`: the loiter the vehicle was established on when RTL
         began (a finished mission's last setpoint): the climb keeps its centre (rtl_direct.cpp CLIMBING,
-        is_established_on_loiter); else the climb is centred where the vehicle is."""
+        is_established_on_loiter); else the climb is centred where the vehicle is. `avoid_path`: the geofence
+        avoidance waypoints (north, east) to fly before home, none when the straight way is clear."""
         super().__init__(nav, params)
         self._loiter_at = loiter_at_ned_m
         self._yaw_err_rad = math.radians(float(params.get("MIS_YAW_ERR")) if "MIS_YAW_ERR" in params else 12.0)
@@ -63,12 +69,17 @@ class RtlTask(Task):
         self._rtl_up_m = self._return_altitude_up(nav)
         self._state = RtlState.IDLE
         self._hold_until_us = 0
+        self._avoid = list(avoid_path)
+        self._cursor = 0  # the avoidance waypoint flown (GeofenceAvoidancePlanner's path cursor)
+        self._avoid_yaw = NAN
         if nav.landed:
             self._enter(RtlState.IDLE, nav)
         else:
-            self._enter(RtlState.CLIMB if -nav.pos_ned_m[2] < self._rtl_up_m else RtlState.RETURN, nav)
+            self._enter(RtlState.CLIMB if -nav.pos_ned_m[2] < self._rtl_up_m else self._after_climb(), nav)
         self._say(Severity.INFO, rtl_start_text(nav.ref_alt_amsl_m + self._rtl_up_m,
                                                 nav.ref_alt_amsl_m - self._home[2]))
+        if self._avoid:
+            self._say(Severity.INFO, "RTL: avoiding geofence")
 
     @property
     def state(self) -> RtlState:
@@ -98,6 +109,10 @@ class RtlTask(Task):
     def _dist_xy(self, nav: NavInput) -> float:
         return math.hypot(self._home[0] - nav.pos_ned_m[0], self._home[1] - nav.pos_ned_m[1])
 
+    def _after_climb(self) -> RtlState:
+        """_updateRtlState after CLIMBING or an AVOID_GEOFENCE waypoint: the next avoidance waypoint, else home."""
+        return RtlState.AVOID if self._cursor < len(self._avoid) else RtlState.RETURN
+
     def _enter(self, state: RtlState, nav: NavInput) -> None:
         self._state = state
         s = self._settings
@@ -105,6 +120,9 @@ class RtlTask(Task):
             at = self._loiter_at if self._loiter_at is not None else nav.pos_ned_m
             self._climb_xy = (at[0], at[1])
             self._climb_yaw = nav.yaw_rad
+        elif state is RtlState.AVOID:  # facing the waypoint from here (MPC_YAW_MODE weathervane off)
+            px, py = self._avoid[self._cursor]
+            self._avoid_yaw = math.atan2(py - nav.pos_ned_m[1], px - nav.pos_ned_m[0])
         elif state is RtlState.RETURN:
             self._return_yaw = self._home_yaw if self._dist_xy(nav) < s.rtl_min_dist else NAN
         elif state is RtlState.HOLD:
@@ -114,12 +132,12 @@ class RtlTask(Task):
         elif state is RtlState.LAND:
             self._say(Severity.INFO, "RTL: land at destination")
 
-    def _heading_reached(self, nav: NavInput) -> bool:
+    def _heading_reached(self, nav: NavInput, yaw_rad: float) -> bool:
         """mission_block.cpp: an item with a heading (the return leg near home faces home's heading) is reached only
         once the heading is within MIS_YAW_ERR (MIS_YAW_TMT -1: no timeout)."""
-        if not math.isfinite(self._return_yaw):
+        if not math.isfinite(yaw_rad):
             return True
-        err = (self._return_yaw - nav.yaw_rad + math.pi) % math.tau - math.pi
+        err = (yaw_rad - nav.yaw_rad + math.pi) % math.tau - math.pi
         return abs(err) < self._yaw_err_rad
 
     def _loiter_up_m(self) -> float:
@@ -135,6 +153,8 @@ class RtlTask(Task):
         if st is RtlState.CLIMB:
             return Waypoint(SetpointType.POSITION, (self._climb_xy[0], self._climb_xy[1], -self._rtl_up_m),
                             self._climb_yaw)
+        if st is RtlState.AVOID:
+            return self._avoid_waypoint()
         if st is RtlState.RETURN:
             return Waypoint(SetpointType.POSITION, (hx, hy, -self._rtl_up_m), self._return_yaw)
         if st in (RtlState.DESCEND, RtlState.HOLD, RtlState.HOVER):
@@ -143,6 +163,20 @@ class RtlTask(Task):
             return Waypoint(SetpointType.LAND, (hx, hy, NAN), self._home_yaw)
         return Waypoint(SetpointType.IDLE, self._home)
 
+    def _avoid_waypoint(self) -> Waypoint:
+        """An AVOID_GEOFENCE item: the line from the previous avoidance waypoint (none to the first one), the next
+        one or home as the triplet's next."""
+        z = -self._rtl_up_m
+        x, y = self._avoid[self._cursor]
+        previous = (*self._avoid[self._cursor - 1], z) if self._cursor > 0 else None
+        nxt = self._avoid[self._cursor + 1] if self._cursor + 1 < len(self._avoid) else (self._home[0], self._home[1])
+        return Waypoint(SetpointType.POSITION, (x, y, z), self._avoid_yaw, NAN, previous, (nxt[0], nxt[1], z))
+
+    def _reached_xyz(self, nav: NavInput, x: float, y: float, up: float) -> bool:
+        s = self._settings
+        return math.hypot(x - nav.pos_ned_m[0], y - nav.pos_ned_m[1]) <= s.nav_acc_rad \
+            and abs(-nav.pos_ned_m[2] - up) <= s.nav_mc_alt_rad
+
     def _advance(self, nav: NavInput) -> None:
         """RtlDirect::_updateRtlState once the current item is reached (mission_block acceptance rules)."""
         s = self._settings
@@ -150,9 +184,13 @@ class RtlTask(Task):
         near_xy = self._dist_xy(nav) <= s.nav_acc_rad
         st = self._state
         if st is RtlState.CLIMB and up >= self._rtl_up_m - s.nav_mc_alt_rad:
-            self._enter(RtlState.RETURN, nav)
+            self._enter(self._after_climb(), nav)
+        elif st is RtlState.AVOID and self._reached_xyz(nav, *self._avoid[self._cursor], self._rtl_up_m) \
+                and self._heading_reached(nav, self._avoid_yaw):
+            self._cursor += 1
+            self._enter(self._after_climb(), nav)
         elif st is RtlState.RETURN and near_xy and abs(up - self._rtl_up_m) <= s.nav_mc_alt_rad \
-                and self._heading_reached(nav):
+                and self._heading_reached(nav, self._return_yaw):
             self._enter(RtlState.LAND if s.rtl_land_delay == 0.0 else RtlState.DESCEND, nav)
         elif st is RtlState.DESCEND and abs(up - self._loiter_up_m()) <= s.nav_mc_alt_rad:
             self._enter(RtlState.HOLD, nav)

@@ -6,8 +6,8 @@ After src/modules/navigator/rtl.cpp (setRtlTypeAndDestination, findRtlDestinatio
   home (GLOBAL_RELATIVE_ALT); others are skipped;
 - RTL_TYPE 0: the closest of home and the rally points more than 10 m from home; 1: the closest rally point more
   than 10 m from home, home if there is none; 3: as 0; 5: the closest rally point (wherever it is), else the current
-  position (with home's yaw); 2 and 4 (mission paths) return home when no mission is flown (the emulator flies
-  no mission paths back);
+  position (with home's yaw); 2 and 4 (mission paths) return home when no valid mission is stored (the mission
+  flown back: flight_tasks/rtl_mission.py);
 - a candidate replaces the best so far only if it is closer by more than 2 m (MIN_DIST_THRESHOLD); distances are
   great circles from the current position;
 - a rally point has no yaw (NaN: the vehicle keeps or turns to its course), home has home's yaw.

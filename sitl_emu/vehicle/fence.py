@@ -5,7 +5,8 @@ Vehicle.step calls `FenceChecks.check_commands` on the navigator's new requests 
 DO_CHANGE_ALTITUDE targets outside the fence are refused, navigator_main.cpp geofence_allows_position) and
 `FenceChecks.step` before each commander cycle (PX4: the navigator's geofence_breach_check
 publishes geofence_result, the commander's health check and failsafe act on it); the mode executor asks
-`rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation).
+`rtl_destination` when Return starts (rtl.cpp setRtlTypeAndDestination on activation), and `FenceChecks.rtl_avoidance`
+for the way around the fence to it (RtlDirect::on_activation: the geofence avoidance planner's path).
 """
 
 from __future__ import annotations
@@ -27,10 +28,10 @@ from sitl_emu.navigator.geofence import (
 from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
 from sitl_emu.navigator.rally import choose_destination
-from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import Vec3
+from sitl_emu.vehicle.rtl_avoidance import RtlAvoidance
 
 # emit(severity, module, text, is_event, statustext), as Vehicle._emit
 Emit = Callable[[Severity, str, str, bool, bool], None]
@@ -58,6 +59,7 @@ class FenceChecks:
         # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
         # changes)
         self._mission_inputs: tuple[object, ...] = (None, None, None, -1)
+        self.avoidance = RtlAvoidance(params)  # Return's way around the fence (rtl_avoidance.py)
 
     @property
     def settings(self) -> GeofenceSettings:
@@ -74,6 +76,15 @@ class FenceChecks:
             self._breach_check(now_us, store, c, estimate_ned_m, truth_ned_m, ref, emit)
         if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
             self._check_mission(store, c, emit)
+        if self.monitor.fence.areas and c.estimator_ready and c.nav_state is not NavState.AUTO_RTL:
+            self.avoidance.track(now_us, self.monitor.fence.areas, estimate_ned_m,
+                                 lambda: rtl_target(estimate_ned_m, self.params, store, c, ref), ref, emit)
+
+    def rtl_avoidance(self, pos_ned_m: Vec3, destination_ned_m: Vec3, ref: GeoRef,
+                      emit: Emit) -> list[tuple[float, float]]:
+        """The geofence avoidance path (north, east) from `pos_ned_m` to Return's destination, empty to fly there
+        directly, around the fence in force."""
+        return self.avoidance.path(self.monitor.fence.areas, pos_ned_m, destination_ned_m, ref, emit)
 
     def _breach_check(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3,
                       truth_ned_m: Vec3, ref: GeoRef, emit: Emit) -> None:
@@ -148,15 +159,23 @@ class FenceChecks:
                                        home_point(c))
 
 
-def rtl_destination(nav: NavInput, params: ParamRegistry, store: MissionStore, c: Commander,
+def rtl_destination(pos_ned_m: Vec3, params: ParamRegistry, store: MissionStore, c: Commander,
                     ref: GeoRef) -> tuple[Vec3, float] | None:
     """RTL's destination in NED with its yaw, or None to return home as before (no rally point chosen)."""
     home = home_point(c)
     if home is None or c.home is None:
         return None
-    here = _geo(ref, nav.pos_ned_m)
+    here = _geo(ref, pos_ned_m)
     dest = choose_destination(int(params["RTL_TYPE"]), store.plan(PLAN_RALLY).items, home, c.home.yaw_rad, here)
     if dest.point == home:
         return None
     p = dest.point
     return global_to_ned(ref, p.lat_deg, p.lon_deg, p.alt_amsl_m), dest.yaw_rad
+
+
+def rtl_target(pos_ned_m: Vec3, params: ParamRegistry, store: MissionStore, c: Commander, ref: GeoRef) -> Vec3:
+    """Where Return would go from `pos_ned_m`: the rally point chosen, else home (the local origin without one)."""
+    destination = rtl_destination(pos_ned_m, params, store, c, ref)
+    if destination is not None:
+        return destination[0]
+    return c.home.pos_ned_m if c.home is not None else (0.0, 0.0, 0.0)

@@ -109,6 +109,7 @@ class Vehicle:
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
         self._fence = FenceChecks(self.params)  # the navigator's geofence check (fence.py)
         self.chain.executor.rtl_destination = self._rtl_destination
+        self.chain.executor.rtl_avoid_path = self._rtl_avoid_path
         self.commander.mission_store = self._missions
         self.chain.executor.attach_missions(self._missions)
 
@@ -174,7 +175,10 @@ class Vehicle:
         return self.chain.nav_input(self._time_us, self._estimate, self.commander, self.ref)
 
     def _rtl_destination(self, nav: NavInput) -> tuple[Vec3, float] | None:
-        return rtl_destination(nav, self.params, self._missions, self.commander, self.ref)
+        return rtl_destination(nav.pos_ned_m, self.params, self._missions, self.commander, self.ref)
+
+    def _rtl_avoid_path(self, nav: NavInput, destination_ned_m: Vec3) -> list[tuple[float, float]]:
+        return self._fence.rtl_avoidance(nav.pos_ned_m, destination_ned_m, self.ref, self._emit)
 
     def _sih_config(self) -> SihConfig:
         if self.params.version != self._sih_version:

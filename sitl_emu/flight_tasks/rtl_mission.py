@@ -1,0 +1,97 @@
+"""AUTO.RTL along the mission path (RTL_TYPE 2 and 4): which return RTL_TYPE asks for, and the task that flies the
+mission back or on to its landing (navigator/mission_return.py) with FlightTaskAuto's core.
+
+rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing pattern (DO_LAND_START followed
+by a land item) returns along it forwards (RtlMissionFast), any other valid mission backwards
+(RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4: forwards only when the landing
+pattern is nearer than the start (reverseIsFurther), else as 2. Not modelled: the mission landing of RTL_TYPE 1 and
+3 (RtlDirectMissionLand); those returns fly RtlDirect home.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Final
+
+from sitl_emu.flight_tasks.core import Task, Waypoint
+from sitl_emu.flight_tasks.mission import mission_settings, mission_waypoint
+from sitl_emu.geo import GeoRef
+from sitl_emu.navigator.mission_items import nav_items
+from sitl_emu.navigator.mission_return import (
+    ForwardMissionNavigator,
+    ReturnNavigator,
+    ReverseMissionNavigator,
+    forward_start_index,
+    reverse_start_index,
+)
+from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
+from sitl_emu.navigator.setpoint import NavInput
+from sitl_emu.params import ParamRegistry
+from sitl_emu.px4 import MavCmd
+
+RTL_TYPE_MISSION_FAST: Final = 2  # rtl_params.yaml: "Return by flying along the mission path (forward or backward)"
+RTL_TYPE_MISSION_FAST_SHORTEST: Final = 4  # "... whichever way is shorter to the landing"
+
+
+def land_start_index(items: tuple[MissionItem, ...]) -> int:
+    """mission.land_start_index as PX4 keeps it: the DO_LAND_START item followed by a land item, else -1."""
+    for index, item in enumerate(items):
+        if item.command == MavCmd.DO_LAND_START:
+            after = items[index + 1:]
+            return index if any(it.command == MavCmd.NAV_LAND for it in after) else -1
+    return -1
+
+
+class MissionReturn(Enum):
+    """The returns along the mission (rtl.h RtlType)."""
+
+    FORWARD = "forward"  # RTL_MISSION_FAST
+    REVERSE = "reverse"  # RTL_MISSION_FAST_REVERSE
+
+
+def mission_return(rtl_type: int, store: MissionStore) -> MissionReturn | None:
+    """The return RTL_TYPE picks for the stored mission (RTL::setRtlTypeAndDestination), None: RtlDirect."""
+    if rtl_type not in (RTL_TYPE_MISSION_FAST, RTL_TYPE_MISSION_FAST_SHORTEST) or not store.mission_valid:
+        return None
+    land_start = land_start_index(store.plan(PLAN_MISSION).items)
+    reverse_is_further = land_start - store.current_seq < store.current_seq
+    if land_start >= 0 and (rtl_type == RTL_TYPE_MISSION_FAST or reverse_is_further):
+        return MissionReturn.FORWARD
+    return MissionReturn.REVERSE
+
+
+class RtlMissionTask(Task):
+    """One activation of AUTO.RTL flying along the mission; the texts, MISSION_CURRENT and MISSION_ITEM_REACHED
+    follow its navigator (the mission_result goes to the store as the mission's does)."""
+
+    def __init__(self, nav: NavInput, params: ParamRegistry, store: MissionStore, ref: GeoRef,
+                 home_alt_amsl_m: float, way: MissionReturn, mission_seq_prior_rtl: int) -> None:
+        """`mission_seq_prior_rtl`: the mission's current item if AUTO.MISSION ran just before, else -1."""
+        super().__init__(nav, params)
+        self._store = store
+        self._mission_settings = mission_settings(params)
+        items = nav_items(store.plan(PLAN_MISSION).items, ref, home_alt_amsl_m)
+        navigator: ReturnNavigator
+        if way is MissionReturn.FORWARD:
+            navigator, first = ForwardMissionNavigator(), forward_start_index(items, mission_seq_prior_rtl, nav)
+        else:
+            navigator, first = ReverseMissionNavigator(), reverse_start_index(items, mission_seq_prior_rtl, nav)
+        self._navigator = navigator
+        navigator.load(items, 0)
+        navigator.start(nav, self._mission_settings, first)
+        self._publish()
+
+    def _publish(self) -> None:
+        navigator, store = self._navigator, self._store
+        store.current_seq = navigator.result.seq_current
+        store.seq_reached = navigator.result.seq_reached
+        store.finished = navigator.result.finished
+        for severity, text in navigator.messages:
+            self._say(severity, text)
+        navigator.messages.clear()
+
+    def _waypoint(self, nav: NavInput) -> Waypoint:
+        navigator = self._navigator
+        navigator.update(nav, self._mission_settings)
+        self._publish()
+        return mission_waypoint(navigator.previous, navigator.current, navigator.next, nav)
