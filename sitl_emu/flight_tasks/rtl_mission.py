@@ -1,5 +1,5 @@
 """AUTO.RTL along the mission path (RTL_TYPE 2 and 4): which return RTL_TYPE asks for, and the task that flies the
-mission back or on to its landing (navigator/mission_return.py) with FlightTaskAuto's core.
+mission back or on to its landing (navigator/return_path.py) with FlightTaskAuto's core.
 
 rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing pattern (DO_LAND_START followed
 by a land item) returns along it forwards (RtlMissionFast), any other valid mission backwards
@@ -17,14 +17,14 @@ from sitl_emu.flight_tasks.core import Task, Waypoint
 from sitl_emu.flight_tasks.mission import mission_settings, mission_waypoint
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.mission_items import nav_items
-from sitl_emu.navigator.mission_return import (
+from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
+from sitl_emu.navigator.return_path import (
     ForwardMissionNavigator,
     ReturnNavigator,
     ReverseMissionNavigator,
     forward_start_index,
     reverse_start_index,
 )
-from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import MavCmd

@@ -2,7 +2,7 @@
 
 mission_store.py (PX4 dataman: the mission, fence and rally plans, replaced whole), mission.py (AUTO.MISSION: the
 current item, reached, jumps, the end; mission.cpp, mission_base.cpp, mission_block.cpp), mission_items.py (the
-stored items as the navigator flies them), mission_return.py (the mission as Return flies it, back or on to its
+stored items as the navigator flies them), return_path.py (the mission as Return flies it, back or on to its
 landing: rtl_mission_fast_reverse.cpp, rtl_mission_fast.cpp), geofence.py (the fence and its point tests;
 geofence.cpp), geofence_monitor.py (the breach check every 200 ms), rally.py (RTL's destination; rtl.cpp),
 geofence_avoidance.py with planner_polygons.py (Return's way around the fence: geofence_avoidance_planner.cpp,

@@ -14,13 +14,13 @@ from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do,
 from sitl_emu.flight_tasks.rtl_mission import MissionReturn, land_start_index, mission_return
 from sitl_emu.geo import GeoRef
 from sitl_emu.navigator.mission_items import nav_items
-from sitl_emu.navigator.mission_return import (
+from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
+from sitl_emu.navigator.return_path import (
     closest_position_item,
     forward_start_index,
     previous_position_index,
     reverse_start_index,
 )
-from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.px4 import MavCmd, MavResult, NavState
 
 RTL_ITEM = do(MavCmd.NAV_RETURN_TO_LAUNCH)
