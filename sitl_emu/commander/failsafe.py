@@ -47,13 +47,16 @@ class Decision:
     delay_s: int = 0
 
     def __init__(self, nav_state: NavState, failsafe: bool, disarm: bool = False, activated: bool = False,
-                 text: str = "", notice: tuple[int, int, int, int] = (0, 0, 0, 0)) -> None:
+                 text: str = "", action: int = 0, delayed_action: int = 0, cause: int = 0, delay_s: int = 0) -> None:
         self.nav_state = nav_state
         self.failsafe = failsafe
         self.disarm = disarm
         self.activated = activated
         self.text = text
-        self.action, self.delayed_action, self.cause, self.delay_s = notice
+        self.action = action
+        self.delayed_action = delayed_action
+        self.cause = cause
+        self.delay_s = delay_s
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
@@ -218,4 +221,4 @@ class Failsafe:
     def _decide(self, nav_state: NavState, disarm: bool, text: str,
                 notice: tuple[int, int, int, int] = (0, 0, 0, 0)) -> Decision:
         self.active = True
-        return Decision(nav_state, True, disarm=disarm, activated=bool(text), text=text, notice=notice)
+        return Decision(nav_state, True, disarm, bool(text), text, *notice)

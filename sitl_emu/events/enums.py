@@ -59,7 +59,7 @@ FAILSAFE_CAUSE = EventEnum("failsafe_cause_t", "uint8_t", "Cause for entering fa
     (4, "critical_battery_level", "critical battery level"),
     (5, "emergency_battery_level", "emergency battery level")))
 
-HEALTH_COMPONENT = EventEnum("health_component_t", "uint32_t", "Bitfield for subsystems & components", tuple(
+HEALTH_COMPONENT: EventEnum = EventEnum("health_component_t", "uint32_t", "Bitfield for subsystems & components", tuple(
     (1 << i, name, text) for i, (name, text) in enumerate((
         ("none", "None"), ("absolute_pressure", "Absolute pressure"),
         ("differential_pressure", "Differential pressure"), ("gps", "GPS"), ("optical_flow", "Optical flow"),
@@ -74,7 +74,7 @@ HEALTH_COMPONENT = EventEnum("health_component_t", "uint32_t", "Bitfield for sub
         ("parachute", "Parachute"), ("magnetometer", "Magnetometer"), ("accel", "Accelerometer"),
         ("gyro", "Gyroscope"), ("open_drone_id", "Open Drone ID system")))), is_bitfield=True)
 
-NAVIGATION_MODE_GROUP = EventEnum(
+NAVIGATION_MODE_GROUP: EventEnum = EventEnum(
     "navigation_mode_group_t", "uint32_t", "Navigation/flight mode group bits. All modes within a group share the "
     "same arming checks. For now we directly map group == mode.", tuple((1 << bit, name, text) for bit, name, text in (
         (0, "manual", "Fully manual mode (w/o any controller support)"), (1, "altctl", "Altitude mode"),
