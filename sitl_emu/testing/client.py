@@ -5,6 +5,9 @@ HEARTBEAT every second, streams the current position setpoint at 20 Hz while one
 its clock. With `Sim.clock` (lockstep) a whole flight runs as fast as the CPU allows and is reproducible; with a
 `px4common.clock.ScaledClock(speed)` the same script flies `sitl-emu serve --speed speed` in another process.
 
+It decodes only the messages it reads (OBSERVED, and what `watch()` adds; testing/frames.py): the other ~80 % of
+an API link's streams are skipped by their header's message id.
+
 `fly_square()` is the reference flight of the tests and the benchmark: wait until healthy, arm, take off, OFFBOARD
 square (PX4's rule: setpoints stream before the switch, reference 4.2), land, wait for the auto-disarm.
 """
@@ -21,6 +24,7 @@ from typing import Any, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.px4 import MODE_FLAG_SAFETY_ARMED, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, main_sub
+from sitl_emu.testing.frames import MessageFilter
 
 NAN = math.nan
 SETPOINT_PERIOD_S = 0.05  # 20 Hz, as MAVSDK's offboard plugin streams
@@ -28,6 +32,10 @@ POLL_S = 0.01
 POSITION_ONLY = 0b0000_1111_1111_1000  # SET_POSITION_TARGET_LOCAL_NED type_mask: use x, y, z only
 MAV_FRAME_LOCAL_NED = 1
 MAV_STATE_STANDBY = 3
+# the messages _observe reads: only these are decoded
+OBSERVED = ("HEARTBEAT", "LOCAL_POSITION_NED", "GLOBAL_POSITION_INT", "SYS_STATUS", "HOME_POSITION", "COMMAND_ACK",
+            "STATUSTEXT", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT",
+            "MISSION_ITEM_REACHED", "MISSION_CURRENT")
 
 
 class Clock(Protocol):
@@ -72,8 +80,7 @@ class FlightClient:
         self.sock.bind(("127.0.0.1", 0))
         self.sock.setblocking(False)
         self.mav = dialect.MAVLink(None, srcSystem=sysid, srcComponent=compid)
-        self._parser = dialect.MAVLink(None)
-        self._parser.robust_parsing = True
+        self._parser = MessageFilter(OBSERVED)
         self.seen = Observed()
         self.setpoint_ned_m: tuple[float, float, float] | None = None
         self._next_heartbeat_s = -math.inf
@@ -81,6 +88,14 @@ class FlightClient:
         self.start_s = clock.now()
 
     # --- I/O -----------------------------------------------------------------------------------------------------
+    def watch(self, *names: str) -> None:
+        """Decode these messages too (e.g. "ORBIT_EXECUTION_STATUS"), for a subclass's `_observe` to read."""
+        self._parser.add(*names)
+
+    def watch_all(self) -> None:
+        """Decode every message (a client that records everything it hears)."""
+        self._parser.add_all()
+
     def send(self, msg: Any) -> None:
         self.sock.sendto(msg.pack(self.mav), self.address)
         self.mav.seq = (self.mav.seq + 1) % 256
@@ -92,7 +107,7 @@ class FlightClient:
                 data, _ = self.sock.recvfrom(65535)
             except (BlockingIOError, InterruptedError, ConnectionRefusedError):
                 break
-            for msg in self._parser.parse_buffer(data) or []:
+            for msg in self._parser.parse(data):
                 self._observe(msg)
         now = self.clock.now()
         if now >= self._next_heartbeat_s:
