@@ -33,9 +33,15 @@ POSITION_ONLY = 0b0000_1111_1111_1000  # SET_POSITION_TARGET_LOCAL_NED type_mask
 MAV_FRAME_LOCAL_NED = 1
 MAV_STATE_STANDBY = 3
 # the messages _observe reads: only these are decoded
-OBSERVED = ("HEARTBEAT", "LOCAL_POSITION_NED", "GLOBAL_POSITION_INT", "SYS_STATUS", "HOME_POSITION", "COMMAND_ACK",
-            "STATUSTEXT", "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT",
+OBSERVED = ("HEARTBEAT", "LOCAL_POSITION_NED", "SYS_STATUS", "HOME_POSITION", "COMMAND_ACK", "STATUSTEXT",
+            "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT",
             "MISSION_ITEM_REACHED", "MISSION_CURRENT")
+# streamed often, read now and then: the newest frame is kept and decoded when read (Observed.lat_lon_deg)
+KEPT_LAST = ("GLOBAL_POSITION_INT",)
+
+
+def _none(name: str) -> Any:
+    return None
 
 
 class Clock(Protocol):
@@ -57,7 +63,6 @@ class Observed:
     sys_status: Any = None
     home_seen: bool = False
     pos_ned_m: tuple[float, float, float] | None = None
-    lat_lon_deg: tuple[float, float] | None = None
     vehicle_time_s: float = 0.0  # the vehicle's time since boot, from LOCAL_POSITION_NED.time_boot_ms
     acks: list[tuple[int, int]] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
@@ -65,6 +70,13 @@ class Observed:
     mission: list[Any] = field(default_factory=list)  # mission protocol answers (testing/mission_client.py)
     reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED seqs as they change
     mission_current: Any = None  # the last MISSION_CURRENT
+    last: Callable[[str], Any] = _none  # the newest message of a KEPT_LAST kind, decoded when asked
+
+    @property
+    def lat_lon_deg(self) -> tuple[float, float] | None:
+        """From the newest GLOBAL_POSITION_INT (50 Hz on the API link), decoded only when this is read."""
+        msg = self.last("GLOBAL_POSITION_INT")
+        return None if msg is None else (msg.lat * 1e-7, msg.lon * 1e-7)
 
 
 class FlightClient:
@@ -81,7 +93,8 @@ class FlightClient:
         self.sock.setblocking(False)
         self.mav = dialect.MAVLink(None, srcSystem=sysid, srcComponent=compid)
         self._parser = MessageFilter(OBSERVED)
-        self.seen = Observed()
+        self._parser.keep_last(*KEPT_LAST)
+        self.seen = Observed(last=self._parser.last)
         self.setpoint_ned_m: tuple[float, float, float] | None = None
         self._next_heartbeat_s = -math.inf
         self._next_setpoint_s = -math.inf
@@ -129,8 +142,6 @@ class FlightClient:
         elif kind == "LOCAL_POSITION_NED":
             self.seen.pos_ned_m = (msg.x, msg.y, msg.z)
             self.seen.vehicle_time_s = msg.time_boot_ms / 1000.0
-        elif kind == "GLOBAL_POSITION_INT":
-            self.seen.lat_lon_deg = (msg.lat * 1e-7, msg.lon * 1e-7)
         elif kind == "SYS_STATUS":
             self.seen.sys_status = msg
         elif kind == "HOME_POSITION":

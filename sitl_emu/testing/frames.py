@@ -10,6 +10,9 @@ incompat flags; a bad frame is a BAD_DATA, as before), so what comes out is exac
     for msg in wanted.parse(datagram):
         ...
 
+A message read now and then but sent often (GLOBAL_POSITION_INT, 50 Hz) can be kept instead (`keep_last`): only its
+newest frame is kept, and decoded when `last(name)` asks for it.
+
 A datagram holds whole frames (PX4 and sitl_emu send one message per datagram); a frame cut short at a datagram's
 end is given to pymavlink with what follows it dropped, so it can never swallow the next datagram.
 """
@@ -48,6 +51,9 @@ class MessageFilter:
         self.every = False  # add_all(): decode every frame (a recorder)
         self.skipped = 0  # frames not decoded
         self._parser = _new_parser()
+        self._kept: set[int] = set()  # keep_last(): the newest frame kept, decoded on demand
+        self._newest: dict[int, bytes] = {}  # kept frames not decoded yet
+        self._last: dict[int, Any] = {}  # the last valid message of each kept id
         self.add(*names)
 
     def add(self, *names: str) -> None:
@@ -57,10 +63,24 @@ class MessageFilter:
         """Decode every message from now on, as pymavlink's parser alone does."""
         self.every = True
 
+    def keep_last(self, *names: str) -> None:
+        """Keep only the newest frame of these messages, decoded when last() asks (not returned by parse())."""
+        self._kept.update(message_id(name) for name in names)
+
+    def last(self, name: str) -> Any:
+        """The newest valid message `name` of those kept (keep_last), decoded now if it is new; None before one."""
+        msg_id = message_id(name)
+        frame = self._newest.pop(msg_id, None)
+        if frame is not None:
+            self._remember([m for m in self._decode(frame) if m.get_type() != "BAD_DATA"])
+        return self._last.get(msg_id)
+
     def parse(self, data: bytes) -> list[Any]:
         """The wanted messages of one datagram, in order (and BAD_DATA for a wanted frame that is not valid)."""
         if self.every:
-            return self._decode(data)
+            msgs = self._decode(data)
+            self._remember(msgs)
+            return msgs
         out: list[Any] = []
         start, size = 0, len(data)
         while start < size:
@@ -70,10 +90,17 @@ class MessageFilter:
                 break
             if msg_id in self.wanted:
                 out.extend(self._decode(data[start:frame_end]))
+            elif msg_id in self._kept:
+                self._newest[msg_id] = data[start:frame_end]
             else:
                 self.skipped += 1
             start = frame_end
         return out
+
+    def _remember(self, msgs: list[Any]) -> None:
+        for msg in msgs:
+            if msg.get_type() != "BAD_DATA" and msg.get_msgId() in self._kept:
+                self._last[msg.get_msgId()] = msg
 
     def _decode(self, frames: bytes) -> list[Any]:
         parser = self._parser

@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 from pymavlink.dialects.v20 import development as dialect
 
+from sitl_emu.runtime.swarm import DEFAULT_HOME
 from sitl_emu.testing.client import OBSERVED, FlightClient
 from sitl_emu.testing.frames import MessageFilter, message_id
 from sitl_emu.testing.sim import Sim
@@ -81,6 +82,22 @@ def test_add_all_decodes_every_frame_as_pymavlink_does():
     assert [m.get_msgbuf() for m in every.parse(data)] == [m.get_msgbuf() for m in _pymavlink(data)]
 
 
+def test_a_kept_message_is_decoded_only_when_asked_and_only_its_newest_valid_frame():
+    mav = dialect.MAVLink(None, srcSystem=1, srcComponent=1)
+    frames = [mav.global_position_int_encode(i, 10 * i, 20 * i, 0, 0, 0, 0, 0, 0).pack(mav) for i in range(3)]
+    broken = frames[2][:-1] + bytes([frames[2][-1] ^ 0xFF])
+    kept = MessageFilter(("HEARTBEAT",))
+    kept.keep_last("GLOBAL_POSITION_INT")
+    assert kept.last("GLOBAL_POSITION_INT") is None
+    assert [m for f in frames[:2] for m in kept.parse(f)] == []  # kept, not returned
+    assert kept.last("GLOBAL_POSITION_INT").lat == 10
+    assert kept.parse(broken) == []
+    assert kept.last("GLOBAL_POSITION_INT").lat == 10  # a bad newest frame leaves the last valid message
+    kept.add_all()
+    kept.parse(frames[2])
+    assert kept.last("GLOBAL_POSITION_INT").lat == 20
+
+
 def test_an_unknown_name_is_one_sentence():
     with pytest.raises(ValueError, match=r"^pymavlink's development dialect has no message named NOT_A_MESSAGE\.$"):
         MessageFilter(("NOT_A_MESSAGE",))
@@ -102,6 +119,10 @@ def test_the_flight_client_decodes_only_what_it_reads(monkeypatch):
         client.wait(lambda: client.healthy, 10.0, "health")
         client.spin(1.0)
         client.close()
+        before_read = [kind for sysid, kind in decoded if sysid == 1]
+        lat, lon = client.seen.lat_lon_deg or (0.0, 0.0)
     from_vehicle = {kind for sysid, kind in decoded if sysid == 1}
-    assert {"HEARTBEAT", "LOCAL_POSITION_NED", "SYS_STATUS"} <= from_vehicle <= set(OBSERVED)
+    assert {"HEARTBEAT", "LOCAL_POSITION_NED", "SYS_STATUS"} <= set(before_read) <= set(OBSERVED)
+    assert from_vehicle == set(before_read) | {"GLOBAL_POSITION_INT"}  # decoded once, when read
     assert client.seen.pos_ned_m is not None and client.seen.home_seen
+    assert abs(lat - DEFAULT_HOME[0]) < 1e-5 and abs(lon - DEFAULT_HOME[1]) < 1e-5
