@@ -117,7 +117,7 @@ class FlightClient:
         """Read what arrived, then send the heartbeat and setpoint that are due."""
         while True:
             try:
-                data, _ = self.sock.recvfrom(65535)
+                data = self.sock.recv(65535)
             except (BlockingIOError, InterruptedError, ConnectionRefusedError):
                 break
             for msg in self._parser.parse(data):

@@ -81,6 +81,16 @@ class MessageFilter:
             msgs = self._decode(data)
             self._remember(msgs)
             return msgs
+        size = len(data)
+        if size >= HEADER_V2 and data[0] == MAGIC_V2:  # the common case first: one MAVLink 2 frame per datagram
+            signed = SIGNATURE if data[2] & IFLAG_SIGNED else 0
+            if HEADER_V2 + data[1] + CHECKSUM + signed == size:
+                out: list[Any] = []
+                self._take(data, data[7] | data[8] << 8 | data[9] << 16, out)
+                return out
+        return self._parse_frames(data)
+
+    def _parse_frames(self, data: bytes) -> list[Any]:
         out: list[Any] = []
         start, size = 0, len(data)
         while start < size:
@@ -88,14 +98,18 @@ class MessageFilter:
             if frame_end < 0 or frame_end > size:  # not a frame start, or a frame cut short: pymavlink judges
                 out.extend(m for m in self._decode(data[start:]) if _wanted_or_bad(m, self.wanted))
                 break
-            if msg_id in self.wanted:
-                out.extend(self._decode(data[start:frame_end]))
-            elif msg_id in self._kept:
-                self._newest[msg_id] = data[start:frame_end]
-            else:
-                self.skipped += 1
+            self._take(data[start:frame_end], msg_id, out)
             start = frame_end
         return out
+
+    def _take(self, frame: bytes, msg_id: int, out: list[Any]) -> None:
+        """One whole frame: decoded into `out` if wanted, kept if kept, else skipped."""
+        if msg_id in self.wanted:
+            out.extend(self._decode(frame))
+        elif msg_id in self._kept:
+            self._newest[msg_id] = frame
+        else:
+            self.skipped += 1
 
     def _remember(self, msgs: list[Any]) -> None:
         for msg in msgs:
