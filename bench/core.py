@@ -16,6 +16,7 @@ from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 POS = OffboardControlMode(position=True)
+CLIENT_POLL_US = 10_000  # how often the scripted client reads (testing/client.py POLL_S)
 
 
 def _command(v: Vehicle, command: int, *params: float) -> None:
@@ -65,22 +66,46 @@ def core_speed() -> tuple[float, float]:
     return v.time_us / 1e6 / cpu, v.time_us / 1e6
 
 
+class _VehicleClock:
+    """The vehicle's simulated seconds, for the scripted client (it never sleeps here: the manoeuvre steps)."""
+
+    def __init__(self, v: Vehicle) -> None:
+        self._v = v
+
+    def now(self) -> float:
+        return self._v.time_us / 1e6
+
+    def sleep(self, seconds: float) -> None:
+        raise RuntimeError("the manoeuvre steps the vehicle; the client only reads")
+
+
 def core_speed_with_io() -> float:
-    """Simulated s per CPU s of the same manoeuvre with a node doing its MAVLink I/O after every step (default
-    streams on both links, sent to a socket nobody reads; a link is read when the runners' socket watch says so)."""
+    """Simulated s per CPU s of the same manoeuvre with a node doing its MAVLink I/O after every step, as in a
+    campaign case: the API link streams its default set to a scripted client in this process (testing/client.py,
+    which talks first and reads every CLIENT_POLL_US; its CPU counts), the GCS link has no peer and builds nothing.
+    A link is read when the runners' socket watch says so."""
     from sitl_emu.runtime.runner import SocketWatch
+    from sitl_emu.testing.client import FlightClient
     from sitl_emu.testing.sim import Sim
 
     with Sim() as sim:
         node = sim.nodes[0]
         v = node.vehicle
+        client = FlightClient(sim.ports(0).api, _VehicleClock(v))
         look = SocketWatch(sim.nodes).ready  # as the runners do: one look at the sockets per tick
+        next_poll_us = [0]
 
         def io() -> None:
             ready = look()
             node.step_io(v.time_us, ready.get(0, 0) if ready else 0)
+            if v.time_us >= next_poll_us[0]:
+                client.pump()
+                next_poll_us[0] = v.time_us + CLIENT_POLL_US
 
         cpu = time.process_time()
         manoeuvre(v, io)
         cpu = time.process_time() - cpu
+        client.close()
+        if client.seen.pos_ned_m is None:
+            raise RuntimeError("the scripted client heard no position: the API link did not stream")
         return v.time_us / 1e6 / cpu

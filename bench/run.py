@@ -1,7 +1,8 @@
 """Run the benchmarks and print one figure per line with its unit: `python -m bench [--quick] [--only NAME ...]`.
 
 Figures (targets from issue 4 in brackets):
-  core        simulated seconds per CPU second, one vehicle, fixed manoeuvre, no I/O [>= 1000]; and with I/O
+  core        simulated seconds per CPU second, one vehicle, fixed manoeuvre, no I/O [>= 1000]; and with I/O (the
+              API link streaming to a scripted client in the process, the GCS link without a peer)
   runner      the runners' own cost: a stub vehicle (no physics) at real time, % of one core and CPU per tick; the
               swarm runner's CPU per vehicle-tick with 100 stub vehicles (bench/runner.py)
   serve       `sitl-emu serve` at real time, hovering, default streams on both links: % of one core [<= 3], with
@@ -67,7 +68,9 @@ def bench_core(quick: bool) -> None:
         f"bench/core.py, no I/O, best of {runs}; target >= 1000, compiled >= 3000)")
     pure, compiled = sides.side_by_side("core_io", runs)
     say(f"core with I/O: {sides.ratio_text(pure, compiled, 'simulated s per CPU s')} (same manoeuvre, MAVLink I/O "
-        f"after every step, default streams on both links, best of {runs}; compiled target >= 500)")
+        f"after every step as in a campaign case: the API link streams its default set to a scripted client in the "
+        f"process that reads every 10 ms, CPU counted; the GCS link has no peer; best of {runs}; compiled target "
+        f">= 500)")
 
 
 def bench_runner(quick: bool) -> None:

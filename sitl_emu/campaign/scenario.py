@@ -11,6 +11,8 @@ sys.path (last), so it may import the modules beside it.
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import importlib
 import importlib.util
 import inspect
@@ -25,7 +27,7 @@ from typing import Any
 from sitl_emu.campaign.cases import Case
 from sitl_emu.campaign.errors import CampaignError
 
-__all__ = ["Limits", "Outcome", "Row", "load_scenario", "run_case", "scenario_ref"]
+__all__ = ["Limits", "Outcome", "Row", "load_scenario", "prepare_worker", "run_case", "scenario_ref"]
 
 Row = dict[str, Any]  # one case's result: see results.py for its columns
 SIM_KEYWORDS_TAKEN = ("params", "seed")  # the case sets these itself
@@ -139,8 +141,24 @@ def one_line(err: BaseException) -> str:
 
 def sim_options(options: Mapping[str, Any], sim_class: Any) -> dict[str, Any]:
     """The case options Sim takes as keywords (e.g. `wind`, once Sim has it); the others are the scenario's only."""
-    accepted = inspect.signature(sim_class).parameters
+    accepted = _keywords(sim_class)
     return {k: v for k, v in options.items() if k in accepted and k not in SIM_KEYWORDS_TAKEN}
+
+
+@functools.cache
+def _keywords(sim_class: Any) -> frozenset[str]:
+    return frozenset(inspect.signature(sim_class).parameters)
+
+
+def prepare_worker(ref: str) -> None:
+    """What a worker does once, before its first case, so that no case pays for it: import the Sim and the scenario,
+    and build and close one Sim (its protocol handlers, parameter definitions and numpy's random generators are
+    imported on first use). A scenario that cannot load is left to each case's error row."""
+    from sitl_emu.testing import Sim
+
+    with contextlib.suppress(CampaignError):
+        load_scenario(ref)
+    Sim().close()
 
 
 def run_case(ref: str, case: Case, limits: Limits, wall_deadline_s: float | None = None) -> Row:

@@ -255,11 +255,11 @@ def serve(port: int, remote: str, gcs_port: int, gcs_remote: str, bind_host: str
     try:
         check_view(view)
         check_host(bind_host, "--bind")
-        settings = LinkSettings(bind_host, port, parse_address(remote, "--remote"), gcs_port,
-                                parse_address(gcs_remote, "--gcs-remote"))
+        api_remote = parse_address(remote, "--remote")
+        settings = LinkSettings(bind_host, port, api_remote, gcs_port, parse_address(gcs_remote, "--gcs-remote"))
         home_lla = parse_home(home) if home else DEFAULT_HOME
         wind = _wind_option(wind_text)
-        check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, settings.api_remote[1])
+        check_instances(instance, count, {"--port": port, "--gcs-port": gcs_port}, api_remote[1])
         check_own_ports([settings.for_instance(i) for i in range(instance, instance + count)])
         build_params(None if params_reset else params_file, assignments)  # a bad one: one sentence, no port open
         key = read_signing_key(signing_key) if signing_key is not None else None

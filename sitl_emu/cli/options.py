@@ -69,7 +69,10 @@ def check_own_ports(links: Sequence[LinkSettings]) -> None:
                                    "vehicle N listens on each port + N): choose ports further apart.")
             listening[port] = option
     for s in links:
-        for option, (host, port) in (("--remote", s.api_remote), ("--gcs-remote", s.gcs_remote)):
+        for option, remote in (("--remote", s.api_remote), ("--gcs-remote", s.gcs_remote)):
+            if remote is None:  # no peer until one talks (a Sim's link): it sends nowhere
+                continue
+            host, port = remote
             if port in listening and (host in THIS_MACHINE or host == s.bind_host):
                 raise UsageProblem(f"{option} {host}:{port} is a port this emulator listens on ({listening[port]}): "
                                    "it would talk to itself; point it at the client (PX4 SITL sends the API link "

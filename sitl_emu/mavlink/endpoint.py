@@ -131,7 +131,10 @@ class Endpoint:
         return self._now_us
 
     def send(self, msg: OutMessage) -> None:
-        """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack."""
+        """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack.
+        Nothing at all while the link has no peer (link.py: a Sim's link nobody has talked to yet)."""
+        if self.link.remote is None:
+            return
         try:
             if self.signing.key is None:
                 data = frame_message(msg, self.seq, self.sysid, COMPID)
@@ -215,6 +218,8 @@ class Endpoint:
 
     def pass_message(self, msg: MAVLink_message) -> None:
         """Send a received message on as it is (its own sysid, compid, sequence and checksum)."""
+        if self.link.remote is None:
+            return
         data = bytes(msg.get_msgbuf())
         self.stats.tx_forwarded += 1
         self.stats.tx_bytes += len(data)
@@ -241,10 +246,13 @@ class Endpoint:
 
     # --- transmit ------------------------------------------------------------------------------------------------
     def emit(self, now_us: int, events: Sequence[VehicleEvent]) -> None:
-        """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream."""
+        """Send what is due at `now_us`: heartbeat, streams, status texts, then let handlers stream.
+
+        A link with no peer (link.py) builds no stream at all: its schedule waits, and the first pass after a peer
+        talks sends the heartbeat and every stream at once, as a link just started would."""
         # Called every tick on every link: when nothing is due and nothing happened this costs a few comparisons.
         self._now_us = now_us
-        if now_us >= self.streams.next_due_us:
+        if now_us >= self.streams.next_due_us and self.link.remote is not None:
             self.streams.emit_due(self, self.node.snapshot)
         if events:
             self._pending_texts.extend(e for e in events if e.statustext)

@@ -5,6 +5,10 @@ PX4 (src/modules/mavlink/mavlink_main.cpp init_udp / send_finish, mavlink_receiv
 later senders are still parsed but never answered. This module does exactly that and nothing else: no parsing, no
 clock. Sockets are non-blocking; `receive()` returns at most `max_datagrams` datagrams so a flood cannot starve the
 physics loop (the kernel drops what does not fit its buffer, as it would for PX4).
+
+An in-process Sim may open a link with no remote at all (`remote=None`: nobody could receive what it sent). Such a
+link sends nothing, and its endpoint builds nothing to send, until the first datagram arrives; its sender is then
+latched as PX4 latches it. `serve` always gives both links a remote, so its wire is PX4's.
 """
 
 from __future__ import annotations
@@ -34,11 +38,13 @@ class LinkStats:
 
 
 class UdpLink:
-    """A bound UDP socket with PX4's addressing: initial remote, then the first peer heard, forever."""
+    """A bound UDP socket with PX4's addressing: initial remote, then the first peer heard, forever.
 
-    def __init__(self, bind_host: str, port: int, remote: Address, name: str = "link") -> None:
+    `remote` None: no peer until one talks (`has_peer` False); what would be sent meanwhile is dropped uncounted."""
+
+    def __init__(self, bind_host: str, port: int, remote: Address | None, name: str = "link") -> None:
         self.name = name
-        self.remote: Address = remote
+        self.remote: Address | None = remote
         self.peer_latched = False
         self.stats = LinkStats()
         self._sock = _open_socket(bind_host, port, name)
@@ -73,8 +79,15 @@ class UdpLink:
             out.append(data)
         return out
 
+    @property
+    def has_peer(self) -> bool:
+        """True when a datagram sent now goes somewhere: a remote was given or a peer has talked."""
+        return self.remote is not None
+
     def send(self, data: bytes) -> None:
         """Send to the peer (or the initial remote); a failed send is counted, never raised (UDP is lossy)."""
+        if self.remote is None:
+            return
         try:
             self._sock.sendto(data, self.remote)
         except OSError as err:

@@ -38,19 +38,20 @@ READ_BOTH = READ_API | READ_GCS
 class LinkSettings:
     bind_host: str = "127.0.0.1"
     api_port: int = 14557
-    api_remote: Address = ("127.0.0.1", 14540)
+    api_remote: Address | None = ("127.0.0.1", 14540)  # None: no peer until one talks (mavlink/link.py)
     gcs_port: int = 18570
-    gcs_remote: Address = ("127.0.0.1", 14550)
+    gcs_remote: Address | None = ("127.0.0.1", 14550)
 
     def for_instance(self, instance: int) -> LinkSettings:
         """Offset the ports as PX4's `-i N` does (px4-rc.mavlink); the GCS remote stays 14550, and a local port 0
         (let the OS pick) stays 0."""
         if instance == 0:
             return self
-        api_remote_port = self.api_remote[1] + instance if instance <= 9 else 14549
+        api_remote = self.api_remote
+        if api_remote is not None:
+            api_remote = (api_remote[0], api_remote[1] + instance if instance <= 9 else 14549)
         return replace(self, api_port=self.api_port + instance if self.api_port else 0,
-                       gcs_port=self.gcs_port + instance if self.gcs_port else 0,
-                       api_remote=(self.api_remote[0], api_remote_port))
+                       gcs_port=self.gcs_port + instance if self.gcs_port else 0, api_remote=api_remote)
 
 
 class NodeVehicle(LinkVehicle, TickVehicle, Protocol):
@@ -103,8 +104,9 @@ class VehicleNode:
         """Where each link listens and sends, e.g. for the CLI's one line."""
         parts = []
         for ep, label in ((self.api, "API"), (self.gcs, "GCS")):
-            (lh, lp), (rh, rp) = ep.link.local_address, ep.link.remote
-            parts.append(f"{label} listens on {lh}:{lp}, sends to {rh}:{rp}")
+            (lh, lp), remote = ep.link.local_address, ep.link.remote
+            to = f"sends to {remote[0]}:{remote[1]}" if remote is not None else "sends nothing until a peer talks"
+            parts.append(f"{label} listens on {lh}:{lp}, {to}")
         return "; ".join(parts)
 
     def filenos(self) -> list[int]:

@@ -5,6 +5,9 @@ HEARTBEAT every second, streams the current position setpoint at 20 Hz while one
 its clock. With `Sim.clock` (lockstep) a whole flight runs as fast as the CPU allows and is reproducible; with a
 `px4common.clock.ScaledClock(speed)` the same script flies `sitl-emu serve --speed speed` in another process.
 
+It decodes only the messages it reads (OBSERVED, and what `watch()` adds; testing/frames.py): the other ~80 % of
+an API link's streams are skipped by their header's message id.
+
 `fly_square()` is the reference flight of the tests and the benchmark: wait until healthy, arm, take off, OFFBOARD
 square (PX4's rule: setpoints stream before the switch, reference 4.2), land, wait for the auto-disarm.
 """
@@ -21,6 +24,7 @@ from typing import Any, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.px4 import MODE_FLAG_SAFETY_ARMED, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, main_sub
+from sitl_emu.testing.frames import MessageFilter
 
 NAN = math.nan
 SETPOINT_PERIOD_S = 0.05  # 20 Hz, as MAVSDK's offboard plugin streams
@@ -28,6 +32,16 @@ POLL_S = 0.01
 POSITION_ONLY = 0b0000_1111_1111_1000  # SET_POSITION_TARGET_LOCAL_NED type_mask: use x, y, z only
 MAV_FRAME_LOCAL_NED = 1
 MAV_STATE_STANDBY = 3
+# the messages _observe reads: only these are decoded
+OBSERVED = ("HEARTBEAT", "LOCAL_POSITION_NED", "SYS_STATUS", "HOME_POSITION", "COMMAND_ACK", "STATUSTEXT",
+            "MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT", "MISSION_ITEM_INT",
+            "MISSION_ITEM_REACHED", "MISSION_CURRENT")
+# streamed often, read now and then: the newest frame is kept and decoded when read (Observed.lat_lon_deg)
+KEPT_LAST = ("GLOBAL_POSITION_INT",)
+
+
+def _none(name: str) -> Any:
+    return None
 
 
 class Clock(Protocol):
@@ -49,7 +63,6 @@ class Observed:
     sys_status: Any = None
     home_seen: bool = False
     pos_ned_m: tuple[float, float, float] | None = None
-    lat_lon_deg: tuple[float, float] | None = None
     vehicle_time_s: float = 0.0  # the vehicle's time since boot, from LOCAL_POSITION_NED.time_boot_ms
     acks: list[tuple[int, int]] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)  # distinct consecutive HEARTBEAT modes, e.g. "AUTO.LOITER"
@@ -57,6 +70,13 @@ class Observed:
     mission: list[Any] = field(default_factory=list)  # mission protocol answers (testing/mission_client.py)
     reached: list[int] = field(default_factory=list)  # MISSION_ITEM_REACHED seqs as they change
     mission_current: Any = None  # the last MISSION_CURRENT
+    last: Callable[[str], Any] = _none  # the newest message of a KEPT_LAST kind, decoded when asked
+
+    @property
+    def lat_lon_deg(self) -> tuple[float, float] | None:
+        """From the newest GLOBAL_POSITION_INT (50 Hz on the API link), decoded only when this is read."""
+        msg = self.last("GLOBAL_POSITION_INT")
+        return None if msg is None else (msg.lat * 1e-7, msg.lon * 1e-7)
 
 
 class FlightClient:
@@ -72,15 +92,23 @@ class FlightClient:
         self.sock.bind(("127.0.0.1", 0))
         self.sock.setblocking(False)
         self.mav = dialect.MAVLink(None, srcSystem=sysid, srcComponent=compid)
-        self._parser = dialect.MAVLink(None)
-        self._parser.robust_parsing = True
-        self.seen = Observed()
+        self._parser = MessageFilter(OBSERVED)
+        self._parser.keep_last(*KEPT_LAST)
+        self.seen = Observed(last=self._parser.last)
         self.setpoint_ned_m: tuple[float, float, float] | None = None
         self._next_heartbeat_s = -math.inf
         self._next_setpoint_s = -math.inf
         self.start_s = clock.now()
 
     # --- I/O -----------------------------------------------------------------------------------------------------
+    def watch(self, *names: str) -> None:
+        """Decode these messages too (e.g. "ORBIT_EXECUTION_STATUS"), for a subclass's `_observe` to read."""
+        self._parser.add(*names)
+
+    def watch_all(self) -> None:
+        """Decode every message (a client that records everything it hears)."""
+        self._parser.add_all()
+
     def send(self, msg: Any) -> None:
         self.sock.sendto(msg.pack(self.mav), self.address)
         self.mav.seq = (self.mav.seq + 1) % 256
@@ -89,10 +117,10 @@ class FlightClient:
         """Read what arrived, then send the heartbeat and setpoint that are due."""
         while True:
             try:
-                data, _ = self.sock.recvfrom(65535)
+                data = self.sock.recv(65535)
             except (BlockingIOError, InterruptedError, ConnectionRefusedError):
                 break
-            for msg in self._parser.parse_buffer(data) or []:
+            for msg in self._parser.parse(data):
                 self._observe(msg)
         now = self.clock.now()
         if now >= self._next_heartbeat_s:
@@ -114,8 +142,6 @@ class FlightClient:
         elif kind == "LOCAL_POSITION_NED":
             self.seen.pos_ned_m = (msg.x, msg.y, msg.z)
             self.seen.vehicle_time_s = msg.time_boot_ms / 1000.0
-        elif kind == "GLOBAL_POSITION_INT":
-            self.seen.lat_lon_deg = (msg.lat * 1e-7, msg.lon * 1e-7)
         elif kind == "SYS_STATUS":
             self.seen.sys_status = msg
         elif kind == "HOME_POSITION":

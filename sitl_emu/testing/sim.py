@@ -14,14 +14,15 @@ seconds, sleep(seconds)), so a joyfly FlightSession can fly a Sim vehicle in loc
 Clients that keep their own wall-clock timers (MAVSDK, MAVROS) need `sim.start(speed)`, which runs the vehicles in a
 background thread at `speed` x real time (the runner of `sitl-emu serve --count`); `stop()` returns to lockstep.
 
-Until a client talks, a vehicle sends its telemetry to a private sink socket, so parallel tests never see each
-other's vehicles. Pass `api_remote=("127.0.0.1", 14540)` to send to where PX4 SITL sends instead (port + instance).
+Until a client talks to it, a link has no peer (sitl_emu/mavlink/link.py): nobody could receive its telemetry, so it
+builds and sends none, and parallel tests never see each other's vehicles. The first datagram a link receives makes
+its sender the peer for good, as PX4 latches it, and the link streams from then on. Pass `api_remote=("127.0.0.1",
+14540)` (or `gcs_remote`) to stream from boot to where PX4 SITL sends instead (the API port + instance), as `serve`.
 """
 
 from __future__ import annotations
 
 import os
-import socket
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -78,8 +79,6 @@ class Sim:
                  log_dir: str | os.PathLike[str] | None = None) -> None:
         """`log_dir`: write a ULog per flight there (vehicle i > 0 in `<log_dir>-<i>`) and serve them over
         LOG_REQUEST_*, as `sitl-emu serve --log-dir` (sitl_emu/log/); `self.loggers` are the loggers."""
-        self._sink = _sink_socket(bind_host)
-        sink: Address = self._sink.getsockname()
         self._param_values = dict(params or {})
         self._seed = seed
         self._vehicle_options = dict(vehicle_options or {})
@@ -89,7 +88,7 @@ class Sim:
             estimate_noise = EstimateNoiseSettings.from_mapping(estimate_noise)
         if estimate_noise is not None:  # sitl_emu/disturbance/estimate.py: white noise and bias walk on the estimate
             self._vehicle_options["estimate_noise"] = estimate_noise
-        settings = LinkSettings(bind_host, 0, api_remote or sink, 0, gcs_remote or sink)
+        settings = LinkSettings(bind_host, 0, api_remote, 0, gcs_remote)  # None: no peer until one talks
         handlers_for = None
         if log_dir is not None:
             from sitl_emu.log.serving import handler_classes, instance_log_dir
@@ -97,21 +96,14 @@ class Sim:
             def handlers_for(instance: int) -> Sequence[type]:
                 return handler_classes(instance_log_dir(log_dir, instance))
         self._vehicles: list[Vehicle] = []  # the nodes' vehicles, as built (a reboot keeps the object)
-        try:
-            self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,
-                                                        spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6),
-                                                        handlers_for=handlers_for)
-        except BaseException:
-            self._sink.close()
-            raise
+        self.nodes: list[VehicleNode] = build_nodes(count, settings, self._make_vehicle, home=home,
+                                                    spacing_m=spacing_m, epoch_unix_us=int(time.time() * 1e6),
+                                                    handlers_for=handlers_for)
         self.loggers: list[Any] = []  # sitl_emu.log.flight_log.FlightLogger, one per vehicle, with log_dir
         if log_dir is not None:
             from sitl_emu.log.serving import attach_logger, instance_log_dir
 
             self.loggers = [attach_logger(node, instance_log_dir(log_dir, i)) for i, node in enumerate(self.nodes)]
-        if api_remote is None:  # every instance shares the sink (for_instance offset the port)
-            for node in self.nodes:
-                node.api.link.remote = sink
         self._timeline = Timeline(self.nodes)  # the lockstep tick loop (runtime/timeline.py)
         self._watch = SocketWatch(self.nodes)
         self._time_us = 0
@@ -203,21 +195,12 @@ class Sim:
         self._watch.close()
         for node in self.nodes:
             node.close()
-        self._sink.close()
 
     def __enter__(self) -> Sim:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _sink_socket(bind_host: str) -> socket.socket:
-    """A bound socket nobody reads, with a small buffer: telemetry sent before a client talks ends here."""
-    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    sock.bind((bind_host if bind_host not in ("0.0.0.0", "") else "127.0.0.1", 0))
-    return sock
 
 
 def _reachable(address: Address) -> Address:

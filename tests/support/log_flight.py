@@ -21,6 +21,7 @@ class RecordingClient(FlightClient):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
+        self.watch_all()
         self.received: dict[str, list[Any]] = defaultdict(list)
         self._next_gcs_heartbeat_s = -math.inf
 

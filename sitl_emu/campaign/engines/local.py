@@ -21,7 +21,7 @@ from typing import Any
 
 from sitl_emu.campaign.cases import Case
 from sitl_emu.campaign.errors import CampaignError
-from sitl_emu.campaign.scenario import Limits, Row, failure_row, load_scenario, run_case
+from sitl_emu.campaign.scenario import Limits, Row, failure_row, prepare_worker, run_case
 
 __all__ = ["LocalEngine"]
 
@@ -30,13 +30,11 @@ READY = "ready"
 
 
 def _serve(conn: Connection, ref: str) -> None:
-    """A worker's loop: "ready" once its imports are done (they do not count in a case's wall time), then
-    (ref, case, limits) in, the row out; None ends it. Ctrl-C is the parent's to handle."""
+    """A worker's loop: "ready" once its imports and start-up are done (scenario.prepare_worker: they do not count
+    in a case's wall time), then (ref, case, limits) in, the row out; None ends it. Ctrl-C is the parent's to
+    handle."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import sitl_emu.testing  # noqa: F401  (the Sim and its MAVLink side)
-
-    with contextlib.suppress(CampaignError):  # a scenario that cannot load is each case's error row
-        load_scenario(ref)
+    prepare_worker(ref)
     conn.send(READY)
     while True:
         try:

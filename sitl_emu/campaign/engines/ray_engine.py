@@ -13,7 +13,6 @@ did not connect (not investigated further).
 
 from __future__ import annotations
 
-import contextlib
 import socket
 import time
 from collections.abc import Iterator, Sequence
@@ -21,7 +20,7 @@ from typing import Any
 
 from sitl_emu.campaign.cases import Case
 from sitl_emu.campaign.errors import CampaignError
-from sitl_emu.campaign.scenario import Limits, Row, failure_row, load_scenario, one_line, run_case
+from sitl_emu.campaign.scenario import Limits, Row, failure_row, one_line, prepare_worker, run_case
 
 __all__ = ["RayEngine"]
 
@@ -107,12 +106,9 @@ def _probe(address: str) -> None:
 
 
 def _preload(ref: str) -> None:
-    """Import the Sim and the scenario in a Ray worker before the first case's wall time starts; the short sleep
+    """A Ray worker's start-up (scenario.prepare_worker) before the first case's wall time starts; the short sleep
     keeps the worker busy so that the next of these lands on another worker."""
-    import sitl_emu.testing  # noqa: F401
-
-    with contextlib.suppress(CampaignError):
-        load_scenario(ref)
+    prepare_worker(ref)
     time.sleep(PRELOAD_HOLD_S)
 
 

@@ -121,3 +121,23 @@ def test_messages_not_only_for_us_are_forwarded_to_the_other_link_unchanged(h):
     acks = qgc.of_type("COMMAND_ACK", source=(255, 190))  # forwarded ones, not the vehicle's own
     assert [(a.target_system, a.target_component) for a in acks] == [(255, 190)]
     assert (h.node.gcs.stats.tx_forwarded, h.node.api.stats.tx_forwarded) == (2, 1)  # +MAVROS heartbeat
+
+
+def test_a_link_without_remote_sends_nothing_until_a_peer_talks_then_answers_it():
+    link = UdpLink("127.0.0.1", 0, None, "GCS")
+    peer = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    peer.bind(("127.0.0.1", 0))
+    peer.settimeout(2.0)
+    try:
+        assert not link.has_peer
+        link.send(b"dropped")
+        assert link.stats.tx_datagrams == link.stats.tx_errors == 0
+        peer.sendto(b"hello", link.local_address)
+        while not link.receive():
+            pass
+        assert link.has_peer and link.remote == peer.getsockname()
+        link.send(b"answer")
+        assert peer.recvfrom(100)[0] == b"answer"
+    finally:
+        link.close()
+        peer.close()

@@ -26,6 +26,7 @@ class Client(FlightClient):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
+        self.watch("ORBIT_EXECUTION_STATUS")
         self.orbit: list[Any] = []
         self.custom_modes: list[int] = []
         self._gcs_heartbeat_s = -math.inf

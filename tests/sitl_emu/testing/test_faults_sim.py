@@ -25,7 +25,8 @@ class GcsClient(FlightClient):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
-        self.last: dict[str, Any] = {}  # the last message of each type
+        self.watch("GPS_RAW_INT", "BATTERY_STATUS")
+        self.last: dict[str, Any] = {}  # the last message of each type decoded
 
     def _observe(self, msg: Any) -> None:
         self.last[msg.get_type()] = msg
