@@ -25,7 +25,17 @@ from sitl_emu.runtime.timeline import Timeline
 
 log = logging.getLogger(__name__)
 
-MAX_LAG_US = 500_000  # if the host stalls longer than this, drop the lost time instead of fast-forwarding through it
+# If the host stalls longer than this, drop the lost time instead of fast-forwarding through it: 0.5 s of simulated
+# time, or of wall time above --speed 1. In simulated time alone the limit was 5 ms of wall time at --speed 100, and a
+# scheduler hiccup that short made serve drop time for good (measured: the loopback flight's vehicle ran at x47 of
+# x100 on a busy 2-core machine, although the server needs under a core at x100).
+MAX_LAG_US = 500_000
+
+
+def lag_limit_us(speed: float) -> int:
+    """The simulated time a runner at `speed` may fall behind before it drops the rest (MAX_LAG_US)."""
+    return round(MAX_LAG_US * max(1.0, speed))
+
 FINE_TIMEOUT_S = 0.002  # below this a wait uses select() (µs resolution), not epoll's or poll's whole ms
 # the selectors whose timeout is counted in whole milliseconds (kqueue's and select()'s are not)
 _MS_TIMEOUT_SELECTORS = tuple(getattr(selectors, name) for name in ("EpollSelector", "DevpollSelector", "PollSelector")
@@ -135,14 +145,15 @@ class RealTimeRunner:
         end_us = None if duration_s is None else anchor_us + round(duration_s * 1e6)
         ready: dict[int, int] | None = None  # None: not known, look before the first tick
         stop = self._stop
+        max_lag_us = lag_limit_us(self.speed)
         while not stop.is_set():
             woke = time.monotonic()
             target_us = anchor_us + int((woke - start_wall) * 1e6 * self.speed)
             if end_us is not None and end_us < target_us:
                 target_us = end_us
             lag_us = target_us - timeline.time_us
-            if lag_us > MAX_LAG_US:  # the host cannot keep up: drop the lost time rather than race through it
-                skipped = lag_us - MAX_LAG_US
+            if lag_us > max_lag_us:  # the host cannot keep up: drop the lost time rather than race through it
+                skipped = lag_us - max_lag_us
                 self._warn_lag(lag_us)
                 anchor_us -= skipped
                 target_us -= skipped

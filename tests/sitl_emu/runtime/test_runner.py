@@ -196,3 +196,23 @@ def test_after_a_host_stall_the_runner_drops_the_lost_time_and_keeps_real_time_a
         assert (us1 - us0) / 1e6 <= 1.5 * (t1 - t0) + 0.02  # paced by the wall clock again, not racing ahead
     finally:
         h.close()
+
+
+class _HiccupVehicle(_StallingVehicle):
+    """A scheduler hiccup of 30 ms wall time: at --speed 100, three simulated seconds."""
+
+    stall_at_us: int = 400_000
+    stall_s: float = 0.03
+
+
+def test_at_high_speed_a_short_hiccup_is_caught_up_not_dropped():
+    # The lag limit was 0.5 s of simulated time, 5 ms of wall time at x100: any hiccup longer than that lost simulated
+    # time for good, and serve's vehicle ran slower than asked (the loopback flight at --speed 100).
+    h = Harness(_HiccupVehicle())
+    try:
+        runner = RealTimeRunner([h.node], speed=100.0)
+        runner.run(duration_s=6.0)
+        assert runner.dropped_us == 0
+        assert h.vehicle.time_us >= 6_000_000
+    finally:
+        h.close()
