@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from sitl_emu.mavlink.telemetry.streams import BUILDERS
+from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.px4 import MavCmd
 from sitl_emu.runtime.node import LinkSettings, VehicleNode
 from sitl_emu.runtime.runner import RealTimeRunner
@@ -26,12 +27,14 @@ from sitl_emu.vehicle.vehicle import Vehicle
 class StubVehicle:
     """What a node needs of a Vehicle: time moves by dt_us per step; snapshot, params and events never change."""
 
-    def __init__(self, snapshot: VehicleSnapshot, params: Any, sysid: int = 1, dt_us: int = 4000) -> None:
+    def __init__(self, snapshot: VehicleSnapshot, params: Any, store: MissionStore, sysid: int = 1,
+                 dt_us: int = 4000) -> None:
         self.time_us = 0
         self.dt_us = dt_us
         self.sysid = sysid
         self.params = params
         self._snapshot = snapshot
+        self._store = store
 
     def step(self) -> None:
         self.time_us += self.dt_us
@@ -42,27 +45,30 @@ class StubVehicle:
     def events_after(self, seq: int) -> list[VehicleEvent]:
         return []
 
+    def mission_store(self) -> MissionStore:
+        return self._store
 
-def hover_snapshot() -> tuple[VehicleSnapshot, Any]:
-    """A real vehicle's snapshot 8 s after NAV_TAKEOFF (hovering in Hold), and its parameters."""
+
+def hover_snapshot() -> tuple[VehicleSnapshot, Any, MissionStore]:
+    """A real vehicle's snapshot 8 s after NAV_TAKEOFF (hovering in Hold), its parameters and its mission store."""
     v = Vehicle()
     v.run_until(2_100_000)
     nan = math.nan
     v.handle_command(VehicleCommand(MavCmd.COMPONENT_ARM_DISARM, (1.0,) + (nan,) * 6))
     v.handle_command(VehicleCommand(MavCmd.NAV_TAKEOFF, (nan,) * 7))
     v.run_until(10_100_000)
-    return v.snapshot(), v.params
+    return v.snapshot(), v.params, v.mission_store()
 
 
 def stub_nodes(count: int, streams: bool = True) -> tuple[list[VehicleNode], socket.socket]:
     """`count` stub nodes on free loopback ports sending to one sink socket; `streams=False` stops every stream
     but HEARTBEAT (SET_MESSAGE_INTERVAL -1), leaving the bare runner and node."""
-    snapshot, params = hover_snapshot()
+    snapshot, params, store = hover_snapshot()
     sink = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sink.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
     sink.bind(("127.0.0.1", 0))
     settings = LinkSettings("127.0.0.1", 0, sink.getsockname(), 0, sink.getsockname())
-    nodes = [VehicleNode(StubVehicle(snapshot, params, i + 1), settings) for i in range(count)]
+    nodes = [VehicleNode(StubVehicle(snapshot, params, store, i + 1), settings) for i in range(count)]
     if not streams:
         for node in nodes:
             for ep in node.endpoints:
