@@ -14,6 +14,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+from sitl_emu.events.catalogue import Px4Event
 from sitl_emu.mavlink.telemetry.streams import BUILDERS
 from sitl_emu.navigator.mission_store import MissionStore
 from sitl_emu.px4 import MavCmd
@@ -43,6 +44,9 @@ class StubVehicle:
         return self._snapshot
 
     def events_after(self, seq: int) -> list[VehicleEvent]:
+        return []
+
+    def px4_events_after(self, seq: int) -> list[tuple[int, Px4Event]]:
         return []
 
     def mission_store(self) -> MissionStore:

@@ -20,6 +20,7 @@ both, for notifyUser's event (events/failsafe_notices.py).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.commander.arming import CheckInputs, Req, can_run
 from sitl_emu.commander.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
@@ -117,9 +118,9 @@ _RANK: dict[NavState, int] = {
     NavState.POSCTL: 2, NavState.ALTCTL: 3, NavState.STAB: 4, NavState.AUTO_LOITER: 5, NavState.AUTO_RTL: 6,
     NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
 }
-_DISARM_RANK = 9
+_DISARM_RANK: Final = 9
 _HOLD_RANK = _RANK[NavState.AUTO_LOITER]
-FAILSAFE_TEXT = "Failsafe activated"
+FAILSAFE_TEXT: Final = "Failsafe activated"
 
 # an action in force: (rank, mode, disarm, cause); rank 0: none, the user's mode. The rank is framework.h's Action.
 _Action = tuple[int, NavState, bool, int]

@@ -30,7 +30,7 @@ import os
 from collections.abc import Callable, Hashable
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Final
 
 from sitl_emu.log import ulog_writer as ulog
 from sitl_emu.log.info import parameter_messages, version_infos
@@ -40,9 +40,9 @@ from sitl_emu.px4 import Severity
 
 log = logging.getLogger(__name__)
 
-SYNC_INTERVAL_US = 500_000  # logger.cpp: "Add sync magic" every 500 ms
+SYNC_INTERVAL_US: Final = 500_000  # logger.cpp: "Add sync magic" every 500 ms
 WHILE_ARMED, BOOT_UNTIL_DISARM, BOOT_UNTIL_SHUTDOWN, FIRST_ARM_UNTIL_SHUTDOWN = 0, 1, 2, 4  # SDLOG_MODE
-BUFFER_BYTES = 64 * 1024
+BUFFER_BYTES: Final = 64 * 1024
 Opener = Callable[[Path], IO[bytes]]
 
 

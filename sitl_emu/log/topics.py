@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Final
 
 from sitl_emu.control.qmath import yaw_from_q
 from sitl_emu.geo import ned_to_global
@@ -37,14 +37,14 @@ from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
 
 NAN = math.nan
 NAN3 = (NAN, NAN, NAN)
-ARMING_STATE_DISARMED = 1  # msg/VehicleStatus.msg
-ARMING_STATE_ARMED = 2
-VEHICLE_TYPE_ROTARY_WING = 1
-MAV_TYPE_QUADROTOR = 2
-BATTERY_CELLS = 4  # BAT1_N_CELLS in PX4 SITL
-SOURCE_MAVLINK_0 = 2  # manual_control_setpoint.data_source of a MAVLink joystick on mavlink instance 0
-ACTUATOR_CONTROLS = 12  # actuator_motors.control
-PWM_OUTPUTS = 16
+ARMING_STATE_DISARMED: Final = 1  # msg/VehicleStatus.msg
+ARMING_STATE_ARMED: Final = 2
+VEHICLE_TYPE_ROTARY_WING: Final = 1
+MAV_TYPE_QUADROTOR: Final = 2
+BATTERY_CELLS: Final = 4  # BAT1_N_CELLS in PX4 SITL
+SOURCE_MAVLINK_0: Final = 2  # manual_control_setpoint.data_source of a MAVLink joystick on mavlink instance 0
+ACTUATOR_CONTROLS: Final = 12  # actuator_motors.control
+PWM_OUTPUTS: Final = 16
 
 Values = dict[str, Any]
 Row = tuple[Any, ...]  # a topic's values, in the order of its field names, arrays spread into their elements
@@ -333,7 +333,7 @@ SPECS = {
                              "bool body_rate;bool thrust_and_torque;bool direct_actuator;uint8_t[1] _padding0",
 }
 
-MS = 1000
+MS: Final = 1000
 # name: (least interval in µs, values, state written on change or None) -- logged_topics.cpp's intervals
 _TABLE: dict[str, tuple[int, Fields, Callable[[Inputs], Hashable] | None]] = {
     "vehicle_attitude": (0, _attitude, None),

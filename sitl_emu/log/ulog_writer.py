@@ -22,15 +22,15 @@ import operator
 import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Final
 
-HEADER_MAGIC = b"ULog\x01\x12\x35"
-FILE_VERSION = 1
+HEADER_MAGIC: Final = b"ULog\x01\x12\x35"
+FILE_VERSION: Final = 1
 SYNC_MAGIC = bytes((0x2F, 0x73, 0x13, 0x20, 0x25, 0x0C, 0xBB, 0x12))
-COMPAT_DEFAULT_PARAMETERS = 1  # ULOG_COMPAT_FLAG0_DEFAULT_PARAMETERS_MASK
-DEFAULT_SYSTEM = 1  # ulog_parameter_default_type_t::system
-DEFAULT_CURRENT_SETUP = 2  # ulog_parameter_default_type_t::current_setup
-MAX_TEXT = 127  # ulog_message_logging_s.message is 128 chars, NUL included
+COMPAT_DEFAULT_PARAMETERS: Final = 1  # ULOG_COMPAT_FLAG0_DEFAULT_PARAMETERS_MASK
+DEFAULT_SYSTEM: Final = 1  # ulog_parameter_default_type_t::system
+DEFAULT_CURRENT_SETUP: Final = 2  # ulog_parameter_default_type_t::current_setup
+MAX_TEXT: Final = 127  # ulog_message_logging_s.message is 128 chars, NUL included
 
 # C type -> struct code (ULog's basic types)
 STRUCT_CODES = {

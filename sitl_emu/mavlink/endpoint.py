@@ -12,7 +12,7 @@ import logging
 import struct
 from collections import deque
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Final, Protocol
 
 from pymavlink.dialects.v20 import development as dialect
 
@@ -35,8 +35,8 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-COMPID = 1  # MAV_COMP_ID default (mavlink_params.yaml)
-MAVLINK_LOG_QUEUE = 8  # msg/MavlinkLog.msg ORB_QUEUE_LENGTH
+COMPID: Final = 1  # MAV_COMP_ID default (mavlink_params.yaml)
+MAVLINK_LOG_QUEUE: Final = 8  # msg/MavlinkLog.msg ORB_QUEUE_LENGTH
 
 # Protocol handlers by other modules, one instance per link (sitl_emu/mavlink/context.py). Missing modules are skipped.
 HANDLER_CLASSES: tuple[tuple[str, str], ...] = (

@@ -17,14 +17,15 @@ import errno
 import logging
 import socket
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.mavlink.link_errors import PortInUseError
 
 log = logging.getLogger(__name__)
 
 Address = tuple[str, int]
-_MAX_DATAGRAM = 65535
-_RCVBUF_BYTES = 1 << 20
+_MAX_DATAGRAM: Final = 65535
+_RCVBUF_BYTES: Final = 1 << 20
 
 
 @dataclass(slots=True)

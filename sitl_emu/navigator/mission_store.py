@@ -19,11 +19,12 @@ from __future__ import annotations
 import struct
 import zlib
 from dataclasses import dataclass, field
+from typing import Final
 
-PLAN_MISSION = 0
-PLAN_FENCE = 1
-PLAN_RALLY = 2
-PLAN_ALL = 255  # MAV_MISSION_TYPE_ALL: MISSION_CLEAR_ALL of every plan
+PLAN_MISSION: Final = 0
+PLAN_FENCE: Final = 1
+PLAN_RALLY: Final = 2
+PLAN_ALL: Final = 255  # MAV_MISSION_TYPE_ALL: MISSION_CLEAR_ALL of every plan
 PLAN_TYPES = (PLAN_MISSION, PLAN_FENCE, PLAN_RALLY)
 
 # How many items each plan holds (MavlinkMissionManager::MAX_COUNT from dataman.h: the mission's
@@ -32,11 +33,11 @@ PLAN_TYPES = (PLAN_MISSION, PLAN_FENCE, PLAN_RALLY)
 MAX_ITEMS = {PLAN_MISSION: 10_000, PLAN_FENCE: 64, PLAN_RALLY: 32}
 
 # MISSION_STATE (common.xml), what MISSION_CURRENT reports for the stored mission
-MISSION_STATE_NO_MISSION = 1
-MISSION_STATE_NOT_STARTED = 2
-MISSION_STATE_ACTIVE = 3
-MISSION_STATE_PAUSED = 4
-MISSION_STATE_COMPLETE = 5
+MISSION_STATE_NO_MISSION: Final = 1
+MISSION_STATE_NOT_STARTED: Final = 2
+MISSION_STATE_ACTIVE: Final = 3
+MISSION_STATE_PAUSED: Final = 4
+MISSION_STATE_COMPLETE: Final = 5
 
 
 @dataclass(frozen=True, slots=True)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Final, Protocol
 
 from sitl_emu.mavlink.context import LinkVehicle
 from sitl_emu.mavlink.endpoint import Endpoint, load_handler_classes
@@ -27,10 +27,10 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-IO_BUDGET_DATAGRAMS = 200  # per link per step_io: a flood waits in the socket buffer instead of starving physics
+IO_BUDGET_DATAGRAMS: Final = 200  # per link per step_io: a flood waits in the socket buffer instead of starving physics
 # `readable` bits of step_io: which links have datagrams waiting (runners learn it from one SocketWatch look per tick)
-READ_API = 1
-READ_GCS = 2
+READ_API: Final = 1
+READ_GCS: Final = 2
 READ_BOTH = READ_API | READ_GCS
 
 

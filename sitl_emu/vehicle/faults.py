@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 
@@ -45,7 +46,7 @@ from sitl_emu.types import CommandAck, Vec3, VehicleCommand
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
 # The estimator noise draws from the seed's own stream, np.random.default_rng(seed); the wind from a second one
-WIND_STREAM = 1  # np.random.default_rng([seed, WIND_STREAM])
+WIND_STREAM: Final = 1  # np.random.default_rng([seed, WIND_STREAM])
 
 
 @dataclass(frozen=True, slots=True)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Final
 
 from sitl_emu import px4
 from sitl_emu.mavlink.telemetry.modes import STANDARD_MODE
@@ -19,11 +19,11 @@ if TYPE_CHECKING:
     from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
 NAN = math.nan
-UINT16_MAX = 0xFFFF
-INT16_MAX = 0x7FFF
+UINT16_MAX: Final = 0xFFFF
+INT16_MAX: Final = 0x7FFF
 
-MAV_TYPE_QUADROTOR = 2
-MAV_AUTOPILOT_PX4 = 12
+MAV_TYPE_QUADROTOR: Final = 2
+MAV_AUTOPILOT_PX4: Final = 12
 
 # Modes whose control mode has flag_control_manual_enabled and attitude (ModeUtil/control_mode.cpp).
 _MANUAL_STABILIZED = frozenset({NavState.MANUAL, NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,

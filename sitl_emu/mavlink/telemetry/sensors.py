@@ -10,7 +10,7 @@ sensors as each builder says; their values are noise-free (the vibration metrics
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Final
 
 from sitl_emu.mavlink.telemetry.messages import rotate_ned_to_body
 from sitl_emu.types import Vec3, VehicleSnapshot
@@ -18,11 +18,11 @@ from sitl_emu.types import Vec3, VehicleSnapshot
 if TYPE_CHECKING:
     from sitl_emu.mavlink.context import EndpointContext, OutMessage
 
-GRAVITY_M_S2 = 9.80665
+GRAVITY_M_S2: Final = 9.80665
 # Earth magnetic field near the SIH default home (Zurich), gauss, NED: ~0.48 G, inclination ~63.5°, declination ~2.5°
 MAG_NED_GAUSS = (0.214, 0.009, 0.430)
-TEMPERATURE_C = 20.0
-HIGHRES_FIELDS_ALL = 0x1FFF  # acc, gyro, mag, abs/diff pressure, pressure altitude, temperature
+TEMPERATURE_C: Final = 20.0
+HIGHRES_FIELDS_ALL: Final = 0x1FFF  # acc, gyro, mag, abs/diff pressure, pressure altitude, temperature
 
 
 def isa_pressure_hpa(alt_amsl_m: float) -> float:
@@ -54,9 +54,9 @@ def scaled_pressure(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage |
 
 # --- range finder (SIH send_dist_snsr, streams/DISTANCE_SENSOR.hpp) ---------------------------------------------------
 DIST_MIN_M, DIST_MAX_M = 0.0, 100.0  # SIH_DISTSNSR_MIN / SIH_DISTSNSR_MAX
-DIST_OUT_OF_RANGE_M = 655.35  # beyond its maximum SIH reports UINT16_MAX / 100, as a LightWare LW20 does
-MAV_DISTANCE_SENSOR_LASER = 0
-MAV_SENSOR_ROTATION_PITCH_270 = 25  # facing down
+DIST_OUT_OF_RANGE_M: Final = 655.35  # beyond its maximum SIH reports UINT16_MAX / 100, as a LightWare LW20 does
+MAV_DISTANCE_SENSOR_LASER: Final = 0
+MAV_SENSOR_ROTATION_PITCH_270: Final = 25  # facing down
 
 
 def range_m(snap: VehicleSnapshot) -> float:
@@ -78,7 +78,7 @@ def distance_sensor(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 
 
 # --- vibration (VehicleIMU vibration metrics of SIH's noisy IMU, streams/VIBRATION.hpp) -------------------------------
-IMU_DT_S = 0.004  # one 250 Hz sample per integration
+IMU_DT_S: Final = 0.004  # one 250 Hz sample per integration
 # SIH's IMU noise (sih.cpp reconstruct_sensors_signals), std per axis: higher once the motors produce thrust
 ACCEL_NOISE = ((0.1, 0.1, 0.1), (0.5, 1.7, 1.4))  # m/s^2: (motors off, motors on)
 GYRO_NOISE = ((0.01, 0.01, 0.01), (0.14, 0.07, 0.03))  # rad/s
@@ -108,7 +108,7 @@ def vibration(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 
 
 # --- GNSS (sensor_gps_sim: SIH's GPS) ---------------------------------------------------------------------------------
-GPS_DEVICE_ID = 0xAF0004  # DRV_GPS_DEVTYPE_SIM on the simulation bus (device_id: devtype << 16 | bus type 4)
+GPS_DEVICE_ID: Final = 0xAF0004  # DRV_GPS_DEVTYPE_SIM on the simulation bus (device_id: devtype << 16 | bus type 4)
 GPS_EPH_M, GPS_EPV_M, GPS_SPEED_VARIANCE_M_S = 0.5, 0.8, 0.2  # what GPS_RAW_INT reports (messages.gps_raw_int)
 
 
@@ -122,9 +122,9 @@ def gnss_integrity(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 # MAV_ODID_* (common.xml)
 ODID_STATUS_GROUND, ODID_STATUS_AIRBORNE, ODID_STATUS_EMERGENCY = 1, 2, 3
 ODID_HOR_ACC_1_METER, ODID_VER_ACC_1_METER, ODID_SPEED_ACC_0_3 = 12, 6, 4
-ODID_TIME_ACC_1_0_SECOND = 10
+ODID_TIME_ACC_1_0_SECOND: Final = 10
 _ODID_ID_OR_MAC = [0] * 20
-ODID_EPOCH_2019_S = 1_546_300_800  # OPEN_DRONE_ID_SYSTEM timestamps count from 2019-01-01
+ODID_EPOCH_2019_S: Final = 1_546_300_800  # OPEN_DRONE_ID_SYSTEM timestamps count from 2019-01-01
 
 
 def _utc_us(ctx: EndpointContext, snap: VehicleSnapshot) -> int:

@@ -15,7 +15,7 @@ import enum
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Final
 
 from sitl_emu.mavlink.telemetry import actuators as ta
 from sitl_emu.mavlink.telemetry import ground_truth as tg
@@ -30,10 +30,10 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-HEARTBEAT_ID = 0
-HEARTBEAT_INTERVAL_US = 1_000_000
-STATUSTEXT_MAX_AGE_US = 5_000_000  # STATUSTEXT.hpp: don't send stale messages
-STATUSTEXT_CHUNK = 50
+HEARTBEAT_ID: Final = 0
+HEARTBEAT_INTERVAL_US: Final = 1_000_000
+STATUSTEXT_MAX_AGE_US: Final = 5_000_000  # STATUSTEXT.hpp: don't send stale messages
+STATUSTEXT_CHUNK: Final = 50
 
 
 class StreamMode(enum.Enum):
@@ -110,14 +110,14 @@ PER_LINK: frozenset[int] = frozenset({8, 42, 115})
 SOURCE_PERIOD_US: dict[int, int] = {380: 2_000_000}
 
 
-MAX_INTERVAL_US = 1e12  # set_interval: from here on, PX4's rate is 1e-6 Hz or less, which stops the stream
+MAX_INTERVAL_US: Final = 1e12  # set_interval: from here on, PX4's rate is 1e-6 Hz or less, which stops the stream
 
 
 def _interval_us(hz: float) -> int:
     return round(1e6 / hz)
 
 
-UNSET = -1  # _Stream.next_us: due at the next pass (a new, re-configured or restarted stream)
+UNSET: Final = -1  # _Stream.next_us: due at the next pass (a new, re-configured or restarted stream)
 
 
 @dataclass(slots=True)
@@ -237,11 +237,12 @@ class Streams:
             return 0
         snap = get_snapshot()
         shared = self.shared
+        streams, per_link = STREAMS, PER_LINK  # module globals: one look-up per pass, not one per message
         sent = 0
         for msg_id in due:
-            builder = tm.heartbeat if msg_id == HEARTBEAT_ID else STREAMS[msg_id]
+            builder = tm.heartbeat if msg_id == HEARTBEAT_ID else streams[msg_id]
             try:
-                if shared is None or msg_id in PER_LINK:
+                if shared is None or msg_id in per_link:
                     msg = builder(ctx, snap)
                 else:
                     msg = shared.build(msg_id, builder, ctx, snap)
@@ -273,7 +274,8 @@ class Streams:
             if due_us <= now:
                 due_us = stream.next_us = _next_due(due_us, stream.interval_us, now)
                 due_ids.append(stream.msg_id)
-            earliest = min(earliest, due_us)
+            if due_us < earliest:
+                earliest = due_us
         self.next_due_us = earliest
         return due_ids
 

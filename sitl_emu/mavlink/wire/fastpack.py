@@ -28,7 +28,7 @@ import contextlib
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Final
 
 from pymavlink.dialects.v20 import development as dialect
 
@@ -41,7 +41,7 @@ try:  # pymavlink's own CRC dependency (a C extension); the stdlib fallback belo
 except ImportError:  # pragma: no cover - depends on the installed pymavlink
     _mcrf4xx = None
 
-MAGIC_V2 = b"\xfd"
+MAGIC_V2: Final = b"\xfd"
 _HEADER = struct.Struct("<BBBBBBHB")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit), after the magic
 _CRC = struct.Struct("<H")
 _BITREV = bytes(int(f"{i:08b}"[::-1], 2) for i in range(256))
