@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 
+from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
-from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
+from sitl_emu.types import CommandAck, OffboardControlMode, TrajectorySetpoint, VehicleCommand
 from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
@@ -41,3 +42,22 @@ def scripted_flight(v: Vehicle) -> list[tuple]:
     run(10.0)
     out.extend((e.seq, e.time_us, e.text) for e in v.events_after(0))
     return out
+
+
+def command(v: Vehicle, cmd: int, *params: float, external: bool = True) -> CommandAck | None:
+    """The vehicle's answer to a command with these params (NaN for the rest), as a ground station sends it."""
+    return v.handle_command(VehicleCommand(cmd, tuple(params) + (NAN,) * (7 - len(params)), from_external=external))
+
+
+def hovering_vehicle(**params: float) -> Vehicle:
+    """A vehicle with these parameters, armed and taken off, holding in AUTO.LOITER after the take-off."""
+    reg = default_registry()
+    for name, value in params.items():
+        reg.set(name, value)
+    v = Vehicle(params=reg)
+    v.run_for(2.5)
+    command(v, MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0)
+    command(v, MavCmd.NAV_TAKEOFF)
+    v.run_for(8.0)
+    assert v.snapshot().nav_state is NavState.AUTO_LOITER and not v.commander.landed
+    return v

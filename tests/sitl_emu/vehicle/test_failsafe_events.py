@@ -9,35 +9,18 @@ import math
 
 import pytest
 from support.events_client import EventsDecoder
+from support.flights import command, hovering_vehicle
 
 from sitl_emu.events import failsafe_notices
 from sitl_emu.events.metadata import events_metadata
-from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, NavState, custom_mode, decode_custom_mode
-from sitl_emu.types import OffboardControlMode, TrajectorySetpoint, VehicleCommand
+from sitl_emu.types import OffboardControlMode, TrajectorySetpoint
 from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 RTL_ACTION, GCS_CONNECTION_LOSS, CRITICAL_BATTERY = 6, 2, 4
 DECODER = EventsDecoder(events_metadata())
 NOTICES = {d.name for d in failsafe_notices.DEFINITIONS}
-
-
-def _cmd(v: Vehicle, command: int, *params: float) -> None:
-    v.handle_command(VehicleCommand(command, tuple(params) + (NAN,) * (7 - len(params)), from_external=True))
-
-
-def _flying(**params: float) -> Vehicle:
-    reg = default_registry()
-    for name, value in params.items():
-        reg.set(name, value)
-    v = Vehicle(params=reg)
-    v.run_for(2.5)
-    _cmd(v, MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0)
-    _cmd(v, MavCmd.NAV_TAKEOFF)
-    v.run_for(8.0)
-    assert v.snapshot().nav_state is NavState.AUTO_LOITER
-    return v
 
 
 def _notices(v: Vehicle, after: int) -> list[tuple[float, str, str, bytes]]:
@@ -60,7 +43,7 @@ def _px4_seq(v: Vehicle) -> int:
 
 
 def test_data_link_loss_tells_its_cause_and_the_return_the_hold_delays():
-    v = _flying(NAV_DLL_ACT=2)
+    v = hovering_vehicle(NAV_DLL_ACT=2)
     for _ in range(20):
         v.gcs_heartbeat()
         v.run_for(0.1)
@@ -85,7 +68,7 @@ def test_data_link_loss_tells_its_cause_and_the_return_the_hold_delays():
 
 
 def test_a_critical_battery_names_its_level():
-    v = _flying(SIM_BAT_DRAIN=60.0, SIM_BAT_MIN_PCT=6.0)  # critical (7 %) -> COM_LOW_BAT_ACT 3: Return
+    v = hovering_vehicle(SIM_BAT_DRAIN=60.0, SIM_BAT_MIN_PCT=6.0)  # critical (7 %) -> COM_LOW_BAT_ACT 3: Return
     seq = _px4_seq(v)
     v.run_for(60.0)
     notices = _notices(v, seq)
@@ -97,10 +80,10 @@ def test_a_critical_battery_names_its_level():
 
 
 def test_offboard_loss_is_a_generic_fallback_without_a_hold():
-    v = _flying()
+    v = hovering_vehicle()
     mode, sp = OffboardControlMode(position=True), TrajectorySetpoint(position_ned_m=(0.0, 0.0, -2.5))
     v.offboard_input(mode, sp)
-    _cmd(v, MavCmd.DO_SET_MODE, 1.0, *decode_custom_mode(custom_mode(NavState.OFFBOARD)))
+    command(v, MavCmd.DO_SET_MODE, 1.0, *decode_custom_mode(custom_mode(NavState.OFFBOARD)))
     v.offboard_input(mode, sp)
     seq = _px4_seq(v)
     v.run_for(3.0)  # the setpoints stopped: COM_OBL_RC_ACT Position cannot run without sticks -> NAV_RCL_ACT Return

@@ -7,34 +7,17 @@ from __future__ import annotations
 import math
 
 import pytest
+from support.flights import command, hovering_vehicle
 
 from sitl_emu.console.shell import Shell
 from sitl_emu.params import default_registry
 from sitl_emu.px4 import MavCmd, MavResult, NavState, Severity
-from sitl_emu.types import CommandAck, VehicleCommand
+from sitl_emu.types import CommandAck
 from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 GPS, BATTERY, MOTOR, RC_SIGNAL = 4.0, 100.0, 101.0, 104.0
 OFF, OK = 1.0, 0.0
-
-
-def _cmd(v: Vehicle, command: int, *params: float, external: bool = True) -> CommandAck | None:
-    return v.handle_command(VehicleCommand(command, tuple(params) + (NAN,) * (7 - len(params)),
-                                           from_external=external))
-
-
-def _flying(**params: float) -> Vehicle:
-    reg = default_registry()
-    for name, value in params.items():
-        reg.set(name, value)
-    v = Vehicle(params=reg)
-    v.run_for(2.5)
-    _cmd(v, MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0)
-    _cmd(v, MavCmd.NAV_TAKEOFF)
-    v.run_for(8.0)
-    assert v.snapshot().nav_state is NavState.AUTO_LOITER and not v.commander.landed
-    return v
 
 
 def _modes(v: Vehicle, seconds: float, *, heartbeat: bool = False) -> list[tuple[float, NavState, bool]]:
@@ -60,7 +43,7 @@ def test_inject_failure_is_denied_without_sys_failure_en_and_tells_nothing():
     v = Vehicle(params=reg)
     v.run_for(1.0)
     seq = v.last_event_seq
-    assert _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.DENIED)
+    assert command(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.DENIED)
     assert v.events_after(seq) == []
     assert v.faults.failures.entries == {}
 
@@ -70,23 +53,23 @@ def test_set_at_runtime_without_reboot_the_manager_is_not_running_so_no_ack():
     reg.set("SYS_FAILURE_EN", 0)
     v = Vehicle(params=reg)
     reg.set("SYS_FAILURE_EN", 1)
-    assert _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) is None
+    assert command(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) is None
     v.reboot()
-    assert _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.ACCEPTED)
+    assert command(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.ACCEPTED)
 
 
 def test_unsupported_units_and_types_as_px4_main():
     v = Vehicle()
-    assert _cmd(v, MavCmd.INJECT_FAILURE, RC_SIGNAL, OFF, 0.0).result == MavResult.UNSUPPORTED  # type: ignore[union-attr]
-    assert _cmd(v, MavCmd.INJECT_FAILURE, MOTOR, 2.0, 1.0).result == MavResult.UNSUPPORTED  # type: ignore[union-attr]
+    assert command(v, MavCmd.INJECT_FAILURE, RC_SIGNAL, OFF, 0.0).result == MavResult.UNSUPPORTED  # type: ignore[union-attr]
+    assert command(v, MavCmd.INJECT_FAILURE, MOTOR, 2.0, 1.0).result == MavResult.UNSUPPORTED  # type: ignore[union-attr]
     assert _texts(v) == []
 
 
 def test_gps_off_loses_the_position_after_dead_reckoning_and_descends():
-    v = _flying()
+    v = hovering_vehicle()
     seq = v.last_event_seq
     t0 = v.time_us / 1e6
-    assert _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.ACCEPTED)
+    assert command(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0) == CommandAck(MavCmd.INJECT_FAILURE, MavResult.ACCEPTED)
     modes = _modes(v, 15.0)
     assert [(m, a) for _, m, a in modes] == [(NavState.AUTO_LOITER, True), (NavState.DESCEND, True),
                                              (NavState.AUTO_LOITER, False)]
@@ -94,15 +77,15 @@ def test_gps_off_loses_the_position_after_dead_reckoning_and_descends():
     assert _texts(v, seq)[:2] == [(Severity.WARNING, "Injected: gps off, all instances"),
                                   (Severity.CRITICAL, "Failsafe activated")]
     assert not v.snapshot().position_valid
-    assert _cmd(v, MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0).result == MavResult.TEMPORARILY_REJECTED  # type: ignore
-    assert _cmd(v, MavCmd.INJECT_FAILURE, GPS, OK, 0.0).result == MavResult.ACCEPTED  # type: ignore[union-attr]
+    assert command(v, MavCmd.COMPONENT_ARM_DISARM, 1.0, 0.0).result == MavResult.TEMPORARILY_REJECTED  # type: ignore
+    assert command(v, MavCmd.INJECT_FAILURE, GPS, OK, 0.0).result == MavResult.ACCEPTED  # type: ignore[union-attr]
     v.run_for(0.1)
     assert v.snapshot().position_valid and _texts(v)[-1] == (Severity.WARNING, "Cleared: gps, all instances")
 
 
 def test_motor_off_the_vehicle_falls_and_yaws():
-    v = _flying()
-    assert _cmd(v, MavCmd.INJECT_FAILURE, MOTOR, OFF, 1.0).result == MavResult.ACCEPTED  # type: ignore[union-attr]
+    v = hovering_vehicle()
+    assert command(v, MavCmd.INJECT_FAILURE, MOTOR, OFF, 1.0).result == MavResult.ACCEPTED  # type: ignore[union-attr]
     assert _texts(v)[-1] == (Severity.WARNING, "Injected: motor off, instances 1")
     z0 = v.snapshot().pos_ned_m[2]
     v.run_for(0.3)
@@ -113,9 +96,9 @@ def test_motor_off_the_vehicle_falls_and_yaws():
 
 
 def test_motor_off_with_flight_termination_allowed_the_failure_detector_terminates():
-    v = _flying(CBRK_FLIGHTTERM=0)
+    v = hovering_vehicle(CBRK_FLIGHTTERM=0)
     seq = v.last_event_seq
-    _cmd(v, MavCmd.INJECT_FAILURE, MOTOR, OFF, 1.0)
+    command(v, MavCmd.INJECT_FAILURE, MOTOR, OFF, 1.0)
     modes = _modes(v, 2.0)
     assert modes[1][1] is NavState.TERMINATION
     assert (Severity.CRITICAL, "Failsafe activated") in _texts(v, seq)
@@ -123,7 +106,7 @@ def test_motor_off_with_flight_termination_allowed_the_failure_detector_terminat
 
 @pytest.mark.slow
 def test_battery_drain_low_critical_return_as_com_low_bat_act_3():
-    v = _flying(SIM_BAT_DRAIN=60.0, SIM_BAT_MIN_PCT=6.0)  # stops at 6 %: critical (7 %), never emergency (5 %)
+    v = hovering_vehicle(SIM_BAT_DRAIN=60.0, SIM_BAT_MIN_PCT=6.0)  # stops at 6 %: critical (7 %), never emergency (5 %)
     seq = v.last_event_seq
     modes = _modes(v, 60.0)
     assert [m for _, m, _ in modes] == [NavState.AUTO_LOITER, NavState.AUTO_RTL]
@@ -138,8 +121,8 @@ def test_battery_drain_low_critical_return_as_com_low_bat_act_3():
 
 
 def test_battery_failure_injected_is_an_emergency_landing():
-    v = _flying()
-    _cmd(v, MavCmd.INJECT_FAILURE, BATTERY, OFF, 0.0)
+    v = hovering_vehicle()
+    command(v, MavCmd.INJECT_FAILURE, BATTERY, OFF, 0.0)
     modes = _modes(v, 7.0)
     assert [m for _, m, _ in modes] == [NavState.AUTO_LOITER, NavState.AUTO_LAND]
     assert v.snapshot().battery_remaining == 0.0
@@ -147,14 +130,14 @@ def test_battery_failure_injected_is_an_emergency_landing():
 
 
 def test_battery_warning_only_with_com_low_bat_act_0():
-    v = _flying(COM_LOW_BAT_ACT=0)
-    _cmd(v, MavCmd.INJECT_FAILURE, BATTERY, OFF, 0.0)
+    v = hovering_vehicle(COM_LOW_BAT_ACT=0)
+    command(v, MavCmd.INJECT_FAILURE, BATTERY, OFF, 0.0)
     assert [m for _, m, _ in _modes(v, 7.0)] == [NavState.AUTO_LOITER]
     assert any(e.text == "Emergency battery level, land immediately" for e in v.events_after(0))
 
 
 def test_data_link_loss_returns_after_com_dl_loss_t_with_nav_dll_act_2():
-    v = _flying(NAV_DLL_ACT=2)
+    v = hovering_vehicle(NAV_DLL_ACT=2)
     _modes(v, 2.0, heartbeat=True)
     seq, t_last = v.last_event_seq, v.time_us / 1e6
     modes = _modes(v, 20.0)
@@ -169,7 +152,7 @@ def test_data_link_loss_returns_after_com_dl_loss_t_with_nav_dll_act_2():
 
 
 def test_data_link_loss_disabled_by_default_only_tells():
-    v = _flying()
+    v = hovering_vehicle()
     _modes(v, 1.0, heartbeat=True)
     assert [m for _, m, _ in _modes(v, 12.0)] == [NavState.AUTO_LOITER]
     assert (Severity.INFO, "Connection to ground station lost") in _texts(v)
@@ -196,12 +179,12 @@ def test_gps_off_in_offboard_position_control_falls_back():
     from sitl_emu.px4 import custom_mode, decode_custom_mode
     from sitl_emu.types import OffboardControlMode, TrajectorySetpoint
 
-    v = _flying()
+    v = hovering_vehicle()
     mode, sp = OffboardControlMode(position=True), TrajectorySetpoint(position_ned_m=(0.0, 0.0, -2.5))
     v.offboard_input(mode, sp)
     main, sub = decode_custom_mode(custom_mode(NavState.OFFBOARD))
-    _cmd(v, MavCmd.DO_SET_MODE, 1.0, main, sub)
-    _cmd(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0)
+    command(v, MavCmd.DO_SET_MODE, 1.0, main, sub)
+    command(v, MavCmd.INJECT_FAILURE, GPS, OFF, 0.0)
     seen = []
     for _ in range(80):  # the setpoints keep coming: only the lost position ends OFFBOARD
         v.offboard_input(mode, sp)
