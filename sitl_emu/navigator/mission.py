@@ -1,5 +1,4 @@
-"""AUTO.MISSION's navigator: which item is current, when it is reached, what comes next. Pure: no MAVLink, simulated
-time comes in with the NavInput.
+"""AUTO.MISSION's navigator: which item is current, when it is reached, what comes next (pure; time in NavInput).
 
 Written from PX4's src/modules/navigator/mission_base.cpp (on_activation, on_active, advance_mission,
 set_mission_items, setEndOfMissionItems, checkClimbRequired, getNonJumpItem), mission.cpp (setActiveMissionItems,
@@ -12,8 +11,8 @@ multicopter:
   by altitude only, a land item when landed; then the heading (finite item yaw: within MIS_YAW_ERR) and the hold
   time (param1) must pass; DO_* items and RETURN_TO_LAUNCH complete at once (processed in the same cycle here, so
   only the last of them is reported, as PX4's mission_result is read once per MAVLink cycle);
-- the triplet: previous position, current, next position item (none while a hold time or delay brakes);
-- DO_JUMP is followed while its repeat count lasts (the counts reset when the mission completes);
+- the triplet: previous position, current, next position item (none while a hold time or delay brakes); DO_JUMP is
+  followed while its repeat count lasts (the counts reset when the mission completes);
 - at the end: "Mission finished, loitering" (or ", landed") and loiter at the last setpoint.
 """
 
@@ -227,13 +226,20 @@ class MissionNavigator:
             index += 1
         return None
 
-    def _set_items(self, nav: NavInput, s: MissionSettings) -> None:
-        """set_mission_items + setActiveMissionItems."""
+    def _item_to_fly(self, nav: NavInput, s: MissionSettings) -> int | None:
+        """The current item once jumps are resolved, made current; None at the end of the mission (handled)."""
         seq = self._resolve(self.result.seq_current, consume=False) if self._active and self._planned_valid else None
         if seq is None:
             self._end_of_mission(nav, s)
+        else:
+            self.result.seq_current = seq
+        return seq
+
+    def _set_items(self, nav: NavInput, s: MissionSettings) -> None:
+        """set_mission_items + setActiveMissionItems."""
+        seq = self._item_to_fly(nav, s)
+        if seq is None:
             return
-        self.result.seq_current = seq
         item = self.items[seq]
         old = self.current
         work = Work.DEFAULT

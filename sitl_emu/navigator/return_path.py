@@ -136,11 +136,9 @@ class ReverseMissionNavigator(ReturnNavigator):
 
     def _set_items(self, nav: NavInput, s: MissionSettings) -> None:
         """RtlMissionFastReverse::setActiveMissionItems."""
-        seq = self._resolve(self.result.seq_current, consume=False) if self._active and self._planned_valid else None
+        seq = self._item_to_fly(nav, s)
         if seq is None:
-            self._end_of_mission(nav, s)
             return
-        self.result.seq_current = seq
         item, work = self.items[seq], Work.DEFAULT
         if item.has_position:
             before = previous_position_index(self.items, seq)
