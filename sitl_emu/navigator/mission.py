@@ -19,7 +19,7 @@ multicopter:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 from sitl_emu.motion_planning.heading import wrap_pi
@@ -389,14 +389,11 @@ class MissionNavigator:
 
 def _replace_kind(item: NavItem, kind: Kind) -> NavItem:
     """The item flown as `kind` (a takeoff item as a waypoint: its yaw ignored, no hold)."""
-    return NavItem(seq=item.seq, command=item.command, kind=kind, target_ned_m=item.target_ned_m,
-                   relative_alt_m=item.relative_alt_m, hold_s=0.0, acceptance_m=item.acceptance_m, yaw_rad=NAN,
-                   autocontinue=item.autocontinue, params=item.params)
+    return replace(item, kind=kind, hold_s=0.0, yaw_rad=NAN)
 
 
 def _with_cruise(sp: Setpoint | None, cruise_m_s: float) -> Setpoint | None:
     """The setpoint flown at `cruise_m_s` (DO_CHANGE_SPEED), or None without one."""
     if sp is None:
         return None
-    return Setpoint(kind=sp.kind, target_ned_m=sp.target_ned_m, yaw_rad=sp.yaw_rad, acceptance_m=sp.acceptance_m,
-                    cruise_m_s=cruise_m_s, loiter=sp.loiter)
+    return replace(sp, cruise_m_s=cruise_m_s)
