@@ -26,11 +26,12 @@ from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight_tasks.mission import MissionFlight, MissionTask
-from sitl_emu.flight_tasks.rtl_mission import RtlMissionTask, mission_return
+from sitl_emu.flight_tasks.rtl_mission import MissionReturn, RtlMissionTask, mission_return
 from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
 from sitl_emu.navigator.mission_store import MissionStore
+from sitl_emu.navigator.rally import ReturnDestination
 from sitl_emu.navigator.setpoint import SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
@@ -96,7 +97,7 @@ class ModeExecutor:
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
-        self.rtl_destination: Callable[[auto.NavInput], tuple[Vec3, float] | None] | None = None
+        self.rtl_destination: Callable[[auto.NavInput], ReturnDestination | None] | None = None
         # the geofence avoidance waypoints (north, east) from the vehicle to a return destination; the vehicle sets it
         self.rtl_avoid_path: Callable[[auto.NavInput, Vec3], list[tuple[float, float]]] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
@@ -267,9 +268,13 @@ class ModeExecutor:
             home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
             return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, way, prior_seq)
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        target = destination[0] if destination is not None else nav.home_ned_m
+        if missions is not None and destination is not None and destination.mission_land:
+            home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
+            return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, MissionReturn.LAND, -1)
+        target = destination.pos_ned_m if destination is not None else nav.home_ned_m
         path = self.rtl_avoid_path(nav, target) if self.rtl_avoid_path else []
-        return auto.make_rtl(nav, self.params, destination, self._mission_loiter(nav), path)
+        where = (destination.pos_ned_m, destination.yaw_rad) if destination is not None else None
+        return auto.make_rtl(nav, self.params, where, self._mission_loiter(nav), path)
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus

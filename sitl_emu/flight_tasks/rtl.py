@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from enum import Enum
 from typing import Final
 
-from sitl_emu.flight_tasks.core import Task, Waypoint
+from sitl_emu.flight_tasks.core import AutoSettings, Task, Waypoint
 from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
@@ -51,6 +51,24 @@ def rtl_start_text(return_alt_amsl_m: float, destination_alt_amsl_m: float) -> s
 def _f32(x: float) -> float:
     """x rounded to the nearest 32-bit float, as PX4 holds it."""
     return float(_F32.unpack(_F32.pack(x))[0]) if math.isfinite(x) else x
+
+
+def return_altitude_up(s: AutoSettings, destination_ned_m: Vec3, pos_ned_m: Vec3) -> float:
+    """RTL::computeReturnAltitude: the return altitude (up, local frame) above `destination_ned_m` after the cone
+    rule, never below the current altitude."""
+    home_up, current_up = -destination_ned_m[2], -pos_ned_m[2]
+    dist = math.hypot(destination_ned_m[0] - pos_ned_m[0], destination_ned_m[1] - pos_ned_m[1])
+    if s.rtl_cone_ang <= 0:
+        return max(current_up, home_up + s.rtl_return_alt)
+    alt = home_up + s.rtl_return_alt
+    if dist <= s.nav_acc_rad:
+        alt = home_up + 2.0 * dist
+    else:
+        if dist <= s.rtl_min_dist:
+            half_angle = math.radians(min(max(s.rtl_cone_ang, 1.0), 89.0))
+            alt = min(dist / math.tan(half_angle) + home_up, alt)
+        alt = max(alt, home_up + 2.0 * s.nav_acc_rad)
+    return max(alt, current_up)
 
 
 class RtlTask(Task):
@@ -90,21 +108,7 @@ class RtlTask(Task):
         return self._rtl_up_m
 
     def _return_altitude_up(self, nav: NavInput) -> float:
-        """Return altitude (up, local frame) after the cone rule, never below the current altitude."""
-        s = self._settings
-        home_up, current_up = -self._home[2], -nav.pos_ned_m[2]
-        dist = self._dist_xy(nav)
-        if s.rtl_cone_ang <= 0:
-            return max(current_up, home_up + s.rtl_return_alt)
-        alt = home_up + s.rtl_return_alt
-        if dist <= s.nav_acc_rad:
-            alt = home_up + 2.0 * dist
-        else:
-            if dist <= s.rtl_min_dist:
-                half_angle = math.radians(min(max(s.rtl_cone_ang, 1.0), 89.0))
-                alt = min(dist / math.tan(half_angle) + home_up, alt)
-            alt = max(alt, home_up + 2.0 * s.nav_acc_rad)
-        return max(alt, current_up)
+        return return_altitude_up(self._settings, self._home, nav.pos_ned_m)
 
     def _dist_xy(self, nav: NavInput) -> float:
         return math.hypot(self._home[0] - nav.pos_ned_m[0], self._home[1] - nav.pos_ned_m[1])

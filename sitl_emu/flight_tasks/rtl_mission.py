@@ -4,8 +4,11 @@ mission back or on to its landing (navigator/return_path.py) with FlightTaskAuto
 rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing pattern (DO_LAND_START followed
 by a land item) returns along it forwards (RtlMissionFast), any other valid mission backwards
 (RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4: forwards only when the landing
-pattern is nearer than the start (reverseIsFurther), else as 2. Not modelled: the mission landing of RTL_TYPE 1 and
-3 (RtlDirectMissionLand); those returns fly RtlDirect home.
+pattern is nearer than the start (reverseIsFurther), else as 2. RTL_TYPE 1 and 3: when navigator/rally.py chooses
+the mission's landing, RtlDirectMissionLand (rtl_direct_mission_land.cpp): from the land start, a climb to the return
+altitude (RTL::computeReturnAltitude towards the land item) when lower, then the landing's items flown as RtlMissionFast
+flies them, MISSION_CURRENT following, the mode AUTO.RTL throughout. PX4 computes that return altitude when the
+return type first becomes the mission landing (every 2 s while Return is inactive); here when Return starts.
 """
 
 from __future__ import annotations
@@ -15,11 +18,14 @@ from typing import Final
 
 from sitl_emu.flight_tasks.core import Task, Waypoint
 from sitl_emu.flight_tasks.mission import mission_settings, mission_waypoint
+from sitl_emu.flight_tasks.rtl import _f32, return_altitude_up
 from sitl_emu.geo import GeoRef
-from sitl_emu.navigator.mission_items import nav_items
+from sitl_emu.navigator.mission_items import Kind, NavItem, nav_items
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
+from sitl_emu.navigator.rally import land_markers
 from sitl_emu.navigator.return_path import (
     ForwardMissionNavigator,
+    MissionLandNavigator,
     ReturnNavigator,
     ReverseMissionNavigator,
     forward_start_index,
@@ -27,19 +33,16 @@ from sitl_emu.navigator.return_path import (
 )
 from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
-from sitl_emu.px4 import MavCmd
 
 RTL_TYPE_MISSION_FAST: Final = 2  # rtl_params.yaml: "Return by flying along the mission path (forward or backward)"
 RTL_TYPE_MISSION_FAST_SHORTEST: Final = 4  # "... whichever way is shorter to the landing"
 
 
 def land_start_index(items: tuple[MissionItem, ...]) -> int:
-    """mission.land_start_index as PX4 keeps it: the DO_LAND_START item followed by a land item, else -1."""
-    for index, item in enumerate(items):
-        if item.command == MavCmd.DO_LAND_START:
-            after = items[index + 1:]
-            return index if any(it.command == MavCmd.NAV_LAND for it in after) else -1
-    return -1
+    """Where the mission's landing starts when it has one (RTL::hasMissionLandStart: both markers of
+    navigator/rally.py land_markers), else -1."""
+    land_start, land = land_markers(items)
+    return land_start if land >= 0 else -1
 
 
 class MissionReturn(Enum):
@@ -47,6 +50,7 @@ class MissionReturn(Enum):
 
     FORWARD = "forward"  # RTL_MISSION_FAST
     REVERSE = "reverse"  # RTL_MISSION_FAST_REVERSE
+    LAND = "land"  # RTL_DIRECT_MISSION_LAND
 
 
 def mission_return(rtl_type: int, store: MissionStore) -> MissionReturn | None:
@@ -72,7 +76,9 @@ class RtlMissionTask(Task):
         self._mission_settings = mission_settings(params)
         items = nav_items(store.plan(PLAN_MISSION).items, ref, home_alt_amsl_m)
         navigator: ReturnNavigator
-        if way is MissionReturn.FORWARD:
+        if way is MissionReturn.LAND:
+            navigator, first = self._mission_land(items, nav, ref), land_start_index(store.plan(PLAN_MISSION).items)
+        elif way is MissionReturn.FORWARD:
             navigator, first = ForwardMissionNavigator(), forward_start_index(items, mission_seq_prior_rtl, nav)
         else:
             navigator, first = ReverseMissionNavigator(), reverse_start_index(items, mission_seq_prior_rtl, nav)
@@ -80,6 +86,12 @@ class RtlMissionTask(Task):
         navigator.load(items, 0)
         navigator.start(nav, self._mission_settings, first)
         self._publish()
+
+    def _mission_land(self, items: tuple[NavItem, ...], nav: NavInput, ref: GeoRef) -> MissionLandNavigator:
+        """RtlDirectMissionLand with its return altitude, computed towards the mission's land item."""
+        land = next(it for it in items if it.kind is Kind.LAND)
+        rtl_up = return_altitude_up(self._settings, land.target_ned_m, nav.pos_ned_m)
+        return MissionLandNavigator(rtl_up_m=rtl_up, rtl_alt_amsl_m=_f32(ref.alt_amsl_m + rtl_up))
 
     def _publish(self) -> None:
         navigator, store = self._navigator, self._store

@@ -21,7 +21,7 @@ VTOL:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from sitl_emu.navigator.mission import MissionNavigator, MissionSettings, Work, _Reach, _replace_kind
 from sitl_emu.navigator.mission_items import Kind, NavItem
@@ -169,6 +169,47 @@ class ReverseMissionNavigator(ReturnNavigator):
         land = NavItem(seq=item.seq, command=item.command, kind=Kind.LAND, target_ned_m=home, relative_alt_m=0.0,
                        hold_s=0.0, acceptance_m=NAN, yaw_rad=NAN, autocontinue=True, params=item.params)
         return land, Work.DEFAULT
+
+
+@dataclass(slots=True)
+class MissionLandNavigator(ForwardMissionNavigator):
+    """RtlDirectMissionLand (rtl_direct_mission_land.cpp, RTL_TYPE 1 and 3): from the mission's land start, a climb
+    first when below the return altitude, then on as RtlMissionFast flies (the land item moved to at the current
+    altitude)."""
+
+    rtl_up_m: float = NAN  # the return altitude (up, local frame)
+    rtl_alt_amsl_m: float = NAN  # the same, AMSL, for the text
+
+    def _climb_needed(self, nav: NavInput, s: MissionSettings, seq: int) -> float:
+        """on_activation: climb when lower than the return altitude."""
+        return self.rtl_up_m if -nav.pos_ned_m[2] < self.rtl_up_m else NAN
+
+    def _set_items(self, nav: NavInput, s: MissionSettings) -> None:
+        """setActiveMissionItems: the climb, a waypoint above the vehicle at the return altitude, before anything
+        else (MISSION_CURRENT shows the land start meanwhile; its end is not reported reached)."""
+        if not (math.isfinite(self._climb_up_m) and self._work is Work.DEFAULT and self._active):
+            super(MissionLandNavigator, self)._set_items(nav, s)
+            return
+        start = self.items[self.result.seq_current]
+        target = (nav.pos_ned_m[0], nav.pos_ned_m[1], -self._climb_up_m)
+        climb = NavItem(seq=start.seq, command=start.command, kind=Kind.WAYPOINT, target_ned_m=target,
+                        relative_alt_m=NAN, hold_s=0.0, acceptance_m=NAN, yaw_rad=NAN, autocontinue=True,
+                        params=start.params)
+        self._say(f"RTL Mission land: climb to {math.ceil(self.rtl_alt_amsl_m):d} m")
+        self._climb_up_m = NAN
+        self.current, self.next = self._setpoint(climb, nav, s), None
+        self._item, self._work = climb, Work.CLIMB
+        self._reach = _Reach()
+
+    def _takeoff_and_land(self, item: NavItem, nav: NavInput, s: MissionSettings) -> tuple[NavItem, Work]:
+        """RtlDirectMissionLand::handleLanding: the move to the land item at the vehicle's altitude."""
+        if item.kind is Kind.LAND and not nav.landed and self._work is Work.DEFAULT:
+            dx, dy = item.target_ned_m[0] - nav.pos_ned_m[0], item.target_ned_m[1] - nav.pos_ned_m[1]
+            if math.hypot(dx, dy) > s.acc_rad:
+                target = (item.target_ned_m[0], item.target_ned_m[1], nav.pos_ned_m[2])
+                return replace(item, kind=Kind.WAYPOINT, target_ned_m=target, relative_alt_m=NAN, hold_s=0.0,
+                               acceptance_m=NAN, yaw_rad=NAN, autocontinue=True), Work.MOVE_TO_LAND
+        return item, Work.DEFAULT
 
 
 def _as_waypoint(item: NavItem) -> NavItem:

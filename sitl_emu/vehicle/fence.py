@@ -27,7 +27,7 @@ from sitl_emu.navigator.geofence import (
 )
 from sitl_emu.navigator.geofence_monitor import GeofenceInputs, GeofenceMonitor, geofence_settings
 from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALLY, MissionStore, Plan
-from sitl_emu.navigator.rally import choose_destination
+from sitl_emu.navigator.rally import ReturnDestination, choose_destination, mission_landing
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
 from sitl_emu.types import Vec3
@@ -160,17 +160,19 @@ class FenceChecks:
 
 
 def rtl_destination(pos_ned_m: Vec3, params: ParamRegistry, store: MissionStore, c: Commander,
-                    ref: GeoRef) -> tuple[Vec3, float] | None:
-    """RTL's destination in NED with its yaw, or None to return home as before (no rally point chosen)."""
+                    ref: GeoRef) -> ReturnDestination | None:
+    """RTL's destination in NED with its yaw (a rally point or the mission's landing), or None to return home."""
     home = home_point(c)
     if home is None or c.home is None:
         return None
     here = _geo(ref, pos_ned_m)
-    dest = choose_destination(int(params["RTL_TYPE"]), store.plan(PLAN_RALLY).items, home, c.home.yaw_rad, here)
-    if dest.point == home:
+    landing = mission_landing(store.plan(PLAN_MISSION).items, store.mission_valid, home.alt_amsl_m)
+    dest = choose_destination(int(params["RTL_TYPE"]), store.plan(PLAN_RALLY).items, home, c.home.yaw_rad, here,
+                              landing)
+    if dest.point == home and not dest.mission_land:
         return None
     p = dest.point
-    return global_to_ned(ref, p.lat_deg, p.lon_deg, p.alt_amsl_m), dest.yaw_rad
+    return ReturnDestination(global_to_ned(ref, p.lat_deg, p.lon_deg, p.alt_amsl_m), dest.yaw_rad, dest.mission_land)
 
 
 def rtl_target(pos_ned_m: Vec3, params: ParamRegistry, store: MissionStore, c: Commander, ref: GeoRef) -> Vec3:

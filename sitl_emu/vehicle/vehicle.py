@@ -30,6 +30,7 @@ from sitl_emu.events.catalogue import Px4Event, to_px4_event
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.geo import SIH_HOME, GeoRef, global_to_ned, ned_to_global
 from sitl_emu.navigator.mission_store import MissionStore
+from sitl_emu.navigator.rally import ReturnDestination
 from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry, default_registry
 from sitl_emu.params.settings import sih_config
@@ -174,7 +175,7 @@ class Vehicle:
         """The navigator task's input, built only when a task runs (before physics: the estimate of this tick)."""
         return self.chain.nav_input(self._time_us, self._estimate, self.commander, self.ref)
 
-    def _rtl_destination(self, nav: NavInput) -> tuple[Vec3, float] | None:
+    def _rtl_destination(self, nav: NavInput) -> ReturnDestination | None:
         return rtl_destination(nav.pos_ned_m, self.params, self._missions, self.commander, self.ref)
 
     def _rtl_avoid_path(self, nav: NavInput, destination_ned_m: Vec3) -> list[tuple[float, float]]:
