@@ -10,6 +10,12 @@ kept: the altitude reference as the INT or float variant of the global frame, an
 Before any of that PX4 main refuses a value in a param the command does not use (command_params.py): e.g. an RTL
 item in a global frame at x = y = 0 is MAV_MISSION_INVALID_PARAM5_X, a waypoint's pass radius (param3)
 MAV_MISSION_INVALID_PARAM3.
+
+DO_LAND_START is a marker in either frame: in MAV_FRAME_MISSION (QGroundControl's landing patterns,
+LandingComplexItem: all seven params 0) it is kept as sent; in a global frame (a plain DO_LAND_START item placed on
+QGroundControl's map carries the optional position MAVLink gives it, params 5-7, which PX4 main's parameter table
+allows) PX4 keeps the position and no param, and a download returns it in the global frame. Either way the navigator
+flies nothing there: the landing starts at the next position item (mission.land_start_index, RTL's mission landing).
 """
 
 from __future__ import annotations
@@ -65,6 +71,7 @@ _GLOBAL_COMMANDS: dict[int, tuple[str, ...]] = {
     MavCmd.NAV_FENCE_CIRCLE_INCLUSION: ("1",), MavCmd.NAV_FENCE_CIRCLE_EXCLUSION: ("1",),
     MavCmd.NAV_RALLY_POINT: (),
     MavCmd.COMPONENT_ARM_DISARM: (), MavCmd.DO_AUTOTUNE_ENABLE: (),
+    MavCmd.DO_LAND_START: (),  # the marker's optional position (params 5-7, command_params.py) kept, no params
 }
 # Commands PX4 accepts in MAV_FRAME_MISSION (params kept as sent)
 _MISSION_FRAME_COMMANDS = frozenset({

@@ -135,3 +135,20 @@ def test_rtl_type_0_ignores_the_mission_landing() -> None:
     _, _, path, _ = _until_disarmed(f)
     assert any(t.startswith("RTL: start return") for t in f.texts[rtl_texts:])
     assert math.hypot(path[-1][0], path[-1][1]) < 1.0
+
+
+@pytest.mark.slow
+def test_a_qgroundcontrol_landing_pattern_with_a_positioned_marker_is_flown_from_its_approach() -> None:
+    """The marker's own position (DO_LAND_START in a global frame) is not flown: the landing starts at the next
+    position item, the final approach (LOITER_TO_ALT as a waypoint for a multicopter)."""
+    items = [TAKEOFF_ITEM, wp(30, 0), wp(30, 30), wp(60, 60, 12.0, cmd=LAND_START),
+             wp(0, 30, 8.0, 1.0, -5.0, 0.0, 1.0, cmd=MavCmd.NAV_LOITER_TO_ALT), wp(0, 45, 0.0, cmd=LAND)]
+    f = Flight(items)
+    f.v.params.set("RTL_TYPE", 1)
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2, 120.0)
+    assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
+    currents, reached, path, _ = _until_disarmed(f)
+    assert currents == [2, 3, 4, 5] and reached == [3, 4, 5]
+    assert min(math.hypot(p[0] - 60.0, p[1] - 60.0) for p in path) > 20.0
+    assert math.hypot(path[-1][0], path[-1][1] - 45.0) < 1.0

@@ -9,6 +9,7 @@ import math
 import pytest
 from support import REPO_ROOT
 from support.handler_ctx import CLIENT_COMPID, CLIENT_SYSID, Client, FakeVehicle, MemoryContext
+from support.mission_wire import LAT, LON, download, item, upload
 
 from sitl_emu.mavlink.protocols.command_params import unused_param_result
 from sitl_emu.mavlink.protocols.mission import MissionProtocol
@@ -25,7 +26,6 @@ from sitl_emu.mavlink.protocols.mission_items import (
 from sitl_emu.navigator.mission_store import MAX_ITEMS
 from sitl_emu.px4 import NavState, Severity
 
-LAT, LON = 473977420, 85455940
 WAYPOINT, TAKEOFF, RTL, FENCE_POLY_IN, FENCE_CIRCLE_IN, RALLY = 16, 22, 20, 5001, 5003, 5100
 MAV_MISSION_INVALID_PARAM1, MAV_MISSION_INVALID_PARAM2 = 6, 7  # common.xml
 MAV_MISSION_INVALID_PARAM3, MAV_MISSION_INVALID_PARAM4 = 8, 9
@@ -36,36 +36,6 @@ INT32_MAX = 2**31 - 1  # MISSION_ITEM_INT's "no value" in x, y
 @pytest.fixture()
 def setup() -> tuple[MissionProtocol, MemoryContext, Client]:
     return MissionProtocol(), MemoryContext(FakeVehicle()), Client()
-
-
-def item(client: Client, seq: int, command: int = WAYPOINT, frame: int = 6, mission_type: int = 0,
-         x: int = LAT, y: int = LON, params: tuple[float, ...] = (0.0, 0.0, 0.0, math.nan), current: int = 0,
-         z: float = 5.0):
-    return client.msg("MISSION_ITEM_INT", 1, 1, seq, frame, command, current, 1, *params, x, y, z, mission_type)
-
-
-def upload(proto: MissionProtocol, ctx: MemoryContext, client: Client, items: list, mission_type: int = 0) -> int:
-    """Answer each request with the item asked for; the final MISSION_ACK type."""
-    proto.handle(client.msg("MISSION_COUNT", 1, 1, len(items), mission_type), ctx)
-    while True:
-        (msg,) = ctx.take()
-        if msg.get_type() == "MISSION_ACK":
-            return msg.type
-        assert msg.get_type() == "MISSION_REQUEST_INT" and msg.mission_type == mission_type
-        proto.handle(items[msg.seq], ctx)
-
-
-def download(proto: MissionProtocol, ctx: MemoryContext, client: Client, mission_type: int = 0,
-             legacy: bool = False) -> list:
-    proto.handle(client.msg("MISSION_REQUEST_LIST", 1, 1, mission_type), ctx)
-    (count,) = ctx.take()
-    assert count.get_type() == "MISSION_COUNT" and count.mission_type == mission_type
-    got = []
-    for seq in range(count.count):
-        proto.handle(client.msg("MISSION_REQUEST" if legacy else "MISSION_REQUEST_INT", 1, 1, seq, mission_type), ctx)
-        got.extend(ctx.take())
-    proto.handle(client.msg("MISSION_ACK", 1, 1, 0, mission_type), ctx)
-    return got
 
 
 def texts(ctx: MemoryContext) -> list[str]:
