@@ -22,11 +22,18 @@ from dataclasses import dataclass
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import isfinite
 from sitl_emu.flight_tasks import auto, orbit
+from sitl_emu.flight_tasks.core import AutoSettings
 from sitl_emu.flight_tasks.follow import FollowTargetTask
 from sitl_emu.flight_tasks.follow_estimator import TargetFix
 from sitl_emu.flight_tasks.manual import ManualAltitudeTask, ManualPositionTask
 from sitl_emu.flight_tasks.mission import MissionFlight, MissionTask
-from sitl_emu.flight_tasks.rtl_mission import MissionReturn, RtlMissionTask, mission_return
+from sitl_emu.flight_tasks.rtl_mission import (
+    RTL_CHECK_PERIOD_US,
+    MissionLandAltitude,
+    MissionReturn,
+    RtlMissionTask,
+    mission_return,
+)
 from sitl_emu.flight_tasks.stabilized import StabilizedMode
 from sitl_emu.geo import GeoRef, global_to_ned
 from sitl_emu.navigator.commands import NavCommand, NavCommandKind
@@ -102,6 +109,8 @@ class ModeExecutor:
         self.rtl_avoid_path: Callable[[auto.NavInput, Vec3], list[tuple[float, float]]] | None = None
         self.missions: MissionFlight | None = None  # AUTO.MISSION's navigator over the stored plans (attach_missions)
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
+        self._mission_land = MissionLandAltitude()  # the mission landing's return altitude (RTL_TYPE 1 and 3)
+        self._rtl_check_us = 0  # when Return's destination is evaluated next while Return is inactive
 
     def attach_missions(self, store: MissionStore) -> None:
         """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
@@ -134,6 +143,9 @@ class ModeExecutor:
                sticks: ManualControlSetpoint = CENTRED) -> ExecutorOutput:
         """This tick's setpoint; `nav_fn` builds the task input (called only when a task runs or starts); `sticks`
         is the last manual input (the commander's, commander/manual_control.py), for the manual modes."""
+        if now_us >= self._rtl_check_us and nav_state is not NavState.AUTO_RTL:
+            self._rtl_check_us = now_us + RTL_CHECK_PERIOD_US
+            self._check_rtl_destination(nav_fn())
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
         if nav_state in _STICK_ATTITUDE_MODES:
             return self._stick_attitude(armed, nav_fn, dt_s, sticks)
@@ -267,14 +279,21 @@ class ModeExecutor:
             prior_seq = missions.store.current_seq if isinstance(self.task, MissionTask) else -1
             home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
             return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, way, prior_seq)
-        destination = self.rtl_destination(nav) if self.rtl_destination else None
+        destination = self._check_rtl_destination(nav)
         if missions is not None and destination is not None and destination.mission_land:
             home_alt = ref.alt_amsl_m - nav.home_ned_m[2]
-            return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, MissionReturn.LAND, -1)
+            return RtlMissionTask(nav, self.params, missions.store, ref, home_alt, MissionReturn.LAND, -1,
+                                  self._mission_land.rtl_up_m)
         target = destination.pos_ned_m if destination is not None else nav.home_ned_m
         path = self.rtl_avoid_path(nav, target) if self.rtl_avoid_path else []
         where = (destination.pos_ned_m, destination.yaw_rad) if destination is not None else None
         return auto.make_rtl(nav, self.params, where, self._mission_loiter(nav), path)
+
+    def _check_rtl_destination(self, nav: auto.NavInput) -> ReturnDestination | None:
+        """RTL::setRtlTypeAndDestination: the destination (the vehicle's choice), the mission landing's altitude."""
+        destination = self.rtl_destination(nav) if self.rtl_destination else None
+        self._mission_land.evaluate(destination, nav, AutoSettings.from_params(self.params))
+        return destination
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
         """The loiter a finished mission left, if the vehicle is established on it (within NAV_ACC_RAD plus

@@ -7,8 +7,8 @@ by a land item) returns along it forwards (RtlMissionFast), any other valid miss
 pattern is nearer than the start (reverseIsFurther), else as 2. RTL_TYPE 1 and 3: when navigator/rally.py chooses
 the mission's landing, RtlDirectMissionLand (rtl_direct_mission_land.cpp): from the land start, a climb to the return
 altitude (RTL::computeReturnAltitude towards the land item) when lower, then the landing's items flown as RtlMissionFast
-flies them, MISSION_CURRENT following, the mode AUTO.RTL throughout. PX4 computes that return altitude when the
-return type first becomes the mission landing (every 2 s while Return is inactive); here when Return starts.
+flies them, MISSION_CURRENT following, the mode AUTO.RTL throughout; that return altitude is the one computed when the
+return type last became the mission landing (MissionLandAltitude).
 """
 
 from __future__ import annotations
@@ -16,13 +16,13 @@ from __future__ import annotations
 from enum import Enum
 from typing import Final
 
-from sitl_emu.flight_tasks.core import Task, Waypoint
+from sitl_emu.flight_tasks.core import AutoSettings, Task, Waypoint
 from sitl_emu.flight_tasks.mission import mission_settings, mission_waypoint
 from sitl_emu.flight_tasks.rtl import _f32, return_altitude_up
 from sitl_emu.geo import GeoRef
-from sitl_emu.navigator.mission_items import Kind, NavItem, nav_items
+from sitl_emu.navigator.mission_items import nav_items
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
-from sitl_emu.navigator.rally import land_markers
+from sitl_emu.navigator.rally import ReturnDestination, land_markers
 from sitl_emu.navigator.return_path import (
     ForwardMissionNavigator,
     MissionLandNavigator,
@@ -33,6 +33,7 @@ from sitl_emu.navigator.return_path import (
 )
 from sitl_emu.navigator.setpoint import NavInput
 from sitl_emu.params import ParamRegistry
+from sitl_emu.types import NAN
 
 RTL_TYPE_MISSION_FAST: Final = 2  # rtl_params.yaml: "Return by flying along the mission path (forward or backward)"
 RTL_TYPE_MISSION_FAST_SHORTEST: Final = 4  # "... whichever way is shorter to the landing"
@@ -43,6 +44,28 @@ def land_start_index(items: tuple[MissionItem, ...]) -> int:
     navigator/rally.py land_markers), else -1."""
     land_start, land = land_markers(items)
     return land_start if land >= 0 else -1
+
+
+RTL_CHECK_PERIOD_US: Final = 2_000_000  # RTL::on_inactive: the return type evaluated at most every 2 s
+
+
+class MissionLandAltitude:
+    """The mission landing's return altitude as PX4 keeps it. RTL::setRtlTypeAndDestination runs every 2 s while
+    Return is inactive and once as it starts, but hands the mission landing its return altitude
+    (computeReturnAltitude, from where the vehicle is then) only when the return type becomes the mission landing
+    (initRtlMissionType): a mission with its landing at home, uploaded on the ground there, keeps the altitude of the
+    ground (2 x the distance to the land item), and Return flies to it without climbing."""
+
+    def __init__(self) -> None:
+        self.rtl_up_m = NAN  # up, local frame
+        self._is_land = False
+
+    def evaluate(self, destination: ReturnDestination | None, nav: NavInput, settings: AutoSettings) -> None:
+        """One setRtlTypeAndDestination with the destination chosen (navigator/rally.py)."""
+        is_land = destination is not None and destination.mission_land
+        if destination is not None and is_land and not self._is_land:
+            self.rtl_up_m = return_altitude_up(settings, destination.pos_ned_m, nav.pos_ned_m)
+        self._is_land = is_land
 
 
 class MissionReturn(Enum):
@@ -69,15 +92,17 @@ class RtlMissionTask(Task):
     follow its navigator (the mission_result goes to the store as the mission's does)."""
 
     def __init__(self, nav: NavInput, params: ParamRegistry, store: MissionStore, ref: GeoRef,
-                 home_alt_amsl_m: float, way: MissionReturn, mission_seq_prior_rtl: int) -> None:
-        """`mission_seq_prior_rtl`: the mission's current item if AUTO.MISSION ran just before, else -1."""
+                 home_alt_amsl_m: float, way: MissionReturn, mission_seq_prior_rtl: int, rtl_up_m: float = NAN) -> None:
+        """`mission_seq_prior_rtl`: the mission's current item if AUTO.MISSION ran just before, else -1; `rtl_up_m`:
+        the mission landing's return altitude (up, local frame; MissionLandAltitude)."""
         super().__init__(nav, params)
         self._store = store
         self._mission_settings = mission_settings(params)
         items = nav_items(store.plan(PLAN_MISSION).items, ref, home_alt_amsl_m)
         navigator: ReturnNavigator
         if way is MissionReturn.LAND:
-            navigator, first = self._mission_land(items, nav, ref), land_start_index(store.plan(PLAN_MISSION).items)
+            navigator = MissionLandNavigator(rtl_up_m=rtl_up_m, rtl_alt_amsl_m=_f32(ref.alt_amsl_m + rtl_up_m))
+            first = land_start_index(store.plan(PLAN_MISSION).items)
         elif way is MissionReturn.FORWARD:
             navigator, first = ForwardMissionNavigator(), forward_start_index(items, mission_seq_prior_rtl, nav)
         else:
@@ -86,12 +111,6 @@ class RtlMissionTask(Task):
         navigator.load(items, 0)
         navigator.start(nav, self._mission_settings, first)
         self._publish()
-
-    def _mission_land(self, items: tuple[NavItem, ...], nav: NavInput, ref: GeoRef) -> MissionLandNavigator:
-        """RtlDirectMissionLand with its return altitude, computed towards the mission's land item."""
-        land = next(it for it in items if it.kind is Kind.LAND)
-        rtl_up = return_altitude_up(self._settings, land.target_ned_m, nav.pos_ned_m)
-        return MissionLandNavigator(rtl_up_m=rtl_up, rtl_alt_amsl_m=_f32(ref.alt_amsl_m + rtl_up))
 
     def _publish(self) -> None:
         navigator, store = self._navigator, self._store

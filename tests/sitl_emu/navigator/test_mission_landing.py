@@ -11,8 +11,9 @@ import math
 import pytest
 from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, wp
 
+from sitl_emu.flight_tasks.rtl_mission import MissionReturn, mission_return
 from sitl_emu.navigator.geofence import GeoPoint, distance_m
-from sitl_emu.navigator.mission_store import MissionItem
+from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem, MissionStore
 from sitl_emu.navigator.rally import choose_destination, land_markers, mission_landing
 from sitl_emu.px4 import MavCmd, MavResult, NavState
 
@@ -24,6 +25,14 @@ def _item(seq: int, cmd: int, north_m: float = 0.0, alt_m: float = 0.0) -> Missi
     frame = MISSION_FRAME if cmd == LAND_START else REL
     lat = HOME.lat_deg + north_m / 111_195.0
     return MissionItem(seq, frame, cmd, 1, 0.0, 0.0, 0.0, math.nan, round(lat * 1e7), round(HOME.lon_deg * 1e7), alt_m)
+
+
+def test_a_land_item_without_a_marker_is_a_landing_for_rtl_type_2() -> None:
+    """mavlink_mission.cpp: with no DO_LAND_START the land item is the land start too, so RTL::hasMissionLandStart
+    holds and RTL_TYPE 2 flies on to it (RtlMissionFast) rather than back."""
+    store = MissionStore()
+    store.replace(PLAN_MISSION, tuple(_item(i, c) for i, c in enumerate([MavCmd.NAV_TAKEOFF, WP, WP, LAND])))
+    assert mission_return(2, store) is MissionReturn.FORWARD
 
 
 def _north(north_m: float) -> GeoPoint:
@@ -152,3 +161,23 @@ def test_a_qgroundcontrol_landing_pattern_with_a_positioned_marker_is_flown_from
     assert currents == [2, 3, 4, 5] and reached == [3, 4, 5]
     assert min(math.hypot(p[0] - 60.0, p[1] - 60.0) for p in path) > 20.0
     assert math.hypot(path[-1][0], path[-1][1] - 45.0) < 1.0
+
+
+@pytest.mark.slow
+def test_a_landing_at_home_keeps_the_return_altitude_computed_on_the_ground() -> None:
+    """rtl.cpp initRtlMissionType: the return altitude is handed to the mission landing when the return type becomes
+    it, here on the ground at home before the flight, next to the land item: 2 x the distance to it
+    (computeReturnAltitude), so Return does not climb."""
+    items = [TAKEOFF_ITEM, wp(30, 0), wp(30, 30), do(LAND_START), wp(0, 10, 8.0), wp(0, 0, 0.0, cmd=LAND)]
+    f = Flight(items)
+    f.v.params.set("RTL_TYPE", 1)
+    f.start()
+    f.run_until(lambda: f.store.current_seq == 2, 120.0)
+    f.v.run_for(2.0)
+    assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
+    texts = len(f.texts)
+    currents, _, path, _ = _until_disarmed(f)
+    assert "Executing Mission" in f.texts[texts:]
+    assert not any(t.startswith("RTL Mission land: climb") for t in f.texts[texts:])
+    assert max(-p[2] for p in path) < 15.0  # the items' altitudes (5-8 m), no climb towards RTL_RETURN_ALT (30 m)
+    assert currents[-2:] == [4, 5] and math.hypot(path[-1][0], path[-1][1]) < 1.0
