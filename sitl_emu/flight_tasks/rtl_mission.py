@@ -1,8 +1,8 @@
-"""AUTO.RTL along the mission path (RTL_TYPE 2 and 4): which return RTL_TYPE asks for, and the task that flies the
-mission back or on to its landing (navigator/return_path.py) with FlightTaskAuto's core.
+"""AUTO.RTL along the mission (RTL_TYPE 1-4): which return RTL_TYPE asks for, and the task that flies the mission
+back, on to its landing or its landing from its start (navigator/return_path.py) with FlightTaskAuto's core.
 
-rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing pattern (DO_LAND_START followed
-by a land item) returns along it forwards (RtlMissionFast), any other valid mission backwards
+rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing (a land item; its start the
+first DO_LAND_START, else the land item: navigator/rally.py land_markers) returns along it forwards (RtlMissionFast), any other valid mission backwards
 (RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4: forwards only when the landing
 pattern is nearer than the start (reverseIsFurther), else as 2. RTL_TYPE 1 and 3: when navigator/rally.py chooses
 the mission's landing, RtlDirectMissionLand (rtl_direct_mission_land.cpp): from the land start, a climb to the return

@@ -1,5 +1,6 @@
 """Return along the mission path (RTL_TYPE 2 and 4): the mission's position items flown as plain waypoints, backwards
-to the start then home, or forwards to its landing. Pure: no MAVLink, simulated time comes with the NavInput.
+to the start then home, or forwards to its landing; and the mission's landing flown from its start (RTL_TYPE 1 and 3,
+MissionLandNavigator: rtl_direct_mission_land.cpp). Pure: no MAVLink, simulated time comes with the NavInput.
 
 Written from PX4 main's src/modules/navigator/rtl_mission_fast_reverse.cpp and rtl_mission_fast.cpp (on_activation,
 setNextMissionItem, setActiveMissionItems, handleLanding) on top of mission_base.cpp (goToPreviousPositionItem,
