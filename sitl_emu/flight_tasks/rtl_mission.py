@@ -1,14 +1,14 @@
 """AUTO.RTL along the mission (RTL_TYPE 1-4): which return RTL_TYPE asks for, and the task that flies the mission
 back, on to its landing or its landing from its start (navigator/return_path.py) with FlightTaskAuto's core.
 
-rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing (a land item; its start the
-first DO_LAND_START, else the land item: navigator/rally.py land_markers) returns along it forwards (RtlMissionFast), any other valid mission backwards
-(RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4: forwards only when the landing
-pattern is nearer than the start (reverseIsFurther), else as 2. RTL_TYPE 1 and 3: when navigator/rally.py chooses
-the mission's landing, RtlDirectMissionLand (rtl_direct_mission_land.cpp): from the land start, a climb to the return
-altitude (RTL::computeReturnAltitude towards the land item) when lower, then the landing's items flown as RtlMissionFast
-flies them, MISSION_CURRENT following, the mode AUTO.RTL throughout; that return altitude is the one computed when the
-return type last became the mission landing (MissionLandAltitude).
+rtl.cpp setRtlTypeAndDestination (PX4 main) for RTL_TYPE 2: a mission with a landing (a land item; its start the first
+DO_LAND_START, else the land item: navigator/rally.py land_markers) returns along it forwards (RtlMissionFast), any
+other valid mission backwards (RtlMissionFastReverse), no valid mission directly (RtlDirect, rtl.py). RTL_TYPE 4:
+forwards only when the landing pattern is nearer than the start (reverseIsFurther), else as 2. RTL_TYPE 1 and 3: when
+navigator/rally.py chooses the mission's landing, RtlDirectMissionLand (rtl_direct_mission_land.cpp): from the land
+start, a climb to the return altitude (RTL::computeReturnAltitude towards the land item) when lower, then the landing's
+items flown as RtlMissionFast flies them, MISSION_CURRENT following, the mode AUTO.RTL throughout; that return altitude
+is the one computed when the return type last became the mission landing (MissionLandAltitude).
 """
 
 from __future__ import annotations
