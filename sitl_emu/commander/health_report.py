@@ -97,6 +97,19 @@ class ReportInputs:
         self.stick_input_disabled = stick_input_disabled
         self.datalink_required = datalink_required
 
+    def __eq__(self, other: object) -> bool:
+        """The dataclass's comparison, field by field, written out so that mypyc compiles it (the generated one
+        stays interpreted; the reporter compares every 100 ms)."""
+        if not isinstance(other, ReportInputs):
+            return NotImplemented
+        return (self.nav_state == other.nav_state and self.armed == other.armed
+                and self.estimator_ready == other.estimator_ready and self.position_lost == other.position_lost
+                and self.missing == other.missing and self.geofence == other.geofence
+                and self.gcs_lost == other.gcs_lost and self.battery_warning == other.battery_warning
+                and self.manual_control == other.manual_control
+                and self.stick_input_disabled == other.stick_input_disabled
+                and self.datalink_required == other.datalink_required)
+
     @classmethod
     def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
            stick_input_disabled: bool, datalink_required: bool) -> ReportInputs:
