@@ -98,6 +98,7 @@ class ModeExecutor:
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
+        self._next_us = 0  # when it runs again: _last_us + its period_us (read once a run, not every tick)
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[auto.NavInput], tuple[Vec3, float] | None] | None = None
         # the geofence avoidance waypoints (north, east) from the vehicle to a return destination; the vehicle sets it
@@ -166,14 +167,14 @@ class ModeExecutor:
         held = self._held
         dt = dt_s
         if held is not None and not new_task:
-            if now_us - self._last_us < task.period_us:
+            if now_us < self._next_us:
                 return held
             dt = (now_us - self._last_us) * 1e-6
         if isinstance(task, _STICK_TASKS):
             task.sticks = sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
-        self._last_us = now_us
+        self._last_us, self._next_us = now_us, now_us + task.period_us
         messages = task.drain_messages()
         if not messages:
             return held
