@@ -71,7 +71,8 @@ class GeofenceMonitor:
     def __init__(self) -> None:
         self.fence = Geofence()
         self.result: GeofenceResult = NO_BREACH
-        self._plan_key: tuple[int, int] | None = None
+        # the fence plan in force: its CRC32 and item count (-1: none yet, never a plan's), compared every cycle
+        self._plan_id, self._plan_count = -1, -1
         self._last_check_us: int | None = None
         self._latched_at_us = 0  # _time_loitering_after_gf_breach (0: not latched)
         self._reposition_sent = False
@@ -79,15 +80,17 @@ class GeofenceMonitor:
     def due(self, now_us: int, plan: Plan, position_valid: bool = True) -> bool:
         """Whether `update` would do anything now (the caller may skip building its inputs otherwise). Without a
         valid position (`update` gets None for it) only a new fence plan or the post-breach latch need an update."""
-        if (plan.opaque_id, plan.count) != self._plan_key or self._latched_at_us:
+        if self._new_plan(plan) or self._latched_at_us:
             return True
         return position_valid and (self._last_check_us is None or now_us - self._last_check_us > CHECK_INTERVAL_US)
 
+    def _new_plan(self, plan: Plan) -> bool:
+        return plan.opaque_id != self._plan_id or plan.count != self._plan_count
+
     def update(self, now_us: int, plan: Plan, s: GeofenceSettings, inp: GeofenceInputs) -> GeofenceStep:
         step = GeofenceStep()
-        key = (plan.opaque_id, plan.count)
-        if key != self._plan_key:  # navigator_main: mission.geofence_id changed -> updateFence
-            self._plan_key = key
+        if self._new_plan(plan):  # navigator_main: mission.geofence_id changed -> updateFence
+            self._plan_id, self._plan_count = plan.opaque_id, plan.count
             self.fence, step.navigator_texts = build_fence(plan.items, home=inp.home, position=inp.estimate,
                                                            landed=inp.landed, action=s.action)
         if not inp.in_hold and self._latched_at_us and now_us - self._latched_at_us > LATCH_RELEASE_US:
