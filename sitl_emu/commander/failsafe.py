@@ -183,7 +183,8 @@ class Failsafe:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
             action = _worse(action, user, wanted, self.manual_loss.disarm, CAUSE_MANUAL_CONTROL_LOSS)
         if faults is not None:
-            for want in self.faults.wanted(now_us, user, *faults):
+            flags, fault_settings = faults  # a starred call would go through Python's call protocol
+            for want in self.faults.wanted(now_us, user, flags, fault_settings):
                 action = _worse(action, user, want.mode, want.disarm, want.cause)
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)

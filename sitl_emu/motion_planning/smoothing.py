@@ -51,7 +51,7 @@ def speed_in_turn(alpha: float, accel: float, radius: float) -> float:
 
 def _angle(a: tuple[float, float], b: tuple[float, float]) -> float:
     """The angle between two 2D vectors (a zero vector counts as orthogonal, as unit_or_zero makes it)."""
-    na, nb = math.hypot(*a), math.hypot(*b)
+    na, nb = math.hypot(a[0], a[1]), math.hypot(b[0], b[1])
     if na <= _EPS or nb <= _EPS:
         return math.pi / 2.0
     return math.acos(max(-1.0, min(1.0, (a[0] * b[0] + a[1] * b[1]) / (na * nb))))
