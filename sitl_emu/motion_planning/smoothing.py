@@ -16,7 +16,6 @@ pulled towards an L1-like crossing point on the line from the previous waypoint 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -230,7 +229,7 @@ class AxisSmoother:
         return self._saturate_t1(a0, jerk, t1)
 
 
-def synchronize(axes: Sequence[AxisSmoother]) -> None:
+def synchronize(axes: list[AxisSmoother]) -> None:
     """Make every axis finish its velocity change together with the slowest one
     (VelocitySmoothing::timeSynchronization)."""
     totals = [axis.total_time for axis in axes]  # each read before its own axis changes
