@@ -43,9 +43,11 @@ def geofence_settings(p: ParamRegistry) -> GeofenceSettings:
                             max_hor_dist_m=float(p["GF_MAX_HOR_DIST"]), max_ver_dist_m=float(p["GF_MAX_VER_DIST"]))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class GeofenceInputs:
-    """What the navigator sees at a check: positions (None while not valid), home (None while not set), state."""
+    """What the navigator sees at a check: positions (None while not valid), home (None while not set), state.
+    Made at every check, so not frozen, its `__init__` written out (ARCHITECTURE.md, On the tick path); read-only by
+    convention."""
 
     estimate: GeoPoint | None
     gps: GeoPoint | None
@@ -53,6 +55,15 @@ class GeofenceInputs:
     landed: bool
     armed: bool
     in_hold: bool  # nav_state AUTO_LOITER
+
+    def __init__(self, estimate: GeoPoint | None, gps: GeoPoint | None, home: GeoPoint | None, landed: bool,
+                 armed: bool, in_hold: bool) -> None:
+        self.estimate = estimate
+        self.gps = gps
+        self.home = home
+        self.landed = landed
+        self.armed = armed
+        self.in_hold = in_hold
 
 
 @dataclass(slots=True)
@@ -63,6 +74,13 @@ class GeofenceStep:
     navigator_texts: list[str] = field(default_factory=list)
     health_texts: list[str] = field(default_factory=list)
     reposition: GeoPoint | None = None
+
+    def __init__(self, navigator_texts: list[str] | None = None, health_texts: list[str] | None = None,
+                 reposition: GeoPoint | None = None) -> None:
+        """Written out (made at every check; ARCHITECTURE.md, On the tick path); None stands for a new empty list."""
+        self.navigator_texts = navigator_texts if navigator_texts is not None else []
+        self.health_texts = health_texts if health_texts is not None else []
+        self.reposition = reposition
 
 
 class GeofenceMonitor:

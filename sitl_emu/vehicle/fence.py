@@ -38,7 +38,8 @@ Emit = Callable[[Severity, str, str, bool, bool], None]
 
 
 def _geo(ref: GeoRef, pos_ned_m: Vec3) -> GeoPoint:
-    return GeoPoint(*ned_to_global(ref, pos_ned_m))
+    lat_deg, lon_deg, alt_amsl_m = ned_to_global(ref, pos_ned_m)
+    return GeoPoint(lat_deg, lon_deg, alt_amsl_m)
 
 
 def home_point(c: Commander) -> GeoPoint | None:
