@@ -141,7 +141,8 @@ class VehicleFaults:
     def _attitude_failed(self, now_us: int, armed: bool, est: RigidBodyState, s: MonitorSettings) -> bool:
         """Roll or pitch beyond its limit for its trigger time (each with its own hysteresis, as PX4's)."""
         since = self._fd_since_us
-        _, qx, qy, _ = est.q_wxyz
+        q = est.q_wxyz
+        qx, qy = q[1], q[2]  # not `_, qx, qy, _ = q`: compiled, `_` holds an object and boxes its floats
         # cos(tilt) = cos(roll) cos(pitch): a vehicle tilted less than both limits has neither beyond (cheap test)
         if not armed or 1.0 - 2.0 * (qx * qx + qy * qy) > s.fd_cos_tilt:
             since[0] = since[1] = None
