@@ -35,9 +35,11 @@ def manoeuvre(v: Vehicle, after_step: Callable[[], None] | None = None) -> None:
             if sp is not None and v.time_us >= next_us[0]:
                 v.offboard_input(POS, sp)
                 next_us[0] = v.time_us + 50_000
-            v.step()
             if after_step is not None:
+                v.step()
                 after_step()
+            else:  # nothing between the steps up to the next setpoint: the vehicle's own loop steps there
+                v.run_until(end if sp is None else min(end, next_us[0]))
 
     run(2.5)
     _command(v, MavCmd.COMPONENT_ARM_DISARM, 1.0)

@@ -24,7 +24,7 @@ from typing import Final
 
 from sitl_emu.control.qmath import (
     add,
-    constrain3,
+    constrain,
     dcm_z,
     norm,
     q_from_yaw,
@@ -39,9 +39,6 @@ from sitl_emu.types import Vec3, Vec4
 GRAVITY_M_S2: Final = 9.80665  # PX4 CONSTANTS_ONE_G
 DEFAULT_DT_S: Final = 0.004  # SIH lockstep at 250 Hz (reference 7.6)
 MAX_RATE_RAD_S: Final = 6.0 * math.pi  # sih.cpp clamps the body rates to +-6 pi rad/s
-# not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183)
-_RATE_MAX: Vec3 = (MAX_RATE_RAD_S, MAX_RATE_RAD_S, MAX_RATE_RAD_S)
-_RATE_MIN: Vec3 = (-MAX_RATE_RAD_S, -MAX_RATE_RAD_S, -MAX_RATE_RAD_S)
 
 
 @dataclass(slots=True)
@@ -153,7 +150,9 @@ def _rates_step(rates: Vec3, u: Vec4, dt_s: float, cfg: SihConfig) -> Vec3:
     dp = (m_x + (iyy - izz) * q * r) / ixx
     dq = (m_y + (izz - ixx) * r * p) / iyy
     dr = (m_z + (ixx - iyy) * p * q) / izz
-    return constrain3(add(rates, scale((dp, dq, dr), dt_s)), _RATE_MIN, _RATE_MAX)
+    p, q, r = add(rates, scale((dp, dq, dr), dt_s))
+    lim = MAX_RATE_RAD_S  # per axis, as a scalar: a module tuple of limits would be looked up in the module's dict
+    return constrain(p, -lim, lim), constrain(q, -lim, lim), constrain(r, -lim, lim)
 
 
 def _attitude_step(q: Vec4, rates: Vec3, dt_s: float) -> Vec4:

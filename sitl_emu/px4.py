@@ -193,7 +193,7 @@ MODE_FLAG_MANUAL_INPUT_ENABLED: Final = 64
 MODE_FLAG_SAFETY_ARMED: Final = 128
 
 # nav_state -> (main_mode, sub_mode) as get_px4_custom_mode() encodes it (v1.15-v1.17: DESCEND -> AUTO.LAND).
-_NAV_TO_MAIN_SUB: dict[NavState, tuple[int, int]] = {
+_NAV_TO_MAIN_SUB: Final[dict[NavState, tuple[int, int]]] = {
     NavState.MANUAL: (MainMode.MANUAL, 0),
     NavState.ALTCTL: (MainMode.ALTCTL, 0),
     NavState.POSCTL: (MainMode.POSCTL, PosctlSubMode.POSCTL),
@@ -217,7 +217,7 @@ _NAV_TO_MAIN_SUB: dict[NavState, tuple[int, int]] = {
 }
 
 # Mode names from src/lib/modes/ui.hpp, used in "Switching to %s is currently not available".
-UI_NAMES: dict[NavState, str] = {
+UI_NAMES: Final[dict[NavState, str]] = {
     NavState.MANUAL: "Manual",
     NavState.ALTCTL: "Altitude",
     NavState.POSCTL: "Position",
@@ -259,7 +259,7 @@ SHELL_MODE_NAMES: dict[str, NavState] = {
     "auto:precland": NavState.AUTO_PRECLAND,
 }
 
-AUTO_MODES = frozenset(
+AUTO_MODES: Final = frozenset(
     {NavState.AUTO_MISSION, NavState.AUTO_LOITER, NavState.AUTO_RTL, NavState.AUTO_TAKEOFF,
      NavState.AUTO_LAND, NavState.AUTO_FOLLOW_TARGET, NavState.AUTO_PRECLAND,
      NavState.AUTO_VTOL_TAKEOFF, NavState.GUIDED_COURSE, NavState.DESCEND}
@@ -268,10 +268,10 @@ AUTO_MODES = frozenset(
 
 # control_mode flag_control_manual_enabled modes, split by who controls the thrust (ModeUtil/control_mode.cpp):
 # the climb-rate modes (the sticks command a climb rate) and the manual-thrust ones (the throttle is the thrust)
-CLIMB_RATE_MANUAL_MODES = frozenset({NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
-                                     NavState.ALTITUDE_CRUISE})
-MANUAL_THRUST_MODES = frozenset({NavState.MANUAL, NavState.STAB, NavState.ACRO})
-MANUAL_MODES = CLIMB_RATE_MANUAL_MODES | MANUAL_THRUST_MODES
+CLIMB_RATE_MANUAL_MODES: Final = frozenset({NavState.ALTCTL, NavState.POSCTL, NavState.POSITION_SLOW,
+                                            NavState.ALTITUDE_CRUISE})
+MANUAL_THRUST_MODES: Final = frozenset({NavState.MANUAL, NavState.STAB, NavState.ACRO})
+MANUAL_MODES: Final = CLIMB_RATE_MANUAL_MODES | MANUAL_THRUST_MODES
 
 
 def main_sub(nav_state: NavState) -> tuple[int, int]:
@@ -311,7 +311,7 @@ def nav_state_from_main_sub(main: int, sub: int) -> NavState | None:
     return None
 
 
-_AUTO_SUB_TO_NAV: dict[int, NavState] = {
+_AUTO_SUB_TO_NAV: Final[dict[int, NavState]] = {
     AutoSubMode.LOITER: NavState.AUTO_LOITER,
     AutoSubMode.MISSION: NavState.AUTO_MISSION,
     AutoSubMode.RTL: NavState.AUTO_RTL,

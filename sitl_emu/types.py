@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Final
 
 from sitl_emu.px4 import LandedState, NavState, Severity
 
 Vec3 = tuple[float, float, float]
 Vec4 = tuple[float, float, float, float]
 
-NAN = math.nan
+NAN: Final = math.nan
 NAN3: Vec3 = (NAN, NAN, NAN)
 
 

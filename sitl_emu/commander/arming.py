@@ -31,7 +31,7 @@ class Req:
 _A, _P, _M = Req.ATTITUDE, Req.POSITION, Req.MANUAL
 
 # mode_requirements.cpp, multicopter (ROTARY_WING) branch
-_REQUIREMENTS: dict[NavState, int] = {
+_REQUIREMENTS: Final[dict[NavState, int]] = {
     NavState.MANUAL: _M,
     NavState.ALTCTL: _A | _P | _M,
     NavState.ALTITUDE_CRUISE: _A | _P | _M,
@@ -55,7 +55,7 @@ _REQUIREMENTS: dict[NavState, int] = {
 }
 
 # The reasons modeCheck.cpp reports (as events) for each failed requirement, in its order.
-_REASONS: tuple[tuple[int, str], ...] = (
+_REASONS: Final[tuple[tuple[int, str], ...]] = (
     (Req.ATTITUDE, "No valid attitude estimate"),
     (Req.POSITION, "Navigation error: No valid position estimate"),
     (Req.MISSION, "No valid mission available"),

@@ -61,17 +61,17 @@ class Decision:
 
 
 # COM_OBL_RC_ACT: 0 Position, 1 Altitude, 2 Stabilized (Manual), 3 Return, 4 Land, 5 Hold, 6 Terminate, 7 Disarm
-_OBL_ACTIONS: dict[int, NavState | None] = {
+_OBL_ACTIONS: Final[dict[int, NavState | None]] = {
     0: NavState.POSCTL, 1: NavState.ALTCTL, 2: NavState.STAB, 3: NavState.AUTO_RTL, 4: NavState.AUTO_LAND,
     5: NavState.AUTO_LOITER, 6: NavState.TERMINATION, 7: None,
 }
 # NAV_RCL_ACT / NAV_DLL_ACT: 1 Hold, 2 Return, 3 Land, 5 Terminate, 6 Disarm (0 "disabled" falls back to Hold)
-_RCL_ACTIONS: dict[int, NavState | None] = {
+_RCL_ACTIONS: Final[dict[int, NavState | None]] = {
     0: NavState.AUTO_LOITER, 1: NavState.AUTO_LOITER, 2: NavState.AUTO_RTL, 3: NavState.AUTO_LAND,
     4: NavState.AUTO_LAND, 5: NavState.TERMINATION, 6: None,
 }
-_MANUAL_CHAIN = (NavState.POSCTL, NavState.ALTCTL, NavState.STAB)
-_AUTO_CHAIN = (NavState.AUTO_LAND, NavState.DESCEND)
+_MANUAL_CHAIN: Final = (NavState.POSCTL, NavState.ALTCTL, NavState.STAB)
+_AUTO_CHAIN: Final = (NavState.AUTO_LAND, NavState.DESCEND)
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,12 +114,12 @@ def resolve_fallback(user: NavState, s: FallbackSettings, inputs: CheckInputs) -
 
 # framework.cpp's order of actions, the worst wins: fallbacks to Position < Altitude < Stabilized < Hold < Return <
 # Land < Descend < Disarm < Terminate
-_RANK: dict[NavState, int] = {
+_RANK: Final[dict[NavState, int]] = {
     NavState.POSCTL: 2, NavState.ALTCTL: 3, NavState.STAB: 4, NavState.AUTO_LOITER: 5, NavState.AUTO_RTL: 6,
     NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
 }
 _DISARM_RANK: Final = 9
-_HOLD_RANK = _RANK[NavState.AUTO_LOITER]
+_HOLD_RANK: Final = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT: Final = "Failsafe activated"
 
 # an action in force: (rank, mode, disarm, cause); rank 0: none, the user's mode. The rank is framework.h's Action.
@@ -183,7 +183,8 @@ class Failsafe:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
             action = _worse(action, user, wanted, self.manual_loss.disarm, CAUSE_MANUAL_CONTROL_LOSS)
         if faults is not None:
-            for want in self.faults.wanted(now_us, user, *faults):
+            flags, fault_settings = faults  # a starred call would go through Python's call protocol
+            for want in self.faults.wanted(now_us, user, flags, fault_settings):
                 action = _worse(action, user, want.mode, want.disarm, want.cause)
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)

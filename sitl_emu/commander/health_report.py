@@ -65,9 +65,10 @@ class HealthReport:
         return bool(self.can_arm >> int(nav_state) & 1)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class ReportInputs:
-    """What the checks look at (a hashable snapshot: the report is only rebuilt when it changes)."""
+    """What the checks look at (compared with the last: the report is only rebuilt when it changes); made every
+    100 ms, so not frozen, its `__init__` written out (ARCHITECTURE.md, On the tick path); read-only by convention."""
 
     nav_state: NavState
     armed: bool
@@ -80,6 +81,34 @@ class ReportInputs:
     manual_control: bool
     stick_input_disabled: bool  # COM_RC_IN_MODE 4
     datalink_required: bool  # NAV_DLL_ACT > 0
+
+    def __init__(self, nav_state: NavState, armed: bool, estimator_ready: bool, position_lost: bool, missing: int,
+                 geofence: GeofenceResult, gcs_lost: bool, battery_warning: int, manual_control: bool,
+                 stick_input_disabled: bool, datalink_required: bool) -> None:
+        self.nav_state = nav_state
+        self.armed = armed
+        self.estimator_ready = estimator_ready
+        self.position_lost = position_lost
+        self.missing = missing
+        self.geofence = geofence
+        self.gcs_lost = gcs_lost
+        self.battery_warning = battery_warning
+        self.manual_control = manual_control
+        self.stick_input_disabled = stick_input_disabled
+        self.datalink_required = datalink_required
+
+    def __eq__(self, other: object) -> bool:
+        """The dataclass's comparison, field by field, written out so that mypyc compiles it (the generated one
+        stays interpreted; the reporter compares every 100 ms)."""
+        if not isinstance(other, ReportInputs):
+            return NotImplemented
+        return (self.nav_state == other.nav_state and self.armed == other.armed
+                and self.estimator_ready == other.estimator_ready and self.position_lost == other.position_lost
+                and self.missing == other.missing and self.geofence == other.geofence
+                and self.gcs_lost == other.gcs_lost and self.battery_warning == other.battery_warning
+                and self.manual_control == other.manual_control
+                and self.stick_input_disabled == other.stick_input_disabled
+                and self.datalink_required == other.datalink_required)
 
     @classmethod
     def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,

@@ -84,7 +84,7 @@ class MulticopterControl:
 
     @property
     def attitude_setpoint_q_wxyz(self) -> Vec4 | None:
-        return self._q_sp
+        return self._q_sp if self._has_q_sp else None
 
     @property
     def rates_setpoint_rad_s(self) -> Vec3:
@@ -117,7 +117,10 @@ class MulticopterControl:
         self.rate.reset()
         self._local_setpoint = None
         self._local_out = None  # the local setpoint's source, until it is built
-        self._q_sp: Vec4 | None = None
+        # the attitude setpoint, valid while _has_q_sp: a plain Vec4 stays unboxed in the compiled build, where an
+        # optional one would be built as a Python tuple every tick
+        self._q_sp: Vec4 = (1.0, 0.0, 0.0, 0.0)
+        self._has_q_sp = False
         self._rates_sp: Vec3 = (0.0, 0.0, 0.0)
         self._thrust = 0.0
         self._in_failsafe = False
@@ -146,17 +149,20 @@ class MulticopterControl:
             self._pos_out = None
         if attitude_sp is not None:
             self.takeoff.update_state(armed, landed, False, now_us, skip_takeoff=True)
-            q_sp, rates_sp, thrust = self._attitude_mode(state, attitude_sp)
+            q_att, rates_sp, thrust = self._attitude_mode(state, attitude_sp)
+            self._has_q_sp = q_att is not None
+            if q_att is not None:
+                self._q_sp = q_att
             self._local_setpoint = self._local_out = None
         elif setpoint is not None:
             out = self._position_cycle(state, setpoint, landed, ground_contact, now_us, dt_s, want_takeoff)
-            q_sp, thrust = out.q_sp, out.collective
-            rates_sp = self.attitude.update(state.q_wxyz, q_sp, out.yawspeed_sp_rad_s)
+            self._q_sp, self._has_q_sp, thrust = out.q_sp, True, out.collective
+            rates_sp = self.attitude.update(state.q_wxyz, out.q_sp, out.yawspeed_sp_rad_s)
         else:
             self.takeoff.update_state(armed, landed, False, now_us)
             self._idle()
             return ZERO4
-        self._q_sp, self._rates_sp, self._thrust = q_sp, rates_sp, thrust
+        self._rates_sp, self._thrust = rates_sp, thrust
         torque = self.rate.update(state.rates_frd_rad_s, rates_sp, dt_s, landed, self._sat_pos, self._sat_neg)
         motors, self._sat_pos, self._sat_neg = mix(torque, thrust)
         return motors
@@ -170,7 +176,7 @@ class MulticopterControl:
     def _idle(self) -> None:
         self.position.reset_integral()
         self.rate.reset()
-        self._local_setpoint, self._q_sp, self._rates_sp, self._thrust = None, None, (0.0, 0.0, 0.0), 0.0
+        self._local_setpoint, self._has_q_sp, self._rates_sp, self._thrust = None, False, (0.0, 0.0, 0.0), 0.0
         self._local_out = None
 
     def _attitude_mode(self, state: RigidBodyState, sp: AttitudeSetpoint) -> tuple[Vec4 | None, Vec3, float]:

@@ -14,7 +14,10 @@ from sitl_emu.types import Vec3
 class LowPassDerivative:
     def __init__(self, cutoff_hz: float) -> None:
         self.cutoff_hz = cutoff_hz
-        self._prev: Vec3 | None = None
+        # the previous sample, valid once _has_prev: a plain Vec3 stays unboxed in the compiled build, where an
+        # optional one would be built as a Python tuple of three floats every update
+        self._prev: Vec3 = (0.0, 0.0, 0.0)
+        self._has_prev = False
         self._out: Vec3 = (0.0, 0.0, 0.0)
 
     @property
@@ -27,13 +30,14 @@ class LowPassDerivative:
         self._omega = 2.0 * math.pi * hz  # rad/s
 
     def reset(self) -> None:
-        self._prev = None
+        self._has_prev = False
         self._out = (0.0, 0.0, 0.0)
 
     def update(self, x: Vec3, dt_s: float) -> Vec3:
         """The filtered derivative of x; unchanged on the first sample (no previous value) or without a time step."""
-        prev, self._prev = self._prev, x
-        if prev is None or dt_s <= 0.0:
+        prev, had_prev = self._prev, self._has_prev
+        self._prev, self._has_prev = x, True
+        if not had_prev or dt_s <= 0.0:
             return self._out
         b = self._omega * dt_s
         alpha = b / (1.0 + b) if self._cutoff_hz > 0.0 else 1.0

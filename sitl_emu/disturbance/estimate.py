@@ -19,12 +19,14 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from sitl_emu.control.qmath import q_mul
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
 from sitl_emu.types import Vec3, Vec4
+
+if TYPE_CHECKING:  # numpy is imported where noise is drawn: a vehicle without noise or wind never loads it
+    import numpy as np
 
 
 @dataclass(frozen=True, slots=True)
@@ -62,6 +64,8 @@ class _Channel:
     """One 3-axis quantity: white noise plus a random-walk bias."""
 
     def __init__(self, white: float, walk: float) -> None:
+        import numpy as np
+
         self.white, self.walk = white, walk
         self.bias = np.zeros(3)
 
@@ -105,6 +109,8 @@ def _add(v: Vec3, n: np.ndarray) -> Vec3:
 
 
 def _rotated(q: Vec4, rot: np.ndarray) -> Vec4:
+    import numpy as np
+
     angle = float(np.linalg.norm(rot))
     if angle < 1e-12:
         return q

@@ -24,13 +24,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Final
-
-import numpy as np
+from typing import TYPE_CHECKING, Final
 
 from sitl_emu.types import Vec3
 
-# scipy.signal is imported where it is used: it takes seconds to import, and a vehicle without turbulence needs none
+if TYPE_CHECKING:
+    import numpy as np
+
+# scipy.signal is imported where it is used: it takes seconds to import, and a vehicle without turbulence needs none;
+# numpy likewise (its import costs 40 ms, and its BLAS threads spin for a while after it): a vehicle without wind or
+# estimate noise never loads it
 
 FT: Final = 0.3048  # m per foot
 TURBULENCE_LEVELS: Final = {"light": 15 * 0.514444, "moderate": 30 * 0.514444, "severe": 45 * 0.514444}  # W20 m/s
@@ -148,6 +151,7 @@ def dryden_transfer_functions(scales: DrydenScales, v_m_s: float) -> list[tuple[
 
 def discrete_filters(scales: DrydenScales, v_m_s: float, dt_s: float) -> list[tuple[np.ndarray, np.ndarray]]:
     """The shaping filters discretised with the bilinear transform (b, a for lfilter)."""
+    import numpy as np
     from scipy import signal
 
     out = []
@@ -161,6 +165,8 @@ class DrydenTurbulence:
     """Seeded Dryden turbulence (u, v, w in m/s), a block of samples at a time."""
 
     def __init__(self, w20_m_s: float, v_m_s: float, dt_s: float, rng: np.random.Generator) -> None:
+        import numpy as np
+
         self.w20, self.v, self.dt = w20_m_s, max(v_m_s, MIN_TURBULENCE_V_M_S), dt_s
         self._rng = rng
         self._band: int | None = None
@@ -173,6 +179,7 @@ class DrydenTurbulence:
         if band != self._band:
             self._band = band
             self._filters = discrete_filters(dryden_scales((band + 0.5) * ALTITUDE_BAND_M, self.w20), self.v, self.dt)
+        import numpy as np
         from scipy import signal
 
         noise = self._rng.standard_normal((3, n)) * math.sqrt(math.pi / self.dt)  # one-sided PSD 1 per rad/s
@@ -186,6 +193,8 @@ class WindModel:
     """The air mass velocity (NED, m/s) tick by tick: mean + SIH_WIND_N/E + turbulence + gusts."""
 
     def __init__(self, settings: WindSettings, dt_s: float, rng: np.random.Generator) -> None:
+        import numpy as np
+
         self.settings = settings
         self._dt = dt_s
         self._mean = settings.mean_ned()

@@ -30,7 +30,7 @@ WANT_TAKEOFF_VZ_M_S: Final = -0.3  # FlightTaskAuto: _want_takeoff = unsmoothed 
 YAW_FIRST: Final = 4  # MPC_YAW_MODE towards_waypoint_yaw_first
 REACTIVATE_VZ_M_S: Final = 0.7  # FlightTaskAuto::reActivate resets the trajectory velocity to 0.7 m/s down
 IDLE_ACC_Z_M_S2: Final = 100.0  # FlightTaskAuto idle: "high downwards acceleration to make sure there's no thrust"
-_IDLE_SETPOINT = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
+_IDLE_SETPOINT: Final = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, IDLE_ACC_Z_M_S2), yaw_rad=NAN)
 
 
 @dataclass(frozen=True, slots=True)
@@ -77,7 +77,7 @@ class AutoSettings:
         return cls(**values)
 
 
-_PARAM_NAMES: dict[str, tuple[str, float]] = {
+_PARAM_NAMES: Final[dict[str, tuple[str, float]]] = {
     "jerk": ("MPC_JERK_AUTO", 4.0), "acc_hor": ("MPC_ACC_HOR", 3.0), "acc_up": ("MPC_ACC_UP_MAX", 4.0),
     "acc_down": ("MPC_ACC_DOWN_MAX", 3.0), "xy_vel_max": ("MPC_XY_VEL_MAX", 12.0),
     "z_v_auto_up": ("MPC_Z_V_AUTO_UP", 3.0), "z_v_auto_dn": ("MPC_Z_V_AUTO_DN", 1.5),

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Final
 
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import isfinite
@@ -51,15 +52,17 @@ from sitl_emu.types import (
     Vec3,
 )
 
-_TASK_MODES = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
-                         NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
-                         NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
-_STICK_ATTITUDE_MODES = frozenset({NavState.STAB, NavState.MANUAL})
+_TASK_MODES: Final = frozenset({NavState.AUTO_LOITER, NavState.AUTO_TAKEOFF, NavState.AUTO_LAND, NavState.DESCEND,
+                                NavState.AUTO_RTL, NavState.POSCTL, NavState.POSITION_SLOW, NavState.ALTCTL,
+                                NavState.AUTO_MISSION, NavState.ORBIT, NavState.AUTO_FOLLOW_TARGET})
+_STICK_ATTITUDE_MODES: Final = frozenset({NavState.STAB, NavState.MANUAL})
 # the modes flight_mode_manager flies with FlightTaskAuto (FlightModeManager::start_flight_task): one after another
 # the task runs on, so the heading setpoint carries over
-_FLIGHT_TASK_AUTO = frozenset({NavState.AUTO_TAKEOFF, NavState.AUTO_LOITER, NavState.AUTO_MISSION, NavState.AUTO_RTL,
-                               NavState.AUTO_LAND})
+_FLIGHT_TASK_AUTO: Final = frozenset({NavState.AUTO_TAKEOFF, NavState.AUTO_LOITER, NavState.AUTO_MISSION,
+                                      NavState.AUTO_RTL, NavState.AUTO_LAND})
 FlightTask = auto.Task | ManualAltitudeTask | orbit.FailedOrbitHold | FollowTargetTask
+# the tasks that read the sticks: a tuple, as `A | B` in isinstance builds a union object at every check
+_STICK_TASKS: Final = (ManualAltitudeTask, FollowTargetTask)
 
 
 @dataclass(slots=True)
@@ -85,7 +88,7 @@ class ExecutorOutput:
         self.want_takeoff = want_takeoff
 
 
-_NO_SETPOINT = ExecutorOutput(None, None, SetpointType.NONE, False, ())
+_NO_SETPOINT: Final = ExecutorOutput(None, None, SetpointType.NONE, False, ())
 
 
 class ModeExecutor:
@@ -103,6 +106,7 @@ class ModeExecutor:
         self._offboard_out: ExecutorOutput | None = None  # built from the offboard inputs when they change
         self._held: ExecutorOutput | None = None  # the task's last output, reused until task.period_us has passed
         self._last_us = 0  # when the task last ran
+        self._next_us = 0  # when it runs again: _last_us + its period_us (read once a run, not every tick)
         # where Return goes when not home (a rally point: NED position, yaw), asked as RTL starts; the vehicle sets it
         self.rtl_destination: Callable[[auto.NavInput], ReturnDestination | None] | None = None
         # the geofence avoidance waypoints (north, east) from the vehicle to a return destination; the vehicle sets it
@@ -176,14 +180,14 @@ class ModeExecutor:
         held = self._held
         dt = dt_s
         if held is not None and not new_task:
-            if now_us - self._last_us < task.period_us:
+            if now_us < self._next_us:
                 return held
             dt = (now_us - self._last_us) * 1e-6
-        if isinstance(task, ManualAltitudeTask | FollowTargetTask):
+        if isinstance(task, _STICK_TASKS):
             task.sticks = sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
-        self._last_us = now_us
+        self._last_us, self._next_us = now_us, now_us + task.period_us
         messages = task.drain_messages()
         if not messages:
             return held

@@ -16,7 +16,6 @@ pulled towards an L1-like crossing point on the line from the previous waypoint 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -51,7 +50,7 @@ def speed_in_turn(alpha: float, accel: float, radius: float) -> float:
 
 def _angle(a: tuple[float, float], b: tuple[float, float]) -> float:
     """The angle between two 2D vectors (a zero vector counts as orthogonal, as unit_or_zero makes it)."""
-    na, nb = math.hypot(*a), math.hypot(*b)
+    na, nb = math.hypot(a[0], a[1]), math.hypot(b[0], b[1])
     if na <= _EPS or nb <= _EPS:
         return math.pi / 2.0
     return math.acos(max(-1.0, min(1.0, (a[0] * b[0] + a[1] * b[1]) / (na * nb))))
@@ -230,7 +229,7 @@ class AxisSmoother:
         return self._saturate_t1(a0, jerk, t1)
 
 
-def synchronize(axes: Sequence[AxisSmoother]) -> None:
+def synchronize(axes: list[AxisSmoother]) -> None:
     """Make every axis finish its velocity change together with the slowest one
     (VelocitySmoothing::timeSynchronization)."""
     totals = [axis.total_time for axis in axes]  # each read before its own axis changes

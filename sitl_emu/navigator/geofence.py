@@ -256,6 +256,14 @@ class GeofenceResult:
     custom: bool = False
     action: int = GF_ACTION_NONE
 
+    def __eq__(self, other: object) -> bool:
+        """The dataclass's comparison, written out so that mypyc compiles it (the commander's checks compare results
+        every cycle)."""
+        if not isinstance(other, GeofenceResult):
+            return NotImplemented
+        return (self.max_dist == other.max_dist and self.max_alt == other.max_alt and self.custom == other.custom
+                and self.action == other.action)
+
     @property
     def triggered(self) -> bool:
         return self.max_dist or self.max_alt or self.custom

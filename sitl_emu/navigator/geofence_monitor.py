@@ -43,9 +43,11 @@ def geofence_settings(p: ParamRegistry) -> GeofenceSettings:
                             max_hor_dist_m=float(p["GF_MAX_HOR_DIST"]), max_ver_dist_m=float(p["GF_MAX_VER_DIST"]))
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class GeofenceInputs:
-    """What the navigator sees at a check: positions (None while not valid), home (None while not set), state."""
+    """What the navigator sees at a check: positions (None while not valid), home (None while not set), state.
+    Made at every check, so not frozen, its `__init__` written out (ARCHITECTURE.md, On the tick path); read-only by
+    convention."""
 
     estimate: GeoPoint | None
     gps: GeoPoint | None
@@ -53,6 +55,15 @@ class GeofenceInputs:
     landed: bool
     armed: bool
     in_hold: bool  # nav_state AUTO_LOITER
+
+    def __init__(self, estimate: GeoPoint | None, gps: GeoPoint | None, home: GeoPoint | None, landed: bool,
+                 armed: bool, in_hold: bool) -> None:
+        self.estimate = estimate
+        self.gps = gps
+        self.home = home
+        self.landed = landed
+        self.armed = armed
+        self.in_hold = in_hold
 
 
 @dataclass(slots=True)
@@ -64,6 +75,13 @@ class GeofenceStep:
     health_texts: list[str] = field(default_factory=list)
     reposition: GeoPoint | None = None
 
+    def __init__(self, navigator_texts: list[str] | None = None, health_texts: list[str] | None = None,
+                 reposition: GeoPoint | None = None) -> None:
+        """Written out (made at every check; ARCHITECTURE.md, On the tick path); None stands for a new empty list."""
+        self.navigator_texts = navigator_texts if navigator_texts is not None else []
+        self.health_texts = health_texts if health_texts is not None else []
+        self.reposition = reposition
+
 
 class GeofenceMonitor:
     """The navigator's Geofence plus geofence_breach_check, and the commander's view of its result."""
@@ -71,7 +89,8 @@ class GeofenceMonitor:
     def __init__(self) -> None:
         self.fence = Geofence()
         self.result: GeofenceResult = NO_BREACH
-        self._plan_key: tuple[int, int] | None = None
+        # the fence plan in force: its CRC32 and item count (-1: none yet, never a plan's), compared every cycle
+        self._plan_id, self._plan_count = -1, -1
         self._last_check_us: int | None = None
         self._latched_at_us = 0  # _time_loitering_after_gf_breach (0: not latched)
         self._reposition_sent = False
@@ -79,15 +98,17 @@ class GeofenceMonitor:
     def due(self, now_us: int, plan: Plan, position_valid: bool = True) -> bool:
         """Whether `update` would do anything now (the caller may skip building its inputs otherwise). Without a
         valid position (`update` gets None for it) only a new fence plan or the post-breach latch need an update."""
-        if (plan.opaque_id, plan.count) != self._plan_key or self._latched_at_us:
+        if self._new_plan(plan) or self._latched_at_us:
             return True
         return position_valid and (self._last_check_us is None or now_us - self._last_check_us > CHECK_INTERVAL_US)
 
+    def _new_plan(self, plan: Plan) -> bool:
+        return plan.opaque_id != self._plan_id or plan.count != self._plan_count
+
     def update(self, now_us: int, plan: Plan, s: GeofenceSettings, inp: GeofenceInputs) -> GeofenceStep:
         step = GeofenceStep()
-        key = (plan.opaque_id, plan.count)
-        if key != self._plan_key:  # navigator_main: mission.geofence_id changed -> updateFence
-            self._plan_key = key
+        if self._new_plan(plan):  # navigator_main: mission.geofence_id changed -> updateFence
+            self._plan_id, self._plan_count = plan.opaque_id, plan.count
             self.fence, step.navigator_texts = build_fence(plan.items, home=inp.home, position=inp.estimate,
                                                            landed=inp.landed, action=s.action)
         if not inp.in_hold and self._latched_at_us and now_us - self._latched_at_us > LATCH_RELEASE_US:

@@ -25,7 +25,7 @@ PLAN_MISSION: Final = 0
 PLAN_FENCE: Final = 1
 PLAN_RALLY: Final = 2
 PLAN_ALL: Final = 255  # MAV_MISSION_TYPE_ALL: MISSION_CLEAR_ALL of every plan
-PLAN_TYPES = (PLAN_MISSION, PLAN_FENCE, PLAN_RALLY)
+PLAN_TYPES: Final = (PLAN_MISSION, PLAN_FENCE, PLAN_RALLY)
 
 # How many items each plan holds (MavlinkMissionManager::MAX_COUNT from dataman.h: the mission's
 # CONFIG_NUM_MISSION_ITMES_SUPPORTED, 10000 in the px4_sitl board configuration as a third party reports it (Kconfig's

@@ -54,7 +54,8 @@ class ControlChain:
         home = c.home
         local = self.control.local_setpoint
         return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, yaw_from_q(est.q_wxyz),
-                        home.pos_ned_m if home else (0.0, 0.0, 0.0), home.yaw_rad if home else 0.0, c.landed, c.armed,
+                        home.pos_ned_m if home is not None else (0.0, 0.0, 0.0),
+                        home.yaw_rad if home is not None else 0.0, c.landed, c.armed,
                         self.control.takeoff.state, ref.alt_amsl_m,
                         local.velocity_ned_m_s if local is not None else NAN3)
 

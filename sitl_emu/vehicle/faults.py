@@ -21,9 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Final
-
-import numpy as np
+from typing import TYPE_CHECKING, Final
 
 from sitl_emu.commander import failure_injection as fi
 from sitl_emu.commander.battery import (
@@ -42,6 +40,9 @@ from sitl_emu.params import ParamRegistry
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.px4 import MavResult, Severity
 from sitl_emu.types import CommandAck, Vec3, VehicleCommand
+
+if TYPE_CHECKING:
+    import numpy as np
 
 # emit(severity, module, text, is_event, statustext)
 Emit = Callable[[Severity, str, str, bool, bool], None]
@@ -83,9 +84,8 @@ class VehicleFaults:
         self.manager_running = int(params["SYS_FAILURE_EN"]) == 1  # reboot_required: read at boot
         self.battery = BatterySimulator()
         self._settings, self._params_version = MonitorSettings.from_params(params), params.version
-        self.wind = WindModel(wind, dt_s, np.random.default_rng([seed, WIND_STREAM])) if wind and wind.active else None
-        self.noise = (EstimateNoise(noise, np.random.default_rng(seed))
-                      if noise is not None and noise.active else None)
+        self.wind = WindModel(wind, dt_s, _rng([seed, WIND_STREAM])) if wind and wind.active else None
+        self.noise = EstimateNoise(noise, _rng(seed)) if noise is not None and noise.active else None
         self._gps_off_us: int | None = None
         self._fd_since_us: list[int | None] = [None, None]  # roll, pitch beyond their limit since
         self._last_gcs_us: int | None = None
@@ -141,7 +141,8 @@ class VehicleFaults:
     def _attitude_failed(self, now_us: int, armed: bool, est: RigidBodyState, s: MonitorSettings) -> bool:
         """Roll or pitch beyond its limit for its trigger time (each with its own hysteresis, as PX4's)."""
         since = self._fd_since_us
-        _, qx, qy, _ = est.q_wxyz
+        q = est.q_wxyz
+        qx, qy = q[1], q[2]  # not `_, qx, qy, _ = q`: compiled, `_` holds an object and boxes its floats
         # cos(tilt) = cos(roll) cos(pitch): a vehicle tilted less than both limits has neither beyond (cheap test)
         if not armed or 1.0 - 2.0 * (qx * qx + qy * qy) > s.fd_cos_tilt:
             since[0] = since[1] = None
@@ -201,3 +202,11 @@ class VehicleFaults:
             self.battery.failed = bool(self.failures.mask(fi.BATTERY))
         elif unit == fi.MOTOR:
             self._motor_stop = self.failures.mask(fi.MOTOR)
+
+
+def _rng(seed: int | list[int]) -> np.random.Generator:
+    """numpy's seeded generator, numpy imported only here: a vehicle without wind or noise never loads it (its import
+    costs tens of ms, and its BLAS threads then spin for a while on the process's CPU time)."""
+    import numpy as np
+
+    return np.random.default_rng(seed)

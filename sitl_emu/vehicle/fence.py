@@ -38,7 +38,8 @@ Emit = Callable[[Severity, str, str, bool, bool], None]
 
 
 def _geo(ref: GeoRef, pos_ned_m: Vec3) -> GeoPoint:
-    return GeoPoint(*ned_to_global(ref, pos_ned_m))
+    lat_deg, lon_deg, alt_amsl_m = ned_to_global(ref, pos_ned_m)
+    return GeoPoint(lat_deg, lon_deg, alt_amsl_m)
 
 
 def home_point(c: Commander) -> GeoPoint | None:
@@ -77,8 +78,14 @@ class FenceChecks:
         if self._inputs_replaced(store.plan(PLAN_MISSION), fence, c):
             self._check_mission(store, c, emit)
         if self.monitor.fence.areas and c.estimator_ready and c.nav_state is not NavState.AUTO_RTL:
-            self.avoidance.track(now_us, self.monitor.fence.areas, estimate_ned_m,
-                                 lambda: rtl_target(estimate_ned_m, self.params, store, c, ref), ref, emit)
+            self._track_avoidance(now_us, store, c, estimate_ned_m, ref, emit)
+
+    def _track_avoidance(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, ref: GeoRef,
+                         emit: Emit) -> None:
+        """Return's way around the fence, kept up to date while a fence has areas (its own method: compiled, the
+        lambda's closure would be built at every call of step)."""
+        self.avoidance.track(now_us, self.monitor.fence.areas, estimate_ned_m,
+                             lambda: rtl_target(estimate_ned_m, self.params, store, c, ref), ref, emit)
 
     def rtl_avoidance(self, pos_ned_m: Vec3, destination_ned_m: Vec3, ref: GeoRef,
                       emit: Emit) -> list[tuple[float, float]]:

@@ -105,6 +105,7 @@ class Vehicle:
         self._mission_finished = False  # the mission result's `finished` the commander last saw
         self._commander_last_us = -COMMANDER_PERIOD_US
         self._nav_fn = self._nav_input  # bound once: the executor is handed it every tick
+        self._emit_fn = self._emit  # likewise, for the geofence work every commander cycle
         self._missions = MissionStore()  # in memory only: a reboot empties it (navigator/mission_store.py)
         self.faults = VehicleFaults(self.params, self.commander.fault_flags, self._emit, seed=self._seed,
                                     dt_s=self.dt_us * 1e-6, wind=self._wind_settings, noise=self._estimate_noise)
@@ -129,14 +130,14 @@ class Vehicle:
         now = self._time_us = self._time_us + self.dt_us
         self._snap = None
         if c.nav_commands:  # the navigator refuses targets outside the geofence (fence.py)
-            self._fence.check_commands(c, self.ref, self._estimate.pos_ned_m, self._emit)
+            self._fence.check_commands(c, self.ref, self._estimate.pos_ned_m, self._emit_fn)
         dt_s = self.dt_us * 1e-6
         if now - self._commander_last_us >= COMMANDER_PERIOD_US:
             self._commander_last_us = now
             self.faults.update(now, c.armed, self._estimate)
             c.observe(now, estimator_ready=now >= self._ready_delay_us, task_finished=self._task_finished)
             self._fence.step(now, self._missions, c, self._estimate.pos_ned_m, self._state.pos_ned_m, self.ref,
-                             self._emit)
+                             self._emit_fn)
             c.update(now)
         chain = self.chain
         out = chain.executor.update(c.nav_state, c.armed, now, self._nav_fn, c.nav_commands, self.ref, dt_s,

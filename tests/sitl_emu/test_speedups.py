@@ -21,7 +21,10 @@ import pytest
 from support import REPO_ROOT
 
 from sitl_emu import _speedups
+from sitl_emu.commander.health_report import ReportInputs
+from sitl_emu.navigator.geofence import GeofenceResult
 from sitl_emu.physics import RIGID_BODY_FIELDS, RigidBodyState
+from sitl_emu.px4 import NavState
 
 SUFFIX = importlib.machinery.EXTENSION_SUFFIXES[0]
 ROOT = REPO_ROOT
@@ -215,3 +218,29 @@ def test_written_out_dataclass_inits_match_the_generated_ones():
         assigned = [t.attr for stmt in init.body if isinstance(stmt, ast.Assign) for t in stmt.targets
                     if isinstance(t, ast.Attribute) and ast.unparse(t.value) == "self"]
         assert assigned == [f.target.id for f in fields], name  # every field set, in order
+
+
+def _other_value(value: object) -> object:
+    """A value of the same kind that differs from `value`."""
+    if isinstance(value, bool):
+        return not value
+    if isinstance(value, NavState):
+        return NavState.AUTO_RTL if value is not NavState.AUTO_RTL else NavState.AUTO_LAND
+    if isinstance(value, int):
+        return value + 1
+    if isinstance(value, GeofenceResult):
+        return dataclasses.replace(value, max_dist=not value.max_dist)
+    raise AssertionError(f"no other value for {value!r}")
+
+
+@pytest.mark.parametrize("instance", [
+    GeofenceResult(max_alt=True, action=1),
+    ReportInputs(NavState.AUTO_LOITER, True, True, False, 3, GeofenceResult(), False, 0, True, False, True),
+], ids=lambda i: type(i).__name__)
+def test_written_out_dataclass_comparisons_match_the_generated_ones(instance):
+    """A written-out __eq__ (compiled by mypyc, unlike a generated one) is equal exactly when every field is."""
+    assert instance == dataclasses.replace(instance)
+    assert instance != object()
+    for field in dataclasses.fields(instance):
+        changed = dataclasses.replace(instance, **{field.name: _other_value(getattr(instance, field.name))})
+        assert instance != changed, field.name
