@@ -102,8 +102,7 @@ def estimate_valid(estimator_ready: bool, position_lost: bool) -> int:
 class CheckInputs:
     """What the checks look at, at one instant.
 
-    Made every commander cycle; read-only by convention (see ARCHITECTURE.md, On the tick path). `have` is the set
-    of Req bits these inputs satisfy, worked out once here."""
+    Made every commander cycle; read-only by convention (see ARCHITECTURE.md, On the tick path)."""
 
     estimator_ready: bool  # the estimator's warm-up is over (SITL: a fixed delay after boot)
     home_valid: bool
@@ -111,7 +110,6 @@ class CheckInputs:
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # a valid mission is stored (navigator/mission_store.py MissionStore.mission_valid)
     position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle/faults.py)
-    have: int = 0
 
     def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
                  mission_valid: bool = False, position_lost: bool = False) -> None:
@@ -121,20 +119,19 @@ class CheckInputs:
         self.manual_control = manual_control
         self.mission_valid = mission_valid
         self.position_lost = position_lost
-        have = estimate_valid(estimator_ready, position_lost) | Req.WIND_AND_FLIGHT_TIME
-        if home_valid:
-            have |= Req.HOME
-        if mission_valid:
-            have |= Req.MISSION
-        if offboard_signal:
-            have |= Req.OFFBOARD
-        if manual_control:
-            have |= Req.MANUAL
-        self.have = have
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
-        return self.have
+        have = estimate_valid(self.estimator_ready, self.position_lost) | Req.WIND_AND_FLIGHT_TIME
+        if self.home_valid:
+            have |= Req.HOME
+        if self.mission_valid:
+            have |= Req.MISSION
+        if self.offboard_signal:
+            have |= Req.OFFBOARD
+        if self.manual_control:
+            have |= Req.MANUAL
+        return have
 
 
 def offboard_available(mode: OffboardControlMode, estimate: int) -> bool:
@@ -156,7 +153,7 @@ def mode_prevents_arming(nav_state: NavState) -> bool:
 
 def missing(nav_state: NavState, c: CheckInputs) -> int:
     """The requirements of nav_state that are not met now (PREVENT_ARMING excluded)."""
-    return requirements(nav_state) & ~(c.have | Req.PREVENT_ARMING)
+    return requirements(nav_state) & ~(c.available() | Req.PREVENT_ARMING)
 
 
 def can_run(nav_state: NavState, c: CheckInputs, ignoring: int = Req.NONE) -> bool:
