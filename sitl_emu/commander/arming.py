@@ -1,10 +1,13 @@
 """Mode requirements, "can run" and "can arm" for a multicopter, as PX4's health and arming checks decide them.
 
 Pure functions of a `CheckInputs` snapshot. Sources:
-- which mode needs what: src/modules/commander/ModeUtil/mode_requirements.cpp (rotary-wing branch)
-- how a failed requirement clears the can-run/arming bits and the reason texts:
-  src/modules/commander/HealthAndArmingChecks/checks/modeCheck.cpp
-- offboard signal freshness: HealthAndArmingChecks/checks/offboardCheck.cpp (timestamp + COM_OF_LOSS_T > now)
+- which mode needs what: src/modules/commander/ModeUtil/mode_requirements.cpp getModeRequirements (the flags
+  failsafe_flags.mode_req_*, multicopter (ROTARY_WING) branch); one `Req` bit per flag;
+- what the estimator provides: HealthAndArmingChecks/checks/estimatorCheck.cpp setModeRequirementFlags (the
+  failsafe_flags *_invalid bits), modelled by `estimate_valid` from what the emulator knows;
+- how a failed requirement clears the can-run/arming bits, in which order, with which texts:
+  HealthAndArmingChecks/checks/modeCheck.cpp (the health report, commander/health_report.py, sends them as events);
+- offboard signal freshness and the estimate it needs: HealthAndArmingChecks/checks/offboardCheck.cpp.
 """
 
 from __future__ import annotations
@@ -13,56 +16,86 @@ from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.px4 import NavState
+from sitl_emu.types import OffboardControlMode
 
 
 class Req:
-    """One bit per mode requirement (failsafe_flags.mode_req_*); plain ints, as enum.Flag is slow per step."""
+    """One bit per mode requirement (failsafe_flags.mode_req_*); plain ints, as enum.Flag is slow per step.
+
+    mode_req_global_position_relaxed (fixed-wing only), mode_req_other (external modes) and mode_req_not_possible
+    (rover) are set for no multicopter mode, so they have no bit here."""
 
     NONE: Final = 0
-    ATTITUDE: Final = 1  # angular velocity + attitude
-    POSITION: Final = 2  # local (relaxed or not), global position and local altitude
-    HOME: Final = 4
-    MISSION: Final = 8
-    OFFBOARD: Final = 16
-    MANUAL: Final = 32
-    PREVENT_ARMING: Final = 64
+    ANGULAR_VELOCITY: Final = 1
+    ATTITUDE: Final = 2
+    LOCAL_ALT: Final = 4
+    LOCAL_POSITION: Final = 8
+    LOCAL_POSITION_RELAXED: Final = 16  # no accuracy limit (COM_POS_FS_EPH): the pilot corrects the drift
+    GLOBAL_POSITION: Final = 32
+    MISSION: Final = 64
+    OFFBOARD: Final = 128
+    HOME: Final = 256
+    MANUAL: Final = 512
+    PREVENT_ARMING: Final = 1024
+    WIND_AND_FLIGHT_TIME: Final = 2048  # COM_WIND_MAX / COM_FLT_TIME_MAX: neither limit is simulated, always met
 
 
-_A, _P, _M = Req.ATTITUDE, Req.POSITION, Req.MANUAL
+_W, _A = Req.ANGULAR_VELOCITY, Req.ANGULAR_VELOCITY | Req.ATTITUDE
+_ALT, _LP, _LPR, _GP = Req.LOCAL_ALT, Req.LOCAL_POSITION, Req.LOCAL_POSITION_RELAXED, Req.GLOBAL_POSITION
+_M, _P, _WF = Req.MANUAL, Req.PREVENT_ARMING, Req.WIND_AND_FLIGHT_TIME
 
-# mode_requirements.cpp, multicopter (ROTARY_WING) branch
+# mode_requirements.cpp getModeRequirements, multicopter branch (MANUAL_PARKING is a rover mode)
 _REQUIREMENTS: Final[dict[NavState, int]] = {
     NavState.MANUAL: _M,
-    NavState.ALTCTL: _A | _P | _M,
-    NavState.ALTITUDE_CRUISE: _A | _P | _M,
-    NavState.POSCTL: _A | _P | _M,
-    NavState.POSITION_SLOW: _A | _P | _M,
-    NavState.AUTO_MISSION: _A | _P | Req.MISSION,
-    NavState.AUTO_LOITER: _A | _P,
-    NavState.GUIDED_COURSE: _A | _P,
-    NavState.AUTO_RTL: _A | _P | Req.HOME | Req.PREVENT_ARMING,
-    NavState.ACRO: _M,
-    NavState.DESCEND: _A | Req.PREVENT_ARMING,
-    NavState.TERMINATION: Req.PREVENT_ARMING,
+    NavState.ALTCTL: _A | _ALT | _M,
+    NavState.ALTITUDE_CRUISE: _A | _ALT | _M,
+    NavState.POSCTL: _A | _ALT | _LPR | _M,
+    NavState.POSITION_SLOW: _A | _ALT | _LPR | _M,
+    NavState.AUTO_MISSION: _A | _GP | _LP | _ALT | Req.MISSION | _WF,
+    NavState.AUTO_LOITER: _A | _GP | _LP | _ALT | _WF,
+    NavState.GUIDED_COURSE: _A | _ALT | _WF | _LPR,
+    NavState.AUTO_RTL: _A | _GP | _LP | _ALT | Req.HOME | _P,
+    NavState.ACRO: _W | _M,
+    NavState.DESCEND: _A | _P,
+    NavState.TERMINATION: _P,
     NavState.OFFBOARD: _A | Req.OFFBOARD,
     NavState.STAB: _A | _M,
-    NavState.AUTO_TAKEOFF: _A | _P,
-    NavState.AUTO_LAND: _A | _P | Req.PREVENT_ARMING,
-    NavState.AUTO_FOLLOW_TARGET: _A | _P | Req.PREVENT_ARMING,
-    NavState.AUTO_PRECLAND: _A | _P | Req.PREVENT_ARMING,
-    NavState.ORBIT: _A | _P | Req.PREVENT_ARMING,
-    NavState.AUTO_VTOL_TAKEOFF: _A | _P,
+    NavState.AUTO_TAKEOFF: _A | _ALT | _LP,
+    NavState.AUTO_LAND: _A | _ALT | _LPR | _P,
+    NavState.AUTO_FOLLOW_TARGET: _A | _LP | _ALT | _P | _WF,
+    NavState.AUTO_PRECLAND: _A | _LP | _ALT | _P,
+    NavState.ORBIT: _A | _LP | _ALT | _P | _WF,
+    NavState.AUTO_VTOL_TAKEOFF: _A | _ALT | _LP,
 }
 
-# The reasons modeCheck.cpp reports (as events) for each failed requirement, in its order.
+# modeCheck.cpp's checks in its order (after "Mode not suitable for arming"): the requirement bits each one looks at
+# and its text. The local position check covers the strict and the relaxed requirement.
 _REASONS: Final[tuple[tuple[int, str], ...]] = (
+    (Req.ANGULAR_VELOCITY, "Angular velocity not valid"),
     (Req.ATTITUDE, "No valid attitude estimate"),
-    (Req.POSITION, "Navigation error: No valid position estimate"),
+    (Req.LOCAL_POSITION | Req.LOCAL_POSITION_RELAXED, "No valid local position estimate"),
+    (Req.GLOBAL_POSITION, "No valid global position estimate"),
+    (Req.LOCAL_ALT, "No valid altitude estimate"),
     (Req.MISSION, "No valid mission available"),
+    (Req.OFFBOARD, "No offboard signal"),
     (Req.HOME, "Home position not set"),
     (Req.MANUAL, "No manual control input"),
-    (Req.OFFBOARD, "No offboard signal"),
 )
+PREVENTS_ARMING_TEXT: Final = "Mode not suitable for arming"
+_POSITION: Final = Req.LOCAL_POSITION | Req.LOCAL_POSITION_RELAXED | Req.GLOBAL_POSITION
+
+
+def estimate_valid(estimator_ready: bool, position_lost: bool) -> int:
+    """The Req bits the estimate satisfies (estimatorCheck.cpp setModeRequirementFlags, inverted *_invalid flags).
+
+    The simulated gyro gives an angular velocity from boot. Until the estimator's warm-up ends there is no attitude,
+    altitude or position. Afterwards a lost GPS (dead reckoning past EKF2_NOAID_TOUT, vehicle/faults.py) takes away
+    the local position (strict and relaxed: lpos.xy_valid is false) and the global position; the barometer keeps
+    the altitude and the IMU the attitude."""
+    if not estimator_ready:
+        return Req.ANGULAR_VELOCITY
+    have = Req.ANGULAR_VELOCITY | Req.ATTITUDE | Req.LOCAL_ALT
+    return have if position_lost else have | _POSITION
 
 
 @dataclass(slots=True)
@@ -71,9 +104,9 @@ class CheckInputs:
 
     Made every commander cycle; read-only by convention (see ARCHITECTURE.md, On the tick path)."""
 
-    estimator_ready: bool  # attitude, local/global position and altitude valid (SITL: after the warm-up)
+    estimator_ready: bool  # the estimator's warm-up is over (SITL: a fixed delay after boot)
     home_valid: bool
-    offboard_signal: bool  # an offboard_control_mode with a setpoint kind, younger than COM_OF_LOSS_T
+    offboard_signal: bool  # offboardCheck.cpp: a fresh offboard_control_mode whose setpoints the estimate supports
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # a valid mission is stored (navigator/mission_store.py MissionStore.mission_valid)
     position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle/faults.py)
@@ -89,9 +122,7 @@ class CheckInputs:
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
-        have = (Req.ATTITUDE | Req.POSITION) if self.estimator_ready else Req.NONE
-        if self.position_lost:
-            have &= ~Req.POSITION
+        have = estimate_valid(self.estimator_ready, self.position_lost) | Req.WIND_AND_FLIGHT_TIME
         if self.home_valid:
             have |= Req.HOME
         if self.mission_valid:
@@ -101,6 +132,15 @@ class CheckInputs:
         if self.manual_control:
             have |= Req.MANUAL
         return have
+
+
+def offboard_available(mode: OffboardControlMode, estimate: int) -> bool:
+    """offboardCheck.cpp, for a fresh signal of these setpoint kinds: the estimate they need is there (a local
+    position for positions, a local velocity (valid with the position here) for velocities, an attitude for
+    accelerations)."""
+    if mode.position or mode.velocity:
+        return bool(estimate & Req.LOCAL_POSITION)
+    return not mode.acceleration or bool(estimate & Req.ATTITUDE)
 
 
 def requirements(nav_state: NavState) -> int:
@@ -122,19 +162,19 @@ def can_run(nav_state: NavState, c: CheckInputs, ignoring: int = Req.NONE) -> bo
 
 
 def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> str | None:
-    """None if arming is allowed in nav_state, else the first failing check's text (canArm is False).
+    """None if arming is allowed in nav_state (canArm), else the text of the first of modeCheck.cpp's checks that
+    fails for it. A check clears the arming bits of the modes requiring what it misses, and nothing else: so with
+    the estimator still warming up, Manual and Acro can arm with sticks (they need no attitude estimate).
 
     While armed the "mode prevents arming" check is skipped (modeCheck.cpp), so vehicle_status.pre_flight_checks_pass
     stays true when flying in Return or Land."""
-    if not c.estimator_ready:
-        # Every arming check needs the estimator (ekf2 not ready: attitude/position invalid).
-        return "No valid attitude estimate"
     if not armed and mode_prevents_arming(nav_state):
-        return "Mode not suitable for arming"
+        return PREVENTS_ARMING_TEXT
     gaps = missing(nav_state, c)
-    for req, text in _REASONS:
-        if req & gaps:
-            return text
+    if gaps:
+        for req, text in _REASONS:
+            if req & gaps:
+                return text
     return None
 
 
@@ -143,5 +183,6 @@ def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:
 
 
 def modes_requiring(req: int) -> int:
-    """The nav_states (one bit each, as failsafe_flags.mode_req_* hold them) whose requirements include `req`."""
+    """The nav_states (one bit each, as failsafe_flags.mode_req_* hold them) whose requirements include any of
+    `req`'s bits."""
     return sum(1 << int(nav) for nav, r in _REQUIREMENTS.items() if r & req)

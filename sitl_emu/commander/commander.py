@@ -179,11 +179,10 @@ class Commander:
                                   mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost)
 
     def _offboard_available(self, now_us: int, st: CommanderSettings) -> bool:
-        """offboardCheck.cpp: a fresh signal, and for position or velocity setpoints a local position and velocity."""
-        if not self._offboard.fresh(now_us, st.of_loss_us):
-            return False
-        mode = self._offboard.mode
-        return not (self.fault_flags.position_lost and mode is not None and (mode.position or mode.velocity))
+        """offboardCheck.cpp: a fresh signal, with the estimate its setpoints need (commander/arming.py)."""
+        mode, fresh = self._offboard.mode, self._offboard.fresh(now_us, st.of_loss_us)
+        estimate = arming.estimate_valid(self.estimator_ready, self.fault_flags.position_lost)
+        return fresh and mode is not None and arming.offboard_available(mode, estimate)
 
     @property
     def mission_valid(self) -> bool:

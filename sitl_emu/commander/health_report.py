@@ -72,9 +72,7 @@ class ReportInputs:
 
     nav_state: NavState
     armed: bool
-    estimator_ready: bool
-    position_lost: bool
-    missing: int  # the Req bits the commander's CheckInputs do not satisfy
+    missing: int  # the Req bits the commander's CheckInputs do not satisfy (failsafe_flags' invalid bits)
     geofence: GeofenceResult
     gcs_lost: bool
     battery_warning: int  # battery_status WARNING_*
@@ -113,8 +111,7 @@ class ReportInputs:
     @classmethod
     def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
            stick_input_disabled: bool, datalink_required: bool) -> ReportInputs:
-        missing = ~c.available() & (Req.ATTITUDE | Req.POSITION | Req.HOME | Req.MISSION | Req.OFFBOARD | Req.MANUAL)
-        return cls(nav_state, armed, c.estimator_ready, c.position_lost, missing, geofence,
+        return cls(nav_state, armed, _CHECKED & ~c.available(), geofence,
                    faults.gcs_connection_lost, faults.battery_warning, c.manual_control, stick_input_disabled,
                    datalink_required)
 
@@ -179,22 +176,30 @@ def _geofence_checks(b: _Builder, g: GeofenceResult) -> None:
             b.fail(event, ALL_MODES, clear_run=False)
 
 
+# modeCheck.cpp's checks after "Mode not suitable for arming", in its order: the requirements each one looks at, its
+# event. Each clears the arming and can-run bits of the modes requiring what it misses. The angular velocity check
+# is left out: the simulated gyro never stops.
+_MODE_CHECKS: Final = (
+    (Req.ATTITUDE, ev.ATTITUDE),
+    (Req.LOCAL_POSITION | Req.LOCAL_POSITION_RELAXED, ev.LOCAL_POSITION),
+    (Req.GLOBAL_POSITION, ev.GLOBAL_POSITION),
+    (Req.LOCAL_ALT, ev.LOCAL_ALTITUDE),
+    (Req.MISSION, ev.MISSION),
+    (Req.OFFBOARD, ev.OFFBOARD_SIGNAL),
+    (Req.HOME, ev.HOME_POSITION),
+)
+_CHECKED: Final = Req.MANUAL | sum(req for req, _ in _MODE_CHECKS)
+
+
 def _mode_checks(b: _Builder, i: ReportInputs) -> None:
-    """modeCheck.cpp, in its order: the mode prevents arming (disarmed only), then each requirement not met."""
+    """modeCheck.cpp, in its order: the mode prevents arming (disarmed only), then each requirement not met, with
+    the modes that require it (mode_requirements.cpp, as commander/arming.py holds them)."""
     prevent = modes_requiring(Req.PREVENT_ARMING)
     if not i.armed and prevent >> int(i.nav_state) & 1:
         b.fail(ev.CANNOT_TAKEOFF, prevent, clear_run=False)
-    if i.missing & Req.ATTITUDE:
-        b.fail(ev.ATTITUDE, modes_requiring(Req.ATTITUDE))
-    if i.missing & Req.POSITION:
-        position = modes_requiring(Req.POSITION)
-        b.fail(ev.LOCAL_POSITION, position)
-        b.fail(ev.GLOBAL_POSITION, position)
-        if not i.estimator_ready:  # a lost GPS leaves the barometer's altitude
-            b.fail(ev.LOCAL_ALTITUDE, position)
-    for req, event in ((Req.MISSION, ev.MISSION), (Req.OFFBOARD, ev.OFFBOARD_SIGNAL), (Req.HOME, ev.HOME_POSITION)):
+    for req, event in _MODE_CHECKS:
         if i.missing & req:
-            b.fail(event, modes_requiring(req))
+            b.fail(event, modes_requiring(i.missing & req))
     if i.missing & Req.MANUAL:
         manual = modes_requiring(Req.MANUAL)
         disabled = i.stick_input_disabled
