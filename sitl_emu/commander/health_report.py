@@ -80,13 +80,11 @@ class ReportInputs:
     stick_input_disabled: bool  # COM_RC_IN_MODE 4
     datalink_required: bool  # NAV_DLL_ACT > 0
 
-    def __init__(self, nav_state: NavState, armed: bool, estimator_ready: bool, position_lost: bool, missing: int,
-                 geofence: GeofenceResult, gcs_lost: bool, battery_warning: int, manual_control: bool,
-                 stick_input_disabled: bool, datalink_required: bool) -> None:
+    def __init__(self, nav_state: NavState, armed: bool, missing: int, geofence: GeofenceResult, gcs_lost: bool,
+                 battery_warning: int, manual_control: bool, stick_input_disabled: bool,
+                 datalink_required: bool) -> None:
         self.nav_state = nav_state
         self.armed = armed
-        self.estimator_ready = estimator_ready
-        self.position_lost = position_lost
         self.missing = missing
         self.geofence = geofence
         self.gcs_lost = gcs_lost
@@ -101,7 +99,6 @@ class ReportInputs:
         if not isinstance(other, ReportInputs):
             return NotImplemented
         return (self.nav_state == other.nav_state and self.armed == other.armed
-                and self.estimator_ready == other.estimator_ready and self.position_lost == other.position_lost
                 and self.missing == other.missing and self.geofence == other.geofence
                 and self.gcs_lost == other.gcs_lost and self.battery_warning == other.battery_warning
                 and self.manual_control == other.manual_control
