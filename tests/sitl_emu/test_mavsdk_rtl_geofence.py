@@ -73,7 +73,8 @@ async def _load_plan_here(system: Any, telemetry: Any, plan_path: Path, s: Sessi
     mission_raw = MissionRawAsync(system)
     data = await s.call("MissionRaw.import_qgroundcontrol_mission",
                         mission_raw.import_qgroundcontrol_mission(str(plan_path)))
-    pos = await s.call("Telemetry.position", telemetry.position())
+    pos = await s.wait_for("a finite position", telemetry.position, lambda p: math.isfinite(p.latitude_deg),
+                           timeout_s=30)  # MAVSDK's first sample is NaN until GLOBAL_POSITION_INT has come
     first = data.mission_items[0]
     dx, dy = first.x - int(1e7 * pos.latitude_deg), first.y - int(1e7 * pos.longitude_deg)
     mission = [_moved(it, dx, dy) for it in data.mission_items]
