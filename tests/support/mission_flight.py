@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 from sitl_emu.geo import ned_to_global
 from sitl_emu.navigator.mission_store import PLAN_MISSION, MissionItem
-from sitl_emu.px4 import MavCmd, MavResult
+from sitl_emu.px4 import MavCmd, MavResult, NavState
 from sitl_emu.types import VehicleCommand
 from sitl_emu.vehicle.vehicle import Vehicle
 
@@ -85,3 +85,21 @@ def do(cmd: int, *params: float) -> tuple:
 
 
 TAKEOFF_ITEM = wp(0, 0, 5.0, cmd=TAKEOFF)
+
+
+def fly_until_disarmed(f: Flight) -> tuple[list[int], list[int], list[tuple[float, float, float]], list[NavState]]:
+    """Fly until disarmed (at most 180 s): MISSION_CURRENT seqs from the one in force, the items reached, the path
+    (local NED, every step) and the armed modes in their order."""
+    currents_before, reached_before = len(f.currents), len(f.reached)
+    path: list[tuple[float, float, float]] = []
+    modes: list[NavState] = []
+
+    def landed() -> bool:
+        snap = f.v.snapshot()
+        path.append(snap.pos_ned_m)
+        if snap.armed and (not modes or modes[-1] is not snap.nav_state):
+            modes.append(snap.nav_state)
+        return not snap.armed
+
+    f.run_until(landed, 180.0)
+    return f.currents[currents_before - 1:], [s for s, _ in f.reached[reached_before:]], path, modes

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, wp
+from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, fly_until_disarmed, wp
 
 from sitl_emu.flight_tasks.rtl_mission import MissionReturn, mission_return
 from sitl_emu.navigator.geofence import GeoPoint, distance_m
@@ -86,26 +86,10 @@ def _rtl_at_item(rtl_type: int, seq: int = 2, after_s: float = 2.0) -> tuple[Fli
     return f, len(f.texts), f.v.snapshot().pos_ned_m
 
 
-def _until_disarmed(f: Flight) -> tuple[list[int], list[int], list[tuple[float, float, float]], list[NavState]]:
-    currents_before, reached_before = len(f.currents), len(f.reached)
-    path: list[tuple[float, float, float]] = []
-    modes: list[NavState] = []
-
-    def landed() -> bool:
-        snap = f.v.snapshot()
-        path.append(snap.pos_ned_m)
-        if snap.armed and (not modes or modes[-1] is not snap.nav_state):
-            modes.append(snap.nav_state)
-        return not snap.armed
-
-    f.run_until(landed, 180.0)
-    return f.currents[currents_before - 1:], [s for s, _ in f.reached[reached_before:]], path, modes
-
-
 @pytest.mark.slow
 def test_rtl_type_1_climbs_then_flies_the_mission_s_landing() -> None:
     f, rtl_texts, at_rtl = _rtl_at_item(1)
-    currents, reached, path, modes = _until_disarmed(f)
+    currents, reached, path, modes = fly_until_disarmed(f)
     texts = f.texts[rtl_texts:]
     # RtlDirectMissionLand: MissionBase's "Executing Mission", the climb to the return altitude (RTL_RETURN_ALT 30 m
     # above the land item, as an AMSL altitude rounded up), no direct return
@@ -127,13 +111,13 @@ def test_rtl_type_1_climbs_then_flies_the_mission_s_landing() -> None:
 def test_rtl_type_3_takes_the_closer_of_home_and_the_mission_s_landing() -> None:
     f, rtl_texts, at = _rtl_at_item(3, seq=4, after_s=1.0)  # near item 2 (30, 30): the land item (0, 45) is closer
     assert math.hypot(at[0], at[1] - 45.0) + 2.0 < math.hypot(at[0], at[1])
-    _, _, path, _ = _until_disarmed(f)
+    _, _, path, _ = fly_until_disarmed(f)
     assert "Executing Mission" in f.texts[rtl_texts:]
     assert math.hypot(path[-1][0], path[-1][1] - 45.0) < 1.0
 
     g, rtl_texts, at = _rtl_at_item(3, seq=2)  # past item 1 (30, 0): home is closer
     assert math.hypot(at[0], at[1]) + 2.0 < math.hypot(at[0], at[1] - 45.0)
-    _, _, path, _ = _until_disarmed(g)
+    _, _, path, _ = fly_until_disarmed(g)
     assert any(t.startswith("RTL: start return") for t in g.texts[rtl_texts:])
     assert math.hypot(path[-1][0], path[-1][1]) < 1.0
 
@@ -141,7 +125,7 @@ def test_rtl_type_3_takes_the_closer_of_home_and_the_mission_s_landing() -> None
 @pytest.mark.slow
 def test_rtl_type_0_ignores_the_mission_landing() -> None:
     f, rtl_texts, _ = _rtl_at_item(0)
-    _, _, path, _ = _until_disarmed(f)
+    _, _, path, _ = fly_until_disarmed(f)
     assert any(t.startswith("RTL: start return") for t in f.texts[rtl_texts:])
     assert math.hypot(path[-1][0], path[-1][1]) < 1.0
 
@@ -157,7 +141,7 @@ def test_a_qgroundcontrol_landing_pattern_with_a_positioned_marker_is_flown_from
     f.start()
     f.run_until(lambda: f.store.current_seq == 2, 120.0)
     assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
-    currents, reached, path, _ = _until_disarmed(f)
+    currents, reached, path, _ = fly_until_disarmed(f)
     assert currents == [2, 3, 4, 5] and reached == [3, 4, 5]
     assert min(math.hypot(p[0] - 60.0, p[1] - 60.0) for p in path) > 20.0
     assert math.hypot(path[-1][0], path[-1][1] - 45.0) < 1.0
@@ -176,7 +160,7 @@ def test_a_landing_at_home_keeps_the_return_altitude_computed_on_the_ground() ->
     f.v.run_for(2.0)
     assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
     texts = len(f.texts)
-    currents, _, path, _ = _until_disarmed(f)
+    currents, _, path, _ = fly_until_disarmed(f)
     assert "Executing Mission" in f.texts[texts:]
     assert not any(t.startswith("RTL Mission land: climb") for t in f.texts[texts:])
     assert max(-p[2] for p in path) < 15.0  # the items' altitudes (5-8 m), no climb towards RTL_RETURN_ALT (30 m)

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 from typing import Any
 
 import pytest
-from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, wp
+from support.mission_flight import MISSION_FRAME, REL, TAKEOFF_ITEM, Flight, do, fly_until_disarmed, wp
 
 from sitl_emu.flight_tasks.rtl_mission import MissionReturn, land_start_index, mission_return
 from sitl_emu.geo import GeoRef
@@ -79,23 +79,11 @@ def _fly_to_rtl(rtl_type: int, items: list[tuple]) -> Flight:
     return f
 
 
-def _flight_after_rtl(f: Flight) -> tuple[list[int], list[int], list[tuple[float, float, float]]]:
-    currents_before, reached_before = len(f.currents), len(f.reached)
-    path: list[tuple[float, float, float]] = []
-
-    def landed() -> bool:
-        path.append(f.v.snapshot().pos_ned_m)
-        return not f.v.snapshot().armed
-
-    f.run_until(landed, 180.0)
-    return f.currents[currents_before - 1:], [s for s, _ in f.reached[reached_before:]], path
-
-
 @pytest.mark.slow
 def test_rtl_type_2_flies_the_mission_backwards_at_its_altitudes_and_lands_home() -> None:
     f = _fly_to_rtl(2, [TAKEOFF_ITEM, wp(30, 0), wp(30, 30, 8.0), wp(0, 30), RTL_ITEM])
     rtl_texts = len(f.texts)
-    currents, reached, path = _flight_after_rtl(f)
+    currents, reached, path, _ = fly_until_disarmed(f)
     # from the item before the RTL item back to the takeoff item (MISSION_CURRENT follows), each reported reached;
     # item 3 is where the vehicle already is: reached in the cycle it became current
     assert currents[0] == 4 and currents[-3:] == [2, 1, 0] and reached == [3, 2, 1, 0]
@@ -113,7 +101,7 @@ def test_rtl_type_2_flies_the_mission_backwards_at_its_altitudes_and_lands_home(
 def test_rtl_type_0_still_returns_directly() -> None:
     f = _fly_to_rtl(0, [TAKEOFF_ITEM, wp(30, 0), wp(30, 30, 8.0), wp(0, 30), RTL_ITEM])
     rtl_texts = len(f.texts)
-    currents, _, path = _flight_after_rtl(f)
+    currents, _, path, _ = fly_until_disarmed(f)
     assert currents == [4] and any(t.startswith("RTL: start return") for t in f.texts[rtl_texts - 1:])
     assert min(math.hypot(p[0] - 30, p[1] - 30) for p in path) > 20.0
 
@@ -129,7 +117,7 @@ def test_rtl_type_2_with_a_landing_pattern_flies_on_to_the_mission_s_landing() -
     f.v.run_for(2.0)
     assert f.command(MavCmd.NAV_RETURN_TO_LAUNCH) == MavResult.ACCEPTED
     rtl_texts = len(f.texts)
-    currents, reached, path = _flight_after_rtl(f)
+    currents, reached, path, _ = fly_until_disarmed(f)
     # on from the item flown, DO_LAND_START skipped, the land item: moved to at the current altitude, landed on
     assert currents == [2, 4, 5] and reached == [2, 4, 5]
     texts = f.texts[rtl_texts:]
