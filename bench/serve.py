@@ -12,6 +12,7 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +32,7 @@ class Server:
     client: FlightClient
     sink: socket.socket
     started_wall: float
+    workdir: tempfile.TemporaryDirectory  # serve's working folder (its parameters file, log/), not the checkout
 
     def cpu_s(self) -> float:
         """User + system CPU seconds of the server process so far."""
@@ -46,6 +48,7 @@ class Server:
             self.proc.kill()
             _, err = self.proc.communicate()
         self.sink.close()
+        self.workdir.cleanup()
         return err or ""
 
 
@@ -68,11 +71,12 @@ def start_server(speed: float = 1.0, extra: tuple[str, ...] = ()) -> Server:
     client_port = client.sock.getsockname()[1]
     args = ["--speed", str(speed), "--port", str(api), "--gcs-port", str(gcs),
             "--remote", f"127.0.0.1:{client_port}", "--gcs-remote", f"127.0.0.1:{sink.getsockname()[1]}", *extra]
+    workdir = tempfile.TemporaryDirectory(prefix="bench-serve-")
     started = time.monotonic()
-    proc = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=REPO,
+    proc = subprocess.Popen([sys.executable, "-m", "sitl_emu", "serve", "--no-console", *args], cwd=workdir.name,
                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO)})
-    return Server(proc, client, sink, started)
+    return Server(proc, client, sink, started, workdir)
 
 
 def startup_times() -> tuple[float, float]:
