@@ -307,9 +307,10 @@ class Commander:
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
-        if decision.activated:
+        if decision.activated:  # a warning has its event only (no text)
             self._send_event(failsafe_notice_event(self.intention.user_intended, decision, now_us))
-            self.say(Severity.CRITICAL, decision.text)
+            if decision.text:
+                self.say(Severity.CRITICAL, decision.text)
         if decision.disarm:
             self.disarm("failsafe", forced=True)
         return inputs
