@@ -110,15 +110,17 @@ class CheckInputs:
     manual_control: bool = False  # RC or MAVLink joystick present: never in SITL without a joystick
     mission_valid: bool = False  # a valid mission is stored (navigator/mission_store.py MissionStore.mission_valid)
     position_lost: bool = False  # no horizontal position (GPS off past EKF2_NOAID_TOUT: vehicle/faults.py)
+    mission_required: bool = False  # COM_ARM_MIS_REQ: arming in any mode needs a valid mission
 
     def __init__(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool = False,
-                 mission_valid: bool = False, position_lost: bool = False) -> None:
+                 mission_valid: bool = False, position_lost: bool = False, mission_required: bool = False) -> None:
         self.estimator_ready = estimator_ready
         self.home_valid = home_valid
         self.offboard_signal = offboard_signal
         self.manual_control = manual_control
         self.mission_valid = mission_valid
         self.position_lost = position_lost
+        self.mission_required = mission_required
 
     def available(self) -> int:
         """The requirement bits these inputs satisfy."""
@@ -167,15 +169,22 @@ def arming_failure(nav_state: NavState, c: CheckInputs, armed: bool = False) -> 
     the estimator still warming up, Manual and Acro can arm with sticks (they need no attitude estimate).
 
     While armed the "mode prevents arming" check is skipped (modeCheck.cpp), so vehicle_status.pre_flight_checks_pass
-    stays true when flying in Return or Land."""
+    stays true when flying in Return or Land. COM_ARM_MIS_REQ 1 makes the mission check fail arming in every mode
+    while no valid mission is stored (only Mission itself cannot run without one)."""
     if not armed and mode_prevents_arming(nav_state):
         return PREVENTS_ARMING_TEXT
-    gaps = missing(nav_state, c)
+    gaps = missing(nav_state, c) | missing_for_arming(c)
     if gaps:
         for req, text in _REASONS:
             if req & gaps:
                 return text
     return None
+
+
+def missing_for_arming(c: CheckInputs) -> int:
+    """What arming needs beyond the mode's own requirements: a valid mission when COM_ARM_MIS_REQ says so
+    (modeCheck.cpp: mission_required_modes becomes NavModes::All for the arming check)."""
+    return Req.MISSION if c.mission_required and not c.mission_valid else Req.NONE
 
 
 def can_arm(nav_state: NavState, c: CheckInputs, armed: bool = False) -> bool:

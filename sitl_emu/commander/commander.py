@@ -29,10 +29,8 @@ from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import AUTO_MODES, MANUAL_MODES, MANUAL_THRUST_MODES, UI_NAMES, MavState, NavState, Severity
 from sitl_emu.types import HomePosition, ManualControlSetpoint, OffboardControlMode, Vec3
 
-# emit(severity, module, text, is_event, statustext)
-Emit = Callable[[Severity, str, str, bool, bool], None]
-# geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
-NedOf = Callable[[float, float, float], Vec3]
+Emit = Callable[[Severity, str, str, bool, bool], None]  # emit(severity, module, text, is_event, statustext)
+NedOf = Callable[[float, float, float], Vec3]  # geo -> local NED: ned_of(lat_deg, lon_deg, alt_amsl_m)
 # the current position as a home candidate, None while the estimator is not ready (asked when home is set)
 Here = Callable[[], HomePosition | None]
 
@@ -176,7 +174,8 @@ class Commander:
         return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
                                   offboard_signal=self._offboard_available(now_us, st),
                                   manual_control=self.manual.valid(now_us, st.rc_loss_us),
-                                  mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost)
+                                  mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost,
+                                  mission_required=st.arm_mission_required)
 
     def _offboard_available(self, now_us: int, st: CommanderSettings) -> bool:
         """offboardCheck.cpp: a fresh signal, with the estimate its setpoints need (commander/arming.py)."""
@@ -307,9 +306,10 @@ class Commander:
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state
         self.failsafe = decision.failsafe
-        if decision.activated:
+        if decision.activated:  # a warning has its event only (no text)
             self._send_event(failsafe_notice_event(self.intention.user_intended, decision, now_us))
-            self.say(Severity.CRITICAL, decision.text)
+            if decision.text:
+                self.say(Severity.CRITICAL, decision.text)
         if decision.disarm:
             self.disarm("failsafe", forced=True)
         return inputs

@@ -11,7 +11,10 @@ fromNavDllOrRclActParam) and failsafe/framework.cpp (notifyUser: "Failsafe activ
 - the fallback clears as soon as the user's mode can run again (WhenConditionClears), and an explicit mode change
   by the user ends it (the new mode can run, or the change was refused);
 - flight termination (DO_FLIGHTTERMINATION) holds TERMINATION while armed;
-- a geofence breach acts as GF_ACTION says (commander/geofence_failsafe.py), ranked with the others.
+- a geofence breach acts as GF_ACTION says (commander/geofence_failsafe.py), ranked with the others;
+- a warning (Action::Warn: GF_ACTION 1, or a geofence Return while the user lands) keeps the user's mode and is no
+  failsafe (vehicle_status.failsafe stays false, PX4 #22879); when it is the worst action and new, the user is told
+  with an event only ("Failsafe warning:"; no "Failsafe activated" since PX4 #24858).
 Each action keeps its cause (failsafe.cpp causedBy: manual-control loss, GCS connection loss, the battery level;
 everything else is generic), and a Hold before a delayed action knows the action it waits for: the Decision carries
 both, for notifyUser's event (events/failsafe_notices.py).
@@ -26,7 +29,12 @@ from sitl_emu.commander.arming import CheckInputs, Req, can_run
 from sitl_emu.commander.fault_failsafes import FaultFailsafes, FaultFlags, FaultSettings
 from sitl_emu.commander.geofence_failsafe import GeofenceFailsafe
 from sitl_emu.commander.manual_control import ManualLossFailsafe, ManualLossSettings
-from sitl_emu.events.failsafe_notices import CAUSE_GCS_CONNECTION_LOSS, CAUSE_GENERIC, CAUSE_MANUAL_CONTROL_LOSS
+from sitl_emu.events.failsafe_notices import (
+    ACTION_WARN,
+    CAUSE_GCS_CONNECTION_LOSS,
+    CAUSE_GENERIC,
+    CAUSE_MANUAL_CONTROL_LOSS,
+)
 from sitl_emu.navigator.geofence import GeofenceResult
 from sitl_emu.px4 import NavState
 
@@ -118,6 +126,7 @@ _RANK: Final[dict[NavState, int]] = {
     NavState.POSCTL: 2, NavState.ALTCTL: 3, NavState.STAB: 4, NavState.AUTO_LOITER: 5, NavState.AUTO_RTL: 6,
     NavState.AUTO_LAND: 7, NavState.DESCEND: 8, NavState.TERMINATION: 10,
 }
+_WARN_RANK: Final = ACTION_WARN  # framework.h Action::Warn: no mode of its own
 _DISARM_RANK: Final = 9
 _HOLD_RANK: Final = _RANK[NavState.AUTO_LOITER]
 FAILSAFE_TEXT: Final = "Failsafe activated"
@@ -189,9 +198,8 @@ class Failsafe:
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)
         rank, mode, disarm, cause = action
-        if rank == 0:
-            self.active, self._rank = False, 0
-            return Decision(user, False)
+        if rank <= _WARN_RANK:
+            return self._warn_or_none(user, rank, cause)
         hold_s, delayed = 0, 0
         if mode is NavState.AUTO_LOITER:
             hold_s, delayed, cause = self._delayed(now_us, cause)
@@ -213,11 +221,22 @@ class Failsafe:
                 delayed, cause = _RANK[source.action], source_cause
         return hold_s, (delayed if hold_s > 0 else 0), cause
 
+    def _warn_or_none(self, user: NavState, rank: int, cause: int) -> Decision:
+        """No action, or only a warning: the user's mode, no failsafe; a new warning is told (no text)."""
+        self.active = False
+        told = rank > self._rank
+        self._rank = rank
+        if rank == 0:
+            return Decision(user, False)
+        return Decision(user, False, activated=told, action=ACTION_WARN, cause=cause)
+
     def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,
                   current: _Action) -> _Action:
-        """The geofence_breached failsafe joins the others: the worse action wins."""
+        """The geofence_breached failsafe joins the others: the worse action wins (a warning beats no action)."""
         worse_than_hold = self._rank > _HOLD_RANK
         wanted = self.geofence.update(now_us, result, user, fail_act_us, worse_than_hold)
+        if self.geofence.warns and current[0] < _WARN_RANK:
+            return _WARN_RANK, user, False, CAUSE_GENERIC
         return _worse(current, user, wanted, False)
 
     def _decide(self, nav_state: NavState, disarm: bool, text: str,

@@ -79,10 +79,11 @@ class ReportInputs:
     manual_control: bool
     stick_input_disabled: bool  # COM_RC_IN_MODE 4
     datalink_required: bool  # NAV_DLL_ACT > 0
+    mission_required: bool = False  # COM_ARM_MIS_REQ
 
     def __init__(self, nav_state: NavState, armed: bool, missing: int, geofence: GeofenceResult, gcs_lost: bool,
                  battery_warning: int, manual_control: bool, stick_input_disabled: bool,
-                 datalink_required: bool) -> None:
+                 datalink_required: bool, mission_required: bool = False) -> None:
         self.nav_state = nav_state
         self.armed = armed
         self.missing = missing
@@ -92,6 +93,7 @@ class ReportInputs:
         self.manual_control = manual_control
         self.stick_input_disabled = stick_input_disabled
         self.datalink_required = datalink_required
+        self.mission_required = mission_required
 
     def __eq__(self, other: object) -> bool:
         """The dataclass's comparison, field by field, written out so that mypyc compiles it (the generated one
@@ -103,14 +105,15 @@ class ReportInputs:
                 and self.gcs_lost == other.gcs_lost and self.battery_warning == other.battery_warning
                 and self.manual_control == other.manual_control
                 and self.stick_input_disabled == other.stick_input_disabled
-                and self.datalink_required == other.datalink_required)
+                and self.datalink_required == other.datalink_required
+                and self.mission_required == other.mission_required)
 
     @classmethod
     def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
            stick_input_disabled: bool, datalink_required: bool) -> ReportInputs:
         return cls(nav_state, armed, _CHECKED & ~c.available(), geofence,
                    faults.gcs_connection_lost, faults.battery_warning, c.manual_control, stick_input_disabled,
-                   datalink_required)
+                   datalink_required, c.mission_required)
 
 
 class _Builder:
@@ -190,13 +193,20 @@ _CHECKED: Final = Req.MANUAL | sum(req for req, _ in _MODE_CHECKS)
 
 def _mode_checks(b: _Builder, i: ReportInputs) -> None:
     """modeCheck.cpp, in its order: the mode prevents arming (disarmed only), then each requirement not met, with
-    the modes that require it (mode_requirements.cpp, as commander/arming.py holds them)."""
+    the modes that require it (mode_requirements.cpp, as commander/arming.py holds them; a missing mission with
+    COM_ARM_MIS_REQ 1 fails arming in every mode)."""
     prevent = modes_requiring(Req.PREVENT_ARMING)
     if not i.armed and prevent >> int(i.nav_state) & 1:
         b.fail(ev.CANNOT_TAKEOFF, prevent, clear_run=False)
     for req, event in _MODE_CHECKS:
-        if i.missing & req:
-            b.fail(event, modes_requiring(i.missing & req))
+        if not i.missing & req:
+            continue
+        modes = modes_requiring(i.missing & req)
+        if req == Req.MISSION and i.mission_required:  # COM_ARM_MIS_REQ: no arming in any mode, Mission cannot run
+            b.fail(event, ALL_MODES, clear_run=False)
+            b.can_run &= ~modes
+        else:
+            b.fail(event, modes)
     if i.missing & Req.MANUAL:
         manual = modes_requiring(Req.MANUAL)
         disabled = i.stick_input_disabled

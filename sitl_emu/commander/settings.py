@@ -25,6 +25,7 @@ class CommanderSettings:
     arm_gesture: bool  # MAN_ARM_GESTURE
     override_speed: float  # MAN_OVERRIDE_SPD (1/s; negative: sticks never take over)
     faults: FaultSettings  # NAV_DLL_ACT, COM_LOW_BAT_ACT, CBRK_FLIGHTTERM... (commander/fault_failsafes.py)
+    arm_mission_required: bool = False  # COM_ARM_MIS_REQ
 
     @classmethod
     def from_params(cls, p: ParamRegistry) -> CommanderSettings:
@@ -43,4 +44,5 @@ class CommanderSettings:
             arm_gesture=int(p["MAN_ARM_GESTURE"]) == 1,
             override_speed=float(p["MAN_OVERRIDE_SPD"]),
             faults=FaultSettings.from_params(p),
+            arm_mission_required=bool(p["COM_ARM_MIS_REQ"]),
         )

@@ -22,6 +22,7 @@ PARAMS: list[ParamDef] = [
     integer("NAV_RCL_ACT", 2, 1, 6),
     integer("COM_RCL_EXCEPT", 0, 0, 31),
     integer("COM_ARM_WO_GPS", 1, 0, 2),
+    integer("COM_ARM_MIS_REQ", 0, 0, 1),  # 1: no arming in any mode without a valid mission (modeCheck.cpp)
     integer("COM_HOME_EN", 1, 0, 1),
     integer("COM_RC_IN_MODE", 1, 0, 8),  # 5-8: RC and MAVLink by priority
     integer("COM_LOW_BAT_ACT", 3, 0, 4),  # 0 warning, 2 Land, 3 Return then Land, 4 Return then Terminate

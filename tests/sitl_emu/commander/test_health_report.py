@@ -68,7 +68,9 @@ def test_ready_in_hold_arming_is_possible_and_only_the_optional_checks_remain():
                                  NavState.AUTO_RTL, NavState.AUTO_LAND, NavState.POSCTL, NavState.ALTCTL,
                                  NavState.STAB, NavState.MANUAL, NavState.OFFBOARD, NavState.ORBIT])
 @pytest.mark.parametrize("c", [READY, arming.CheckInputs(True, True, True, manual_control=True, mission_valid=True),
-                               arming.CheckInputs(True, False, False, position_lost=True)], ids=["bare", "all", "gps"])
+                               arming.CheckInputs(True, False, False, position_lost=True),
+                               arming.CheckInputs(True, True, False, mission_required=True)],
+                         ids=["bare", "all", "gps", "mission_required"])
 def test_can_arm_of_the_current_mode_is_what_the_commander_decides(nav, c):
     assert health_report(_inputs(c, nav)).can_arm_in(nav) == arming.can_arm(nav, c)
 
@@ -89,6 +91,21 @@ def test_a_geofence_breach_fails_arming_in_every_mode_but_lets_them_run():
     r = health_report(_inputs(geofence=GeofenceResult(max_dist=True, custom=True, action=GF_ACTION_RETURN)))
     assert _names(r)[:2] == ["check_gf_violation_max_hor_dist", "check_gf_violation_custom_gf"]
     assert r.can_arm == 0 and r.can_run >> NavState.AUTO_LOITER & 1
+
+
+def test_com_arm_mis_req_without_a_mission_fails_arming_in_every_mode_but_lets_them_run():
+    """modeCheck.cpp: COM_ARM_MIS_REQ makes mission_required_modes NavModes::All for the arming check; the can-run
+    bits stay those of mode_req_mission (Mission only)."""
+    required = arming.CheckInputs(True, True, False, mission_required=True)
+    r = health_report(_inputs(required))
+    (mission,) = [c for c in r.checks if c.event is ev.MISSION]
+    assert (mission.modes, mission.level, mission.component) == (ALL_MODES, Log.INFO, SYSTEM)
+    assert r.can_arm == 0
+    assert r.can_run >> NavState.AUTO_LOITER & 1 and not r.can_run >> NavState.AUTO_MISSION & 1
+    stored = arming.CheckInputs(True, True, False, mission_valid=True, mission_required=True)
+    assert health_report(_inputs(stored)).can_arm_in(NavState.AUTO_LOITER)
+    assert arming.arming_failure(NavState.AUTO_LOITER, required) == "No valid mission available"
+    assert arming.arming_failure(NavState.AUTO_LOITER, stored) is None
 
 
 def test_a_lost_ground_station_blocks_arming_only_when_nav_dll_act_needs_it():

@@ -11,7 +11,9 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+from support.events_client import EVENT, EventsDecoder, extra_of
 
+from sitl_emu.events.metadata import events_metadata
 from sitl_emu.geo import GeoRef, ned_to_global
 from sitl_emu.px4 import MavCmd, MavResult, MavState, NavState
 from sitl_emu.testing.client import FlightClient
@@ -30,6 +32,7 @@ class Gcs(FlightClient):
     def __init__(self, sim: Sim) -> None:
         super().__init__(sim.ports(0).api, sim.clock, sysid=245, compid=190)
         self.mission: list[Any] = []
+        self.events: list[dict[str, Any]] = []  # EVENT's fields, once watch_all() decodes them
         self._next_gcs_hb_s = -math.inf
 
     def pump(self) -> None:
@@ -44,6 +47,9 @@ class Gcs(FlightClient):
         super()._observe(msg)
         if msg.get_type() in ("MISSION_REQUEST_INT", "MISSION_REQUEST", "MISSION_ACK", "MISSION_COUNT"):
             self.mission.append(msg)
+        extra = extra_of(msg)
+        if extra is not None and extra[0] == EVENT:
+            self.events.append(extra[1])
 
     def upload(self, items: list[Any], mission_type: int) -> int:
         """MISSION_COUNT, then each requested item; the MISSION_ACK type."""
@@ -280,14 +286,19 @@ def test_reposition_outside_the_fence_is_refused(sim):
 
 
 def test_warning_only_reports_and_terminate_stops_the_motors(sim):
-    """GF_ACTION 1: the breach text, no failsafe, the flight goes on; GF_ACTION 4: termination at once (HEARTBEAT
+    """GF_ACTION 1: the breach text and the failsafe warning's EVENT (framework.cpp notifyUser, Action::Warn: no
+    "Failsafe activated" STATUSTEXT), no failsafe, the flight goes on; GF_ACTION 4: termination at once (HEARTBEAT
     FLIGHT_TERMINATION, the vehicle falls)."""
     gcs = Gcs(sim)
+    gcs.watch_all()  # EVENT is no message of pymavlink's dialect: decoded with the rest (support/events_client.py)
     fly_up(sim, gcs, {"GF_MAX_HOR_DIST": 15.0, "GF_ACTION": 1})
-    n0 = len(gcs.seen.texts)
+    n0, e0 = len(gcs.seen.texts), len(gcs.events)
     offboard_to(gcs, 0.0, 25.0, 5.0)
     gcs.wait(lambda: gcs.seen.pos_ned_m is not None and abs(gcs.seen.pos_ned_m[1] - 25.0) < 1.0, 30.0, "25 m east")
     assert gcs.texts_after(n0) == ["Geofence: exceeding maximum distance to Home"]
+    decoder = EventsDecoder(events_metadata())
+    notices = [decoder.decode(e["id"], e["arguments"]) for e in gcs.events[e0:]]
+    assert notices.count(("commander_failsafe_enter_generic_warn", "Failsafe warning:")) == 1
     assert gcs.in_mode(NavState.OFFBOARD) and gcs.seen.heartbeat.system_status != MAV_STATE_CRITICAL
     sim.vehicle().params.set("GF_ACTION", 4)
     gcs.wait(lambda: gcs.in_mode(NavState.TERMINATION), 5.0, "termination")

@@ -183,5 +183,5 @@ def test_a_failsafe_notice_decodes_with_the_downloaded_metadata(h):
     h.run(3.0)
     notices = [decoder.decode(f["id"], f["arguments"]) for msg_id, f in filter(None, map(extra_of,
                h.gcs.received[start:])) if msg_id == 410]
-    assert ("commander_failsafe_enter_generic", "Failsafe activated: Autopilot disengaged, switching to RTL") \
+    assert ("commander_failsafe_enter_generic", "Failsafe activated: switching to RTL") \
         in notices

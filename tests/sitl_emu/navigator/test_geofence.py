@@ -7,7 +7,10 @@ import math
 
 import pytest
 
+from sitl_emu.commander.arming import CheckInputs
+from sitl_emu.commander.failsafe import Failsafe, FallbackSettings
 from sitl_emu.commander.geofence_failsafe import GeofenceFailsafe
+from sitl_emu.events.failsafe_notices import failsafe_notice
 from sitl_emu.geo import GeoRef, ned_to_global
 from sitl_emu.navigator.geofence import (
     GF_ACTION_HOLD,
@@ -273,9 +276,27 @@ def test_failsafe_return_and_land_hold_first_for_com_fail_act_t(action, mode):
     assert h.update(0, BREACH[action], NavState.POSCTL, 5 * S, True) is mode  # already in a worse failsafe
 
 
-def test_failsafe_return_while_returning_is_a_warning():
+def test_failsafe_return_while_landing_is_a_warning():
+    """framework.cpp getSelectedAction: already landing, a Return (even its Hold first) becomes Action::Warn."""
     f = GeofenceFailsafe()
-    assert f.update(0, BREACH[GF_ACTION_RETURN], NavState.AUTO_RTL, 5 * S, False) is None
+    assert f.update(0, BREACH[GF_ACTION_RETURN], NavState.AUTO_LAND, 5 * S, False) is None
+    assert f.warns
+    g = GeofenceFailsafe()
+    assert g.update(0, BREACH[GF_ACTION_RETURN], NavState.AUTO_RTL, 5 * S, False) is None
+    assert not g.warns
+
+
+def test_failsafe_warning_lasts_while_breached_and_comes_back_with_a_new_breach():
+    """GF_ACTION 1 is Action::Warn with ClearCondition::WhenConditionClears: no mode, gone when back inside."""
+    f = GeofenceFailsafe()
+    assert f.update(0, BREACH[GF_ACTION_WARN], NavState.POSCTL, 5 * S, False) is None and f.warns
+    assert f.update(1 * S, BREACH[GF_ACTION_WARN], NavState.POSCTL, 5 * S, False) is None and f.warns
+    assert f.update(2 * S, GeofenceResult(action=GF_ACTION_WARN), NavState.POSCTL, 5 * S, False) is None
+    assert not f.warns
+    f.update(3 * S, BREACH[GF_ACTION_WARN], NavState.POSCTL, 5 * S, False)
+    assert f.warns
+    f.update(4 * S, BREACH[GF_ACTION_HOLD], NavState.POSCTL, 5 * S, False)  # GF_ACTION changed during the breach
+    assert f.action is NavState.AUTO_LOITER and not f.warns
 
 
 def test_failsafe_mode_change_takes_over_until_the_breach_clears_and_returns():
@@ -337,3 +358,25 @@ def test_failsafe_action_follows_a_gf_action_change_during_the_breach():
     f = GeofenceFailsafe()
     assert f.update(0, BREACH[GF_ACTION_WARN], NavState.OFFBOARD, 5 * S, False) is None
     assert f.update(1 * S, BREACH[GF_ACTION_TERMINATE], NavState.OFFBOARD, 5 * S, False) is NavState.TERMINATION
+
+
+def test_commander_failsafe_tells_a_new_warning_once_with_no_text_and_no_failsafe():
+    """failsafe.py: the geofence's Action::Warn is ranked above no action, keeps the user's mode, is no failsafe, and
+    is told (notifyUser: an event, no "Failsafe activated") when it is new; a worse action still wins over it."""
+    inputs = CheckInputs(estimator_ready=True, home_valid=True, offboard_signal=False, mission_valid=True)
+    settings = FallbackSettings(obl_rc_act=0, rcl_act=2)
+    f = Failsafe()
+
+    def decide(now_s: float, result: GeofenceResult):
+        return f.update(armed=True, user=NavState.AUTO_MISSION, inputs=inputs, settings=settings,
+                        now_us=round(now_s * S), geofence=result, fail_act_us=5 * S)
+
+    first = decide(0.0, BREACH[GF_ACTION_WARN])
+    assert (first.nav_state, first.failsafe, first.activated, first.text) == (NavState.AUTO_MISSION, False, True, "")
+    assert failsafe_notice(0, first.action, first.delayed_action, first.cause, first.delay_s)[0].name == \
+        "commander_failsafe_enter_generic_warn"
+    assert not decide(0.1, BREACH[GF_ACTION_WARN]).activated  # told once while it lasts
+    assert decide(0.2, GeofenceResult(action=GF_ACTION_WARN)).action == 0  # back inside: gone
+    assert decide(0.3, BREACH[GF_ACTION_WARN]).activated  # a new breach: told again
+    worse = decide(0.4, BREACH[GF_ACTION_TERMINATE])
+    assert (worse.nav_state, worse.failsafe, worse.text) == (NavState.TERMINATION, True, "Failsafe activated")

@@ -89,6 +89,17 @@ def test_offboard_loss_is_a_generic_fallback_without_a_hold():
     v.run_for(3.0)  # the setpoints stopped: COM_OBL_RC_ACT Position cannot run without sticks -> NAV_RCL_ACT Return
     assert v.snapshot().nav_state is NavState.AUTO_RTL
     ((_, name, message, arguments),) = _notices(v, seq)
-    assert (name, message) == ("commander_failsafe_enter_generic",
-                               "Failsafe activated: Autopilot disengaged, switching to RTL")
+    assert (name, message) == ("commander_failsafe_enter_generic", "Failsafe activated: switching to RTL")
     assert arguments[:5] == custom_mode(NavState.OFFBOARD).to_bytes(4, "little") + bytes([RTL_ACTION])
+
+
+@pytest.mark.parametrize(("action", "name"), [(6, "commander_failsafe_enter_generic"),
+                                              (7, "commander_failsafe_enter_generic"),
+                                              (3, "commander_failsafe_enter_autopilot_disengaged"),
+                                              (4, "commander_failsafe_enter_autopilot_disengaged"),
+                                              (8, "commander_failsafe_enter_autopilot_disengaged")])
+def test_only_an_action_that_leaves_position_control_says_autopilot_disengaged(action, name):
+    """framework.cpp notifyUser (PX4 #23543): a generic Return or Land is "Failsafe activated: switching to ...";
+    the Altitude and Stabilized fallbacks and Descend keep "Autopilot disengaged"."""
+    definition, values = failsafe_notices.failsafe_notice(custom_mode(NavState.POSCTL), action, 0, 0, 0)
+    assert definition.name == name and values == (custom_mode(NavState.POSCTL), action)
