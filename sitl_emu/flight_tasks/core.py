@@ -4,9 +4,10 @@ NavInput, and the setpoint types are the navigator's: navigator/setpoint.py).
 `AutoCore` turns a waypoint (type + target + yaw) into a smoothed trajectory setpoint the way PX4's
 `src/modules/flight_mode_manager/tasks/Auto/FlightTaskAuto.cpp` does: per-cycle trajectory constraints
 (_updateTrajConstraints: takeoff speed/acceleration near the ground, MPC_ACC_UP_MAX/MPC_Z_V_AUTO_UP upwards,
-MPC_ACC_DOWN_MAX/MPC_Z_V_AUTO_DN downwards), the land speed profile (_prepareLandSetpoints), the idle setpoint,
-heading towards the waypoint (MPC_YAW_MODE 0) and its smoothing (_smoothYaw: heading.py, MPC_YAWRAUTO_MAX and
-MPC_YAWRAUTO_ACC).
+MPC_ACC_DOWN_MAX/MPC_Z_V_AUTO_DN downwards, and how far the trajectory may run ahead of a lagging vehicle before
+its time stops: MPC_XY_ERR_MAX horizontally, MPC_Z_ERR_MAX vertically), the land speed profile
+(_prepareLandSetpoints), the idle setpoint, heading towards the waypoint (MPC_YAW_MODE 0) and its smoothing
+(_smoothYaw: heading.py, MPC_YAWRAUTO_MAX and MPC_YAWRAUTO_ACC).
 It also reproduces FlightModeManager's reset of the trajectory while the takeoff ramp has not started
 (`src/modules/flight_mode_manager/FlightModeManager.cpp` generateTrajectorySetpoint -> FlightTaskAuto::reActivate).
 """
@@ -54,6 +55,7 @@ class AutoSettings:
     land_alt3: float
     xy_cruise: float
     xy_err_max: float
+    z_err_max: float
     yawrate_max_rad_s: float
     yawacc_max_rad_s2: float
     yaw_err_rad: float
@@ -85,6 +87,7 @@ _PARAM_NAMES: Final[dict[str, tuple[str, float]]] = {
     "tko_ramp_t": ("MPC_TKO_RAMP_T", 3.0), "land_speed": ("MPC_LAND_SPEED", 0.7),
     "land_crawl": ("MPC_LAND_CRWL", 0.3), "land_alt1": ("MPC_LAND_ALT1", 10.0), "land_alt2": ("MPC_LAND_ALT2", 5.0),
     "land_alt3": ("MPC_LAND_ALT3", 1.0), "xy_cruise": ("MPC_XY_CRUISE", 5.0), "xy_err_max": ("MPC_XY_ERR_MAX", 2.0),
+    "z_err_max": ("MPC_Z_ERR_MAX", 1.0),
     "yawrate_max_rad_s": ("MPC_YAWRAUTO_MAX", 60.0), "yawacc_max_rad_s2": ("MPC_YAWRAUTO_ACC", 20.0),
     "yaw_err_rad": ("MIS_YAW_ERR", 12.0), "yaw_mode": ("MPC_YAW_MODE", 0),
     "nav_acc_rad": ("NAV_ACC_RAD", 10.0), "nav_mc_alt_rad": ("NAV_MC_ALT_RAD", 0.8),
@@ -193,6 +196,7 @@ class AutoCore:
         vel_max = s.xy_vel_max
         sm.cruise_speed_m_s = min(cruise, vel_max)
         sm.max_xy_error_m = s.xy_err_max
+        sm.max_z_error_m = s.z_err_max  # the vertical time stretch: the altitude setpoint waits for a lagging vehicle
         if self._unsmoothed_vz < 0.0:  # going up
             acc_z, vel_z = s.acc_up, s.z_v_auto_up
             if wp.kind is SetpointType.TAKEOFF and self._dist_to_ground(nav) < s.land_alt1:

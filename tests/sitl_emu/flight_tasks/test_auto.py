@@ -224,7 +224,9 @@ def test_land_speed_profile_and_push_down_on_the_ground(params):
     assert pm.pos[2] == 0.0
     last = pm.history[-1][4]
     assert last.velocity_ned_m_s[2] >= 0.3 - 1e-6  # still commanding a descent on the ground
-    assert last.position_ned_m[2] > 1.0  # the trajectory keeps running below the ground
+    # the trajectory keeps running below the ground, but no further than MPC_Z_ERR_MAX (1 m) ahead of the vehicle:
+    # PositionSmoothing slows the vertical trajectory's time while the vehicle lags behind it
+    assert 0.9 < last.position_ned_m[2] <= 1.0
     assert pm.pos[:2] == pytest.approx((0.0, 0.0), abs=0.01)
 
 

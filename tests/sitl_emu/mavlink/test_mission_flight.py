@@ -175,9 +175,19 @@ def test_flight1_times_against_the_reference(flight1: Flight) -> None:
     texts = dict((text.rstrip("\t"), t) for t, text in flight1.texts)
     assert texts["Takeoff detected"] == pytest.approx(METRICS["t_takeoff_text_s"], abs=0.6)
     assert texts["Returning to launch"] == pytest.approx(METRICS["_info"]["texts_t_s"][4], abs=0.6)
-    # the return itself is RTL's (flight_tasks/rtl.py): it lands ~2 s sooner than PX4 did, hence the 3 s here
-    assert texts["RTL: land at destination"] == pytest.approx(METRICS["_info"]["texts_t_s"][6], abs=3.0)
-    assert texts["Disarmed by landing"] == pytest.approx(METRICS["t_disarmed_text_s"], abs=4.0)
+    # the return phase by phase: the climb and the way home, the descent with
+    # its land detection (the altitude setpoint waits within MPC_Z_ERR_MAX for the vehicle, so the descent keeps to
+    # the MPC_LAND_ALT1/ALT2 speed profile as PX4's does), COM_DISARM_LAND
+    t_px4 = METRICS["_info"]["texts_t_s"]
+    px4 = {"rtl": t_px4[4], "land": t_px4[6], "landed": t_px4[7], "disarmed": t_px4[8]}
+    ours = {"rtl": texts["Returning to launch"], "land": texts["RTL: land at destination"],
+            "landed": texts["Landing detected"], "disarmed": texts["Disarmed by landing"]}
+    for a, b, tolerance_s in (("rtl", "land", 0.6), ("land", "landed", 1.0), ("landed", "disarmed", 0.2)):
+        assert ours[b] - ours[a] == pytest.approx(px4[b] - px4[a], abs=tolerance_s), (a, b)
+    # ~1.2 s sooner in all: the mission hands over 0.34 s sooner, and PX4's height estimate touches down 0.24 m below
+    # its take-off height (its LOCAL_POSITION_NED z goes back to 0 after the landing), which lengthens its last
+    # 0.3 m/s (MPC_LAND_CRWL) crawl by ~0.7 s; the emulator's estimate does not drift so
+    assert ours["disarmed"] == pytest.approx(METRICS["t_disarmed_text_s"], abs=1.5)
 
 
 @pytest.mark.parametrize("leg", [(0, 1), (1, 2), (2, 4)])
