@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Final
 
-from sitl_emu.control.qmath import isfinite
+from sitl_emu.control.qmath import atan2, hypot, isfinite
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.motion_planning.heading import HeadingSmoother, wrap_pi
 from sitl_emu.motion_planning.smoothing import PositionSmoother
@@ -231,8 +231,8 @@ class AutoCore:
         # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
         dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
         dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
-        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self._acceptance(wp):
-            self._yaw_lock = math.atan2(dy, dx)
+        if self.s.yaw_mode in (0, 4) and isfinite(dx) and hypot(dx, dy) > self._acceptance(wp):
+            self._yaw_lock = atan2(dy, dx)
         if self._yaw_lock is None:
             self._yaw_lock = nav.yaw_rad
         return self._yaw_lock
