@@ -115,6 +115,8 @@ class ModeExecutor:
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
         self._mission_land = MissionLandAltitude()  # the mission landing's return altitude (RTL_TYPE 1 and 3)
         self._rtl_check_us = 0  # when Return's destination is evaluated next while Return is inactive
+        self._auto_settings: AutoSettings | None = None  # for that evaluation, read again when a parameter changes
+        self._auto_version = -1
 
     def attach_missions(self, store: MissionStore) -> None:
         """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
@@ -296,7 +298,9 @@ class ModeExecutor:
     def _check_rtl_destination(self, nav: auto.NavInput) -> ReturnDestination | None:
         """RTL::setRtlTypeAndDestination: the destination (the vehicle's choice), the mission landing's altitude."""
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        self._mission_land.evaluate(destination, nav, AutoSettings.from_params(self.params))
+        if self._auto_settings is None or self._auto_version != self.params.version:
+            self._auto_settings, self._auto_version = AutoSettings.from_params(self.params), self.params.version
+        self._mission_land.evaluate(destination, nav, self._auto_settings)
         return destination
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:
