@@ -44,11 +44,19 @@ TEXT_NO_HOME: Final = "Geofence invalid, doesn't contain Home position"
 TEXT_NO_CURRENT: Final = "Geofence invalid, doesn't contain current vehicle position"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class GeoPoint:
+    """A global position; read-only by convention (made at every geofence check: ARCHITECTURE.md, On the tick
+    path)."""
+
     lat_deg: float
     lon_deg: float
     alt_amsl_m: float
+
+    def __init__(self, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> None:
+        self.lat_deg = lat_deg
+        self.lon_deg = lon_deg
+        self.alt_amsl_m = alt_amsl_m
 
 
 @dataclass(frozen=True, slots=True)
