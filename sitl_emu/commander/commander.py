@@ -316,7 +316,7 @@ class Commander:
 
     def report_health(self, now_us: int, inputs: arming.CheckInputs | None = None, force: bool = False) -> None:
         """HealthAndArmingChecks::update (10 Hz, on a status change, forced by RUN_PREARM_CHECKS): a report if due."""
-        if self._health.due(now_us, (self.nav_state, self.armed), force):
+        if self._health.due(now_us, self.nav_state, self.armed, force):
             st = self.settings
             checked = inputs or self._check_inputs(now_us, st)
             report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, self.fault_flags,
