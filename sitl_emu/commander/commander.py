@@ -48,6 +48,7 @@ class Commander:
                  send_event: SendEvent = drop) -> None:
         self.params = params
         self._settings = CommanderSettings.from_params(params)
+        self._param_changes = params.changes
         self._settings_version = params.version
         self._emit, self._send_event = emit, send_event  # texts; PX4 events no text tells (commander/notices.py)
         self._health = HealthReporter()
@@ -86,9 +87,9 @@ class Commander:
 
     @property
     def settings(self) -> CommanderSettings:
-        if self.params.version != self._settings_version:
+        if self._param_changes.value != self._settings_version:
             self._settings = CommanderSettings.from_params(self.params)
-            self._settings_version = self.params.version
+            self._settings_version = self._param_changes.value
         return self._settings
 
     # ---- inputs -------------------------------------------------------------------------------------------------

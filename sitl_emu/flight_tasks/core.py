@@ -257,6 +257,7 @@ class Task:
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params = params
+        self._param_changes = params.changes
         self._version = params.version
         self._settings = AutoSettings.from_params(params)
         self._core = AutoCore(nav, self._settings)
@@ -265,8 +266,8 @@ class Task:
 
     def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
         """The trajectory setpoint for this cycle (NaN = not controlled)."""
-        if self._params.version != self._version:
-            self._version = self._params.version
+        if self._param_changes.value != self._version:
+            self._version = self._param_changes.value
             self._settings = AutoSettings.from_params(self._params)
             self._core.s = self._settings
         wp = self._waypoint(nav)

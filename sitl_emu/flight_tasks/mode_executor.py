@@ -96,6 +96,7 @@ class ModeExecutor:
 
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
+        self._param_changes = params.changes
         self.task: FlightTask | None = None
         self._stabilized: StabilizedMode | None = None  # STABILIZED / MANUAL, while in force
         self._task_mode: NavState | None = None  # the mode self.task flies; None exactly when no task runs
@@ -298,8 +299,8 @@ class ModeExecutor:
     def _check_rtl_destination(self, nav: auto.NavInput) -> ReturnDestination | None:
         """RTL::setRtlTypeAndDestination: the destination (the vehicle's choice), the mission landing's altitude."""
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        if self._auto_settings is None or self._auto_version != self.params.version:
-            self._auto_settings, self._auto_version = AutoSettings.from_params(self.params), self.params.version
+        if self._auto_settings is None or self._auto_version != self._param_changes.value:
+            self._auto_settings, self._auto_version = AutoSettings.from_params(self.params), self._param_changes.value
         self._mission_land.evaluate(destination, nav, self._auto_settings)
         return destination
 

@@ -41,6 +41,7 @@ class ControlChain:
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
         self.control = MulticopterControl(cascade_settings(params))
+        self._param_changes = params.changes
         self._control_params_version = params.version
         self.executor = ModeExecutor(params)
         self._detector = LandDetector(params)
@@ -62,8 +63,8 @@ class ControlChain:
     def control_update(self, est: RigidBodyState, out: ExecutorOutput, armed: bool, landed: bool, now_us: int,
                        dt_s: float) -> Vec4:
         """The cascade with the task's want_takeoff (auto modes) and the land detector's ground contact."""
-        if self.params.version != self._control_params_version:  # a parameter changed: new controller settings
-            self._control_params_version = self.params.version
+        if self._param_changes.value != self._control_params_version:  # a parameter changed: new controller settings
+            self._control_params_version = self._param_changes.value
             self.control.settings = cascade_settings(self.params)
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)

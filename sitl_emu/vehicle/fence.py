@@ -54,6 +54,7 @@ class FenceChecks:
         self.params = params
         self.monitor = GeofenceMonitor()
         self._settings: GeofenceSettings = geofence_settings(params)
+        self._param_changes = params.changes
         self._version = params.version
         self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
         # the very objects that key was made of (plans and home are replaced, never changed in place): while they
@@ -67,8 +68,8 @@ class FenceChecks:
 
     @property
     def settings(self) -> GeofenceSettings:
-        if self.params.version != self._version:
-            self._settings, self._version = geofence_settings(self.params), self.params.version
+        if self._param_changes.value != self._version:
+            self._settings, self._version = geofence_settings(self.params), self._param_changes.value
         return self._settings
 
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
@@ -130,7 +131,7 @@ class FenceChecks:
 
     def _inputs_replaced(self, mission: Plan, fence: Plan, c: Commander) -> bool:
         """Whether a plan, home or the parameters were replaced since the last call (maybe with equal values)."""
-        version = self.params.version
+        version = self._param_changes.value
         if (mission is self._checked_mission and fence is self._checked_fence and c.home is self._checked_home
                 and version == self._checked_version):
             return False
