@@ -229,20 +229,23 @@ class AxisSmoother:
         return self._saturate_t1(a0, jerk, t1)
 
 
-def synchronize(axes: list[AxisSmoother]) -> None:
+def synchronize(x: AxisSmoother, y: AxisSmoother, z: AxisSmoother) -> None:
     """Make every axis finish its velocity change together with the slowest one
-    (VelocitySmoothing::timeSynchronization)."""
-    totals = [axis.total_time for axis in axes]  # each read before its own axis changes
-    longest = 0
-    for i, total in enumerate(totals):
-        if total > totals[longest]:
-            longest = i
-    desired = totals[longest]
+    (VelocitySmoothing::timeSynchronization). Three named axes, not a list: mypyc keeps their times unboxed."""
+    tx, ty, tz = x.total_time, y.total_time, z.total_time  # each read before its own axis changes
+    desired = tx  # the longest, the first of equals (PX4's scan)
+    if ty > desired:
+        desired = ty
+    if tz > desired:
+        desired = tz
     if desired <= _EPS:
         return
-    for i, axis in enumerate(axes):
-        if i != longest and totals[i] < desired:
-            axis.update_durations_given_total_time(desired)
+    if tx < desired:  # the longest axis keeps its plan
+        x.update_durations_given_total_time(desired)
+    if ty < desired:
+        y.update_durations_given_total_time(desired)
+    if tz < desired:
+        z.update_durations_given_total_time(desired)
 
 
 class PositionSmoother:
@@ -264,8 +267,10 @@ class PositionSmoother:
         self._max_speed_previous = 0.0
 
     def reset(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
-        for i, axis in enumerate(self.axes):
-            axis.reset(accel[i], vel[i], pos[i])
+        ax, ay, az = self.axes  # named: an index that varies would box the vectors' floats
+        ax.reset(accel[0], vel[0], pos[0])
+        ay.reset(accel[1], vel[1], pos[1])
+        az.reset(accel[2], vel[2], pos[2])
 
     def set_limits(self, jerk: float, accel_xy: float, accel_z: float, vel_xy: float, vel_z: float) -> None:
         ax, ay, az = self.axes
@@ -381,7 +386,7 @@ class PositionSmoother:
         ax.update_durations(vel_sp[0])
         ay.update_durations(vel_sp[1])
         az.update_durations(vel_sp[2])
-        synchronize(self.axes)
+        synchronize(ax, ay, az)
 
     def _stretch_xy(self, vehicle_pos: Vec3) -> float:
         """Slow the trajectory while the vehicle lags behind it (PositionSmoothing::_generateTrajectory)."""
