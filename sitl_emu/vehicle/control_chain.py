@@ -12,7 +12,7 @@ from typing import Final
 
 from sitl_emu.commander.commander import Commander
 from sitl_emu.control.cascade import MulticopterControl
-from sitl_emu.control.qmath import isfinite, norm, yaw_from_q
+from sitl_emu.control.qmath import isfinite, norm
 from sitl_emu.flight_tasks.core import IDLE_ACC_Z_M_S2
 from sitl_emu.flight_tasks.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.geo import GeoRef
@@ -54,7 +54,7 @@ class ControlChain:
         """What the navigator task sees (flight_tasks/core.py NavInput)."""
         home = c.home
         local = self.control.local_setpoint
-        return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, yaw_from_q(est.q_wxyz),
+        return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, self.control.heading_rad(est),
                         home.pos_ned_m if home is not None else (0.0, 0.0, 0.0),
                         home.yaw_rad if home is not None else 0.0, c.landed, c.armed,
                         self.control.takeoff.state, ref.alt_amsl_m,
