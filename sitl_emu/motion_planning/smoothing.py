@@ -233,11 +233,8 @@ def synchronize(x: AxisSmoother, y: AxisSmoother, z: AxisSmoother) -> None:
     """Make every axis finish its velocity change together with the slowest one
     (VelocitySmoothing::timeSynchronization). Three named axes, not a list: mypyc keeps their times unboxed."""
     tx, ty, tz = x.total_time, y.total_time, z.total_time  # each read before its own axis changes
-    desired = tx  # the longest, the first of equals (PX4's scan)
-    if ty > desired:
-        desired = ty
-    if tz > desired:
-        desired = tz
+    desired = ty if ty > tx else tx  # the longest, the first of equals (PX4's scan)
+    desired = tz if tz > desired else desired
     if desired <= _EPS:
         return
     if tx < desired:  # the longest axis keeps its plan
