@@ -154,7 +154,7 @@ class ModeExecutor:
             self._rtl_check_us = now_us + RTL_CHECK_PERIOD_US
             self._check_rtl_destination(nav_fn())
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
-        if nav_state in _STICK_ATTITUDE_MODES:
+        if self._task_mode is None and nav_state in _STICK_ATTITUDE_MODES:  # a task runs only in a task mode
             return self._stick_attitude(armed, nav_fn, dt_s, sticks)
         self._stabilized = None
         if nav_state is NavState.OFFBOARD:
@@ -213,7 +213,8 @@ class ModeExecutor:
         navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
         the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
         command = self._take_commands(commands) if commands else None
-        if nav_state not in _TASK_MODES or not armed:
+        # the running task's mode is a task mode: the set look-up only when the mode changed
+        if not armed or (nav_state is not self._task_mode and nav_state not in _TASK_MODES):
             self.task, self._task_mode, self._held = None, None, None
             if nav_state is not NavState.AUTO_TAKEOFF:
                 self._pending_takeoff = None
