@@ -111,6 +111,9 @@ DEFAULT_MODULES = (
     "sitl_emu/commander/health_report.py",  # 5.9: HealthReporter.due every cycle, the report's inputs every 100 ms
     "sitl_emu/commander/settings.py",  # 0.7: CommanderSettings fields
     "sitl_emu/commander/mode_intention.py",  # 0.2: ModeIntention.user_intended
+    # a fourth profile (the same): the parameter registry's change count, which every settings cache on the tick path
+    # asks each tick or cycle, a Python attribute look-up on the interpreted registry (params/changes.py)
+    "sitl_emu/params/changes.py",  # ~3
     # serve's tick path beyond Sim's: the flight log (serve writes one by default), its topics, packing and writer
     "sitl_emu/log/topics.py",
     "sitl_emu/log/ulog_writer.py",

@@ -46,6 +46,7 @@ class Commander:
                  send_event: SendEvent = drop) -> None:
         self.params = params
         self._settings = CommanderSettings.from_params(params)
+        self._param_changes = params.changes
         self._settings_version = params.version
         self._emit, self._send_event = emit, send_event  # texts; PX4 events no text tells (commander/notices.py)
         self._health = HealthReporter()
@@ -84,9 +85,9 @@ class Commander:
 
     @property
     def settings(self) -> CommanderSettings:
-        if self.params.version != self._settings_version:
+        if self._param_changes.value != self._settings_version:
             self._settings = CommanderSettings.from_params(self.params)
-            self._settings_version = self.params.version
+            self._settings_version = self._param_changes.value
         return self._settings
 
     # ---- inputs -------------------------------------------------------------------------------------------------
@@ -316,7 +317,7 @@ class Commander:
 
     def report_health(self, now_us: int, inputs: arming.CheckInputs | None = None, force: bool = False) -> None:
         """HealthAndArmingChecks::update (10 Hz, on a status change, forced by RUN_PREARM_CHECKS): a report if due."""
-        if self._health.due(now_us, (self.nav_state, self.armed), force):
+        if self._health.due(now_us, self.nav_state, self.armed, force):
             st = self.settings
             checked = inputs or self._check_inputs(now_us, st)
             report = ReportInputs.of(self.nav_state, self.armed, checked, self.geofence, self.fault_flags,

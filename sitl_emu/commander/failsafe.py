@@ -161,6 +161,7 @@ class Failsafe:
         self.faults = FaultFailsafes()  # link loss, battery, failure detector (commander/fault_failsafes.py)
         self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
+        self._calm = Decision(NavState.MANUAL, False)  # the last no-failsafe decision (_no_failsafe)
 
     def reset(self, *, user_mode_change: bool = False) -> None:
         """Arming, disarming or a user mode change ends every failsafe action (a mode change during the
@@ -179,7 +180,7 @@ class Failsafe:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.reset()
-            return Decision(user, False)
+            return self._no_failsafe(user)
         if terminated:
             return self._decide(NavState.TERMINATION, False, "")
         action: _Action = (0, user, False, CAUSE_GENERIC)
@@ -208,6 +209,13 @@ class Failsafe:
         self._rank = rank
         return decision
 
+    def _no_failsafe(self, user: NavState) -> Decision:
+        """The user's mode, no failsafe: one Decision kept while the user's mode stays (a Decision is read-only), not
+        a new one every commander cycle."""
+        if self._calm.nav_state is not user:
+            self._calm = Decision(user, False)
+        return self._calm
+
     def _delayed(self, now_us: int, cause: int) -> tuple[int, int, int]:
         """(seconds of Hold left, the action it delays, that action's cause) for the Hold before a delayed action;
         (0, 0, cause) for a Hold that is the action itself. The worst delayed action wins, as its cause."""
@@ -227,7 +235,7 @@ class Failsafe:
         told = rank > self._rank
         self._rank = rank
         if rank == 0:
-            return Decision(user, False)
+            return self._no_failsafe(user)
         return Decision(user, False, activated=told, action=ACTION_WARN, cause=cause)
 
     def _geofence(self, now_us: int, result: GeofenceResult, user: NavState, fail_act_us: int,

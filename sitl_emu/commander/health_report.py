@@ -225,13 +225,14 @@ class HealthReporter:
         self._last_report_us = 0
         self._unreported = False
         self._last_check_us: int | None = None
-        self._status: object = None
+        self._nav_state: NavState | None = None  # the status at the last run
+        self._armed = False
 
-    def due(self, now_us: int, status: object, force: bool = False) -> bool:
-        """Whether the checks run now: 100 ms after the last run, when `status` (mode, arming) changed, or forced."""
-        if force or status != self._status or self._last_check_us is None \
+    def due(self, now_us: int, nav_state: NavState, armed: bool, force: bool = False) -> bool:
+        """Whether the checks run now: 100 ms after the last run, when the mode or arming changed, or forced."""
+        if force or nav_state is not self._nav_state or armed != self._armed or self._last_check_us is None \
                 or now_us >= self._last_check_us + CHECK_INTERVAL_US:
-            self._last_check_us, self._status = now_us, status
+            self._last_check_us, self._nav_state, self._armed = now_us, nav_state, armed
             return True
         return False
 

@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from math import acos, asin, cos, sin
+from math import cos, sin
 from typing import Final
 
 from sitl_emu.control.qmath import (
+    acos,
     add,
+    asin,
     constrain,
     constrain3,
     dcm_z,

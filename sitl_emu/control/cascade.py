@@ -56,6 +56,8 @@ class MulticopterControl:
         self.rate = RateControl()
         self.takeoff = TakeoffHandling()
         self.hte = HoverThrustEstimator()
+        self._heading_of: RigidBodyState | None = None  # the state whose heading _heading_rad is (heading_rad)
+        self._heading_rad = 0.0
         self.settings = settings or CascadeSettings()
         self.reset()
 
@@ -73,6 +75,13 @@ class MulticopterControl:
         self.takeoff.configure(s.spoolup_time_s, s.tko_ramp_t_s, s.position.vel_p[2])
         self._sat_pos: tuple[bool, bool, bool] = (False, False, False)
         self._sat_neg: tuple[bool, bool, bool] = (False, False, False)
+
+    def heading_rad(self, state: RigidBodyState) -> float:
+        """The heading of `state`, worked out once per state: the navigator's task input and the position controller
+        read the same estimate in a tick (a state is read-only by convention: ARCHITECTURE.md, On the tick path)."""
+        if state is not self._heading_of:
+            self._heading_of, self._heading_rad = state, yaw_from_q(state.q_wxyz)
+        return self._heading_rad
 
     # --- telemetry -------------------------------------------------------------------------------------------
     @property
@@ -216,7 +225,7 @@ class MulticopterControl:
             self.position.reset_integral()
         self._set_limits(flying, dt_s)
         sp, self._in_failsafe = self._select_setpoint(sp, now_us)
-        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, yaw_from_q(state.q_wxyz), sp, dt_s)
+        out = self.position.update(state.pos_ned_m, state.vel_ned_m_s, self.heading_rad(state), sp, dt_s)
         self._local_setpoint, self._local_out = None, out
         self._update_hover_thrust(state, out, landed, dt_s, now_us)
         return out

@@ -4,10 +4,10 @@ ControlMath.cpp): NaN-aware sums, the horizontal velocity limit, the tilt limit 
 
 from __future__ import annotations
 
-from math import acos, cos, hypot, sin, sqrt
+from math import cos, sin, sqrt
 from typing import Final
 
-from sitl_emu.control.qmath import constrain, cross, isfinite, normalized, q_from_dcm_columns
+from sitl_emu.control.qmath import acos, constrain, cross, hypot, isfinite, normalized, q_from_dcm_columns
 from sitl_emu.types import Vec3, Vec4
 
 FLT_EPSILON: Final = 1.2e-7

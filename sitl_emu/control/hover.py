@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
-from sitl_emu.control.qmath import constrain, isfinite
+from sitl_emu.control.qmath import constrain, hypot, isfinite
 
 G: Final = 9.80665
 NOISE_LEARNING_TAU_S: Final = 2.0
@@ -72,7 +72,7 @@ class HoverThrustEstimator:
         self.var += s.process_noise * s.process_noise * dt_s * dt_s  # predict (as PX4: var += q dt^2)
         # trust the measurement less at speed: noise x (1 + the larger excess over HTE_VZ_THR / HTE_VXY_THR)^2
         vz_coeff = abs(vel_ned_m_s[2]) - s.vz_thr + 1.0
-        vxy_coeff = math.hypot(vel_ned_m_s[0], vel_ned_m_s[1]) - s.vxy_thr + 1.0
+        vxy_coeff = hypot(vel_ned_m_s[0], vel_ned_m_s[1]) - s.vxy_thr + 1.0
         coeff = vxy_coeff if vxy_coeff > vz_coeff else vz_coeff
         scale = (coeff if coeff > 1.0 else 1.0) ** 2
         self._fuse(acc_up_m_s2, thrust_up, scale, dt_s)

@@ -15,12 +15,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from math import hypot, sqrt
+from math import sqrt
 from typing import Final
 
 from sitl_emu.control.control_math import add_if_not_nan3, bodyz_to_attitude, constrain_xy, limit_tilt
 from sitl_emu.control.filters import LowPassDerivative
-from sitl_emu.control.qmath import at_least, at_most, constrain, emult, isfinite, norm, normalized, scale, sub
+from sitl_emu.control.qmath import (
+    at_least,
+    at_most,
+    constrain,
+    emult,
+    hypot,
+    isfinite,
+    norm,
+    normalized,
+    scale,
+    sub,
+)
 from sitl_emu.types import TrajectorySetpoint, Vec3, Vec4
 
 G: Final = 9.80665  # CONSTANTS_ONE_G

@@ -7,8 +7,17 @@ vectors into the world frame, `dcm_z` is the body z axis expressed in the world 
 from __future__ import annotations
 
 import math
+from typing import Final
 
 from sitl_emu.types import Vec3, Vec4
+
+# The math functions mypyc has no primitive for (it has sqrt, sin, cos, ...), for the tick path: compiled, a call of
+# `math.atan2` looks the name up in the math module first, one of these reads a C static (ARCHITECTURE.md, "On the
+# tick path"). The very same functions, so both builds compute the same bits.
+atan2: Final = math.atan2
+acos: Final = math.acos
+asin: Final = math.asin
+hypot: Final = math.hypot
 
 
 def q_mul(a: Vec4, b: Vec4) -> Vec4:
@@ -105,20 +114,20 @@ def q_from_yaw(yaw_rad: float) -> Vec4:
 def euler_from_q(q: Vec4) -> Vec3:
     """(roll, pitch, yaw) in radians, ZYX convention as PX4's Eulerf."""
     w, x, y, z = q
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
     return roll, pitch, yaw_from_q(q)
 
 
 def yaw_from_q(q: Vec4) -> float:
     """Heading in radians (the yaw of the ZYX Euler angles)."""
     w, x, y, z = q
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def tilt_from_q(q: Vec4) -> float:
     """Angle between the body z axis and the world down axis, in radians."""
-    return math.acos(max(-1.0, min(1.0, dcm_z(q)[2])))
+    return acos(max(-1.0, min(1.0, dcm_z(q)[2])))
 
 
 def rotate_world_to_body(q: Vec4, v: Vec3) -> Vec3:

@@ -7,10 +7,9 @@ cycle and hands the `TrajectorySetpoint` to the controller. Behaviour after PX4'
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
-from sitl_emu.control.qmath import isfinite
+from sitl_emu.control.qmath import hypot, isfinite
 from sitl_emu.flight_tasks.core import AutoSettings, Task, Waypoint
 from sitl_emu.flight_tasks.rtl import RtlTask
 from sitl_emu.motion_planning.smoothing import braking_distance
@@ -121,7 +120,7 @@ class RepositionTask(Task):
 def braking_point(nav: NavInput, settings: AutoSettings) -> Vec3:
     """Navigator::calculate_breaking_stop: where the vehicle stops horizontally, at the current altitude."""
     vx, vy = nav.vel_ned_m_s[0], nav.vel_ned_m_s[1]
-    speed = math.hypot(vx, vy)
+    speed = hypot(vx, vy)
     if speed < 1e-6:
         return nav.pos_ned_m
     dist = braking_distance(speed, settings.jerk, settings.acc_hor, 0.6 * settings.jerk)

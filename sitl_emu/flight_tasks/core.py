@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Final
 
-from sitl_emu.control.qmath import isfinite
+from sitl_emu.control.qmath import atan2, hypot, isfinite
 from sitl_emu.control.takeoff import TakeoffState
 from sitl_emu.motion_planning.heading import HeadingSmoother, wrap_pi
 from sitl_emu.motion_planning.smoothing import PositionSmoother
@@ -235,8 +235,8 @@ class AutoCore:
         # MPC_YAW_MODE 0: face the waypoint while outside the acceptance radius, else keep the locked heading
         dx = wp.target_ned_m[0] - nav.pos_ned_m[0]
         dy = wp.target_ned_m[1] - nav.pos_ned_m[1]
-        if self.s.yaw_mode in (0, 4) and isfinite(dx) and math.hypot(dx, dy) > self._acceptance(wp):
-            self._yaw_lock = math.atan2(dy, dx)
+        if self.s.yaw_mode in (0, 4) and isfinite(dx) and hypot(dx, dy) > self._acceptance(wp):
+            self._yaw_lock = atan2(dy, dx)
         if self._yaw_lock is None:
             self._yaw_lock = nav.yaw_rad
         return self._yaw_lock
@@ -261,6 +261,7 @@ class Task:
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params = params
+        self._param_changes = params.changes
         self._version = params.version
         self._settings = AutoSettings.from_params(params)
         self._core = AutoCore(nav, self._settings)
@@ -269,8 +270,8 @@ class Task:
 
     def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
         """The trajectory setpoint for this cycle (NaN = not controlled)."""
-        if self._params.version != self._version:
-            self._version = self._params.version
+        if self._param_changes.value != self._version:
+            self._version = self._param_changes.value
             self._settings = AutoSettings.from_params(self._params)
             self._core.s = self._settings
         wp = self._waypoint(nav)

@@ -96,6 +96,7 @@ class ModeExecutor:
 
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
+        self._param_changes = params.changes
         self.task: FlightTask | None = None
         self._stabilized: StabilizedMode | None = None  # STABILIZED / MANUAL, while in force
         self._task_mode: NavState | None = None  # the mode self.task flies; None exactly when no task runs
@@ -115,6 +116,8 @@ class ModeExecutor:
         self._target_fix: TargetFix | None = None  # the latest FOLLOW_TARGET, for Follow Target
         self._mission_land = MissionLandAltitude()  # the mission landing's return altitude (RTL_TYPE 1 and 3)
         self._rtl_check_us = 0  # when Return's destination is evaluated next while Return is inactive
+        self._auto_settings: AutoSettings | None = None  # for that evaluation, read again when a parameter changes
+        self._auto_version = -1
 
     def attach_missions(self, store: MissionStore) -> None:
         """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
@@ -151,7 +154,7 @@ class ModeExecutor:
             self._rtl_check_us = now_us + RTL_CHECK_PERIOD_US
             self._check_rtl_destination(nav_fn())
         new_task = self._select_task(nav_state, armed, nav_fn, commands, ref)
-        if nav_state in _STICK_ATTITUDE_MODES:
+        if self._task_mode is None and nav_state in _STICK_ATTITUDE_MODES:  # a task runs only in a task mode
             return self._stick_attitude(armed, nav_fn, dt_s, sticks)
         self._stabilized = None
         if nav_state is NavState.OFFBOARD:
@@ -183,7 +186,9 @@ class ModeExecutor:
             if now_us < self._next_us:
                 return held
             dt = (now_us - self._last_us) * 1e-6
-        if isinstance(task, _STICK_TASKS):
+        # the auto tasks' compiled class first: a native type check, where the tuple of interpreted classes costs two
+        # __instancecheck__ look-ups every task cycle
+        if not isinstance(task, auto.Task) and isinstance(task, _STICK_TASKS):
             task.sticks = sticks
         sp = task.update(nav_fn(), dt)
         held = self._held = ExecutorOutput(sp, None, task.setpoint_type, task.finished, (), task.want_takeoff)
@@ -208,7 +213,8 @@ class ModeExecutor:
         navigator_main.cpp runs no mode while disarmed ("Do not execute any state machine while we are disarmed"):
         the task starts at arming, with the parameters of a NAV_TAKEOFF received before."""
         command = self._take_commands(commands) if commands else None
-        if nav_state not in _TASK_MODES or not armed:
+        # the running task's mode is a task mode: the set look-up only when the mode changed
+        if not armed or (nav_state is not self._task_mode and nav_state not in _TASK_MODES):
             self.task, self._task_mode, self._held = None, None, None
             if nav_state is not NavState.AUTO_TAKEOFF:
                 self._pending_takeoff = None
@@ -296,7 +302,9 @@ class ModeExecutor:
     def _check_rtl_destination(self, nav: auto.NavInput) -> ReturnDestination | None:
         """RTL::setRtlTypeAndDestination: the destination (the vehicle's choice), the mission landing's altitude."""
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        self._mission_land.evaluate(destination, nav, AutoSettings.from_params(self.params))
+        if self._auto_settings is None or self._auto_version != self._param_changes.value:
+            self._auto_settings, self._auto_version = AutoSettings.from_params(self.params), self._param_changes.value
+        self._mission_land.evaluate(destination, nav, self._auto_settings)
         return destination
 
     def _mission_loiter(self, nav: auto.NavInput) -> Vec3 | None:

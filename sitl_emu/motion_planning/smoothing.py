@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
-from sitl_emu.control.qmath import all_finite3, constrain, isfinite
+from sitl_emu.control.qmath import acos, all_finite3, constrain, hypot, isfinite
 from sitl_emu.types import Vec3
 
 _EPS: Final = 1.1920929e-07  # FLT_EPSILON, as PX4 compares with it
@@ -50,10 +50,10 @@ def speed_in_turn(alpha: float, accel: float, radius: float) -> float:
 
 def _angle(a: tuple[float, float], b: tuple[float, float]) -> float:
     """The angle between two 2D vectors (a zero vector counts as orthogonal, as unit_or_zero makes it)."""
-    na, nb = math.hypot(a[0], a[1]), math.hypot(b[0], b[1])
+    na, nb = hypot(a[0], a[1]), hypot(b[0], b[1])
     if na <= _EPS or nb <= _EPS:
         return math.pi / 2.0
-    return math.acos(max(-1.0, min(1.0, (a[0] * b[0] + a[1] * b[1]) / (na * nb))))
+    return acos(max(-1.0, min(1.0, (a[0] * b[0] + a[1] * b[1]) / (na * nb))))
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,14 +70,14 @@ class _Limits:
 def _start_speed(start: Vec3, target: Vec3, following: Vec3, exit_speed: float, lim: _Limits) -> float:
     """Fastest speed at `start` that still makes the turn at `target` towards `following`
     (TrajectoryConstraints.hpp computeStartXYSpeedFromWaypoints)."""
-    leg_next = math.hypot(target[0] - following[0], target[1] - following[1])
+    leg_next = hypot(target[0] - following[0], target[1] - following[1])
     at_target = 0.0
     if leg_next > 0.001 and leg_next >= lim.accept_xy:  # different points, the next outside the acceptance radius
         alpha = _angle((target[0] - start[0], target[1] - start[1]),
                        (target[0] - following[0], target[1] - following[1]))
         turn = speed_in_turn(min(max(alpha, 0.0), math.pi - _EPS), lim.gain * lim.accel, lim.accept_xy)
         at_target = min(turn, exit_speed, lim.cruise)
-    dist = math.hypot(start[0] - target[0], start[1] - target[1])
+    dist = hypot(start[0] - target[0], start[1] - target[1])
     return min(lim.cruise, max_speed_from_distance(lim.jerk, lim.accel, dist, at_target))
 
 
@@ -229,20 +229,20 @@ class AxisSmoother:
         return self._saturate_t1(a0, jerk, t1)
 
 
-def synchronize(axes: list[AxisSmoother]) -> None:
+def synchronize(x: AxisSmoother, y: AxisSmoother, z: AxisSmoother) -> None:
     """Make every axis finish its velocity change together with the slowest one
-    (VelocitySmoothing::timeSynchronization)."""
-    totals = [axis.total_time for axis in axes]  # each read before its own axis changes
-    longest = 0
-    for i, total in enumerate(totals):
-        if total > totals[longest]:
-            longest = i
-    desired = totals[longest]
+    (VelocitySmoothing::timeSynchronization). Three named axes, not a list: mypyc keeps their times unboxed."""
+    tx, ty, tz = x.total_time, y.total_time, z.total_time  # each read before its own axis changes
+    desired = ty if ty > tx else tx  # the longest, the first of equals (PX4's scan)
+    desired = tz if tz > desired else desired
     if desired <= _EPS:
         return
-    for i, axis in enumerate(axes):
-        if i != longest and totals[i] < desired:
-            axis.update_durations_given_total_time(desired)
+    if tx < desired:  # the longest axis keeps its plan
+        x.update_durations_given_total_time(desired)
+    if ty < desired:
+        y.update_durations_given_total_time(desired)
+    if tz < desired:
+        z.update_durations_given_total_time(desired)
 
 
 class PositionSmoother:
@@ -264,8 +264,10 @@ class PositionSmoother:
         self._max_speed_previous = 0.0
 
     def reset(self, accel: Vec3, vel: Vec3, pos: Vec3) -> None:
-        for i, axis in enumerate(self.axes):
-            axis.reset(accel[i], vel[i], pos[i])
+        ax, ay, az = self.axes  # named: an index that varies would box the vectors' floats
+        ax.reset(accel[0], vel[0], pos[0])
+        ay.reset(accel[1], vel[1], pos[1])
+        az.reset(accel[2], vel[2], pos[2])
 
     def set_limits(self, jerk: float, accel_xy: float, accel_z: float, vel_xy: float, vel_z: float) -> None:
         ax, ay, az = self.axes
@@ -298,7 +300,7 @@ class PositionSmoother:
         else:
             self._max_speed_previous = xy_speed
         dx, dy = crossing[0] - pos[0], crossing[1] - pos[1]
-        dist = math.hypot(dx, dy)
+        dist = hypot(dx, dy)
         ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
         vel_sp = (ux * xy_speed, uy * xy_speed, _sign(crossing[2] - pos[2]) * self._z_speed(pos, target, following))
         self._advance(vehicle_pos, vel_sp, dt_s)
@@ -317,9 +319,9 @@ class PositionSmoother:
         """The trajectory moves (> 0.2 m/s) more than ~10 degrees away from the target, outside its acceptance
         radius (PositionSmoothing::_isTurning)."""
         ax, ay = self.axes[0], self.axes[1]
-        speed = math.hypot(ax.v, ay.v)
+        speed = hypot(ax.v, ay.v)
         tx, ty = target[0] - ax.x, target[1] - ay.x
-        dist = math.hypot(tx, ty)
+        dist = hypot(tx, ty)
         if speed <= 0.2 or dist <= self.acceptance_xy_m:
             return False
         cos_align = (ax.v * tx + ay.v * ty) / (speed * dist) if dist > 0.0 else 0.0
@@ -346,9 +348,9 @@ class PositionSmoother:
         arrival = 0.0
         if abs(target[2] - following[2]) > 0.001:
             # PX4 pairs each point's horizontal distance from the origin with its altitude
-            start = (math.hypot(pos[0], pos[1]), pos[2])
-            tgt = (math.hypot(target[0], target[1]), target[2])
-            nxt = (math.hypot(following[0], following[1]), following[2])
+            start = (hypot(pos[0], pos[1]), pos[2])
+            tgt = (hypot(target[0], target[1]), target[2])
+            nxt = (hypot(following[0], following[1]), following[2])
             alpha = _angle((tgt[0] - start[0], tgt[1] - start[1]), (tgt[0] - nxt[0], tgt[1] - nxt[1]))
             turn = speed_in_turn(min(max(alpha, 0.0), math.pi - _EPS), az.max_accel, self.acceptance_z_m)
             arrival = min(turn, az.max_vel)
@@ -360,7 +362,7 @@ class PositionSmoother:
         ax, ay, az = self.axes
         if isfinite(target[0]) and isfinite(target[1]):
             dx, dy = target[0] - ax.x, target[1] - ay.x
-            dist = math.hypot(dx, dy)
+            dist = hypot(dx, dy)
             speed = min(self.cruise_speed_m_s, max_speed_from_distance(ax.max_jerk, ax.max_accel, dist, 0.0))
             ux, uy = (dx / dist, dy / dist) if dist > 1e-6 else (0.0, 0.0)
             out0 = ux * speed + (ff[0] if isfinite(ff[0]) else 0.0)
@@ -381,7 +383,7 @@ class PositionSmoother:
         ax.update_durations(vel_sp[0])
         ay.update_durations(vel_sp[1])
         az.update_durations(vel_sp[2])
-        synchronize(self.axes)
+        synchronize(ax, ay, az)
 
     def _stretch_xy(self, vehicle_pos: Vec3) -> float:
         """Slow the trajectory while the vehicle lags behind it (PositionSmoothing::_generateTrajectory)."""
@@ -389,7 +391,7 @@ class PositionSmoother:
         ex, ey = ax.x - vehicle_pos[0], ay.x - vehicle_pos[1]
         if self.max_xy_error_m <= _EPS or ex * ax.v + ey * ay.v < 0.0:
             return 1.0
-        return 1.0 - constrain(math.hypot(ex, ey) / self.max_xy_error_m, 0.0, 1.0)
+        return 1.0 - constrain(hypot(ex, ey) / self.max_xy_error_m, 0.0, 1.0)
 
     def _stretch_z(self, vehicle_pos: Vec3) -> float:
         ez = self.axes[2].x - vehicle_pos[2]

@@ -44,11 +44,19 @@ TEXT_NO_HOME: Final = "Geofence invalid, doesn't contain Home position"
 TEXT_NO_CURRENT: Final = "Geofence invalid, doesn't contain current vehicle position"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class GeoPoint:
+    """A global position; read-only by convention (made at every geofence check: ARCHITECTURE.md, On the tick
+    path)."""
+
     lat_deg: float
     lon_deg: float
     alt_amsl_m: float
+
+    def __init__(self, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> None:
+        self.lat_deg = lat_deg
+        self.lon_deg = lon_deg
+        self.alt_amsl_m = alt_amsl_m
 
 
 @dataclass(frozen=True, slots=True)
@@ -247,14 +255,22 @@ def mission_fence_violation(mission: Sequence[MissionItem], fence: Geofence, s: 
     return None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class GeofenceResult:
-    """geofence_result (navigator -> commander): which limit is crossed, and GF_ACTION."""
+    """geofence_result (navigator -> commander): which limit is crossed, and GF_ACTION; read-only by convention (made
+    at every geofence check: ARCHITECTURE.md, On the tick path)."""
 
     max_dist: bool = False
     max_alt: bool = False
     custom: bool = False
     action: int = GF_ACTION_NONE
+
+    def __init__(self, max_dist: bool = False, max_alt: bool = False, custom: bool = False,
+                 action: int = GF_ACTION_NONE) -> None:
+        self.max_dist = max_dist
+        self.max_alt = max_alt
+        self.custom = custom
+        self.action = action
 
     def __eq__(self, other: object) -> bool:
         """The dataclass's comparison, written out so that mypyc compiles it (the commander's checks compare results

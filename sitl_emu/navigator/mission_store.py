@@ -89,7 +89,9 @@ def plan_id(items: tuple[MissionItem, ...]) -> int:
 class MissionStore:
     """The three plans, the mission's current item and the vehicle-wide transfer lock."""
 
-    plans: dict[int, Plan] = field(default_factory=lambda: {t: Plan() for t in PLAN_TYPES})
+    # indexed by plan type (PLAN_TYPES are 0, 1, 2): a list, as the navigator's geofence check reads two plans every
+    # commander cycle (a dict look-up hashes a boxed int)
+    plans: list[Plan] = field(default_factory=lambda: [Plan() for _ in PLAN_TYPES])
     current_seq: int = 0
     transfer_owner: object | None = None  # the link (protocol handler) whose upload is running
     uploads: int = 0  # completed mission uploads (PX4 looks MIS_DIST_1WP etc. up from the first one)

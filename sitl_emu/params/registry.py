@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Protocol
 
+from sitl_emu.params.changes import ChangeCount
+
 FLT_MAX = 3.4028234663852886e38  # the largest finite float32: a REAL32 travels and is stored as float32 in PX4
 INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
 _F32 = struct.Struct("<f")
@@ -76,7 +78,8 @@ def same_value(kind: ParamType, a: float, b: float) -> bool:
 
 
 class ParamRegistry:
-    """Values by name. `version` increases on every accepted change, so users can cache derived settings.
+    """Values by name. `version` increases on every accepted change, so users can cache derived settings (on the tick
+    path through `changes`, the same count: params/changes.py).
 
     `used` names the parameters listed at start (default: all of `defs`); the others are known but unlisted.
     """
@@ -95,11 +98,16 @@ class ParamRegistry:
         if unknown:
             raise ValueError(f"used parameters without a definition: {', '.join(unknown)}")
         self._index = {n: i for i, n in enumerate(self._used)}
-        self.version = 0
+        self.changes = ChangeCount()
         self.storage: ParamStorage | None = None  # set by whoever keeps the values between runs (`serve`)
         self._hash: tuple[int, int, int] | None = None  # (version, used count, hash)
 
     # --- what exists ---------------------------------------------------------------------------------------------
+    @property
+    def version(self) -> int:
+        """How many accepted changes there were (`changes.value`)."""
+        return self.changes.value
+
     def __contains__(self, name: object) -> bool:
         """Known by name (used or not), as PX4's param_find_no_notification finds every compiled-in parameter."""
         return name in self._defs
@@ -169,7 +177,7 @@ class ParamRegistry:
         v = _checked(d, value)
         if not same_value(d.type, self._values[name], v):
             self._values[name] = v
-            self.version += 1
+            self.changes.value += 1
         return self._values[name]
 
     def reset(self, names: Iterable[str] | None = None) -> None:
@@ -181,7 +189,7 @@ class ParamRegistry:
                 self._values[d.name] = d.default
                 changed = True
         if changed:
-            self.version += 1
+            self.changes.value += 1
 
     def values(self) -> dict[str, float]:
         """Every known parameter's value."""

@@ -12,7 +12,7 @@ from typing import Final
 
 from sitl_emu.commander.commander import Commander
 from sitl_emu.control.cascade import MulticopterControl
-from sitl_emu.control.qmath import isfinite, norm, yaw_from_q
+from sitl_emu.control.qmath import isfinite, norm
 from sitl_emu.flight_tasks.core import IDLE_ACC_Z_M_S2
 from sitl_emu.flight_tasks.mode_executor import ExecutorOutput, ModeExecutor
 from sitl_emu.geo import GeoRef
@@ -41,6 +41,7 @@ class ControlChain:
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
         self.control = MulticopterControl(cascade_settings(params))
+        self._param_changes = params.changes
         self._control_params_version = params.version
         self.executor = ModeExecutor(params)
         self._detector = LandDetector(params)
@@ -53,7 +54,7 @@ class ControlChain:
         """What the navigator task sees (flight_tasks/core.py NavInput)."""
         home = c.home
         local = self.control.local_setpoint
-        return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, yaw_from_q(est.q_wxyz),
+        return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, self.control.heading_rad(est),
                         home.pos_ned_m if home is not None else (0.0, 0.0, 0.0),
                         home.yaw_rad if home is not None else 0.0, c.landed, c.armed,
                         self.control.takeoff.state, ref.alt_amsl_m,
@@ -62,8 +63,8 @@ class ControlChain:
     def control_update(self, est: RigidBodyState, out: ExecutorOutput, armed: bool, landed: bool, now_us: int,
                        dt_s: float) -> Vec4:
         """The cascade with the task's want_takeoff (auto modes) and the land detector's ground contact."""
-        if self.params.version != self._control_params_version:  # a parameter changed: new controller settings
-            self._control_params_version = self.params.version
+        if self._param_changes.value != self._control_params_version:  # a parameter changed: new controller settings
+            self._control_params_version = self._param_changes.value
             self.control.settings = cascade_settings(self.params)
         return self.control.update(est, out.trajectory, out.attitude, armed, landed, now_us, dt_s,
                                    ground_contact=self.ground_contact, want_takeoff=out.want_takeoff)

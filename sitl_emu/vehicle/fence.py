@@ -30,7 +30,7 @@ from sitl_emu.navigator.mission_store import PLAN_FENCE, PLAN_MISSION, PLAN_RALL
 from sitl_emu.navigator.rally import ReturnDestination, choose_destination, mission_landing
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import NavState, Severity
-from sitl_emu.types import Vec3
+from sitl_emu.types import HomePosition, Vec3
 from sitl_emu.vehicle.rtl_avoidance import RtlAvoidance
 
 # emit(severity, module, text, is_event, statustext), as Vehicle._emit
@@ -54,18 +54,22 @@ class FenceChecks:
         self.params = params
         self.monitor = GeofenceMonitor()
         self._settings: GeofenceSettings = geofence_settings(params)
+        self._param_changes = params.changes
         self._version = params.version
         self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
         # the very objects that key was made of (plans and home are replaced, never changed in place): while they
         # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
         # changes)
-        self._mission_inputs: tuple[object, ...] = (None, None, None, -1)
+        self._checked_mission: Plan | None = None
+        self._checked_fence: Plan | None = None
+        self._checked_home: HomePosition | None = None
+        self._checked_version = -1
         self.avoidance = RtlAvoidance(params)  # Return's way around the fence (rtl_avoidance.py)
 
     @property
     def settings(self) -> GeofenceSettings:
-        if self.params.version != self._version:
-            self._settings, self._version = geofence_settings(self.params), self.params.version
+        if self._param_changes.value != self._version:
+            self._settings, self._version = geofence_settings(self.params), self._param_changes.value
         return self._settings
 
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
@@ -127,10 +131,12 @@ class FenceChecks:
 
     def _inputs_replaced(self, mission: Plan, fence: Plan, c: Commander) -> bool:
         """Whether a plan, home or the parameters were replaced since the last call (maybe with equal values)."""
-        inputs = self._mission_inputs
-        if inputs[0] is mission and inputs[1] is fence and inputs[2] is c.home and inputs[3] == self.params.version:
+        version = self._param_changes.value
+        if (mission is self._checked_mission and fence is self._checked_fence and c.home is self._checked_home
+                and version == self._checked_version):
             return False
-        self._mission_inputs = (mission, fence, c.home, self.params.version)
+        self._checked_mission, self._checked_fence, self._checked_home = mission, fence, c.home
+        self._checked_version = version
         return True
 
     def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:

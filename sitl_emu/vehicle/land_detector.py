@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 from typing import Final
 
-from sitl_emu.control.qmath import isfinite
+from sitl_emu.control.qmath import hypot, isfinite
 from sitl_emu.params import ParamRegistry
 from sitl_emu.types import Vec3
 
@@ -122,6 +122,7 @@ class LandDetector:
 
     def __init__(self, params: ParamRegistry) -> None:
         self._params = params
+        self._param_changes = params.changes
         self._version = -1
         self._s = _Settings.from_params(params)
         self._freefall = Hysteresis(False, FREEFALL_TRIGGER_US)
@@ -156,9 +157,9 @@ class LandDetector:
                                  self._freefall.state)
 
     def _refresh(self) -> None:
-        if self._params.version == self._version:
+        if self._param_changes.value == self._version:
             return
-        self._version = self._params.version
+        self._version = self._param_changes.value
         self._s = _Settings.from_params(self._params)
         for h in (self._ground_contact, self._maybe_landed, self._landed):
             h.time_from_false_us = self._s.stage_us
@@ -169,7 +170,7 @@ class LandDetector:
         vel = inp.vel_ned_m_s
         vz_limit = s.z_vel_max * (WIDEN_FACTOR if self._maybe_landed.state else 1.0)
         vertical_movement = abs(vel[2]) > vz_limit
-        horizontal_movement = math.hypot(vel[0], vel[1]) > s.xy_vel_max
+        horizontal_movement = hypot(vel[0], vel[1]) > s.xy_vel_max
         share = 0.6 if s.use_hte else 0.3  # 60 % of the min..hover range with a hover-thrust estimate, else 30 %
         contact = inp.thrust_setpoint <= s.thr_min + (inp.hover_thrust - s.thr_min) * share
         if inp.in_descent_mode and not self._maybe_landed.state and not self._landed.state:
@@ -186,6 +187,6 @@ class LandDetector:
         if inp.thrust_setpoint > min_thrust or self._freefall.state:
             return False
         rot_limit = s.rot_max_rad_s * (WIDEN_FACTOR if self._maybe_landed.state else 1.0)
-        if math.hypot(inp.rates_frd_rad_s[0], inp.rates_frd_rad_s[1]) > rot_limit:
+        if hypot(inp.rates_frd_rad_s[0], inp.rates_frd_rad_s[1]) > rot_limit:
             return False
         return self._ground_contact.state

@@ -77,6 +77,7 @@ class Vehicle:
         flight: disturbance/estimate.py) are off by default (faults.py).
         """
         self.params: ParamRegistry = params if params is not None else default_registry()
+        self._param_changes = self.params.changes  # params/changes.py
         self.sysid = sysid
         self._home_tuple = home
         self._seed = seed
@@ -183,8 +184,8 @@ class Vehicle:
         return self._fence.rtl_avoidance(nav.pos_ned_m, destination_ned_m, self.ref, self._emit)
 
     def _sih_config(self) -> SihConfig:
-        if self.params.version != self._sih_version:
-            self._sih, self._sih_version = sih_config(self.params), self.params.version
+        if self._param_changes.value != self._sih_version:
+            self._sih, self._sih_version = sih_config(self.params), self._param_changes.value
         return self._sih
 
     # ---- inputs -------------------------------------------------------------------------------------------------

@@ -145,10 +145,11 @@ def test_the_summaries_and_a_checks_arguments_as_events_send_packs_them():
 
 def test_the_checks_run_at_10_hz_and_at_once_when_the_mode_or_arming_changes():
     reporter = HealthReporter()  # Commander::run: every 100 ms, on _status_changed, or forced
-    hold, armed = (NavState.AUTO_LOITER, False), (NavState.AUTO_LOITER, True)
-    assert reporter.due(0, hold) and not reporter.due(50_000, hold)
-    assert reporter.due(60_000, armed) and not reporter.due(100_000, armed)
-    assert reporter.due(160_000, armed) and reporter.due(170_000, armed, force=True)
+    hold = NavState.AUTO_LOITER
+    assert reporter.due(0, hold, False) and not reporter.due(50_000, hold, False)
+    assert reporter.due(60_000, hold, True) and not reporter.due(100_000, hold, True)
+    assert not reporter.due(110_000, hold, True) and reporter.due(120_000, NavState.AUTO_LAND, True)
+    assert reporter.due(220_000, NavState.AUTO_LAND, True) and reporter.due(230_000, hold, True, force=True)
 
 
 @pytest.mark.parametrize(("warning", "name", "level", "modes"), [

@@ -56,6 +56,15 @@ def test_set_keeps_the_value_and_bumps_the_version(reg):
     assert reg.version == v0 + 1
 
 
+def test_a_reader_that_keeps_the_change_count_sees_every_change(reg):
+    """The tick path's settings caches keep `changes` (params/changes.py), not the registry: it is the version."""
+    changes = reg.changes
+    reg.set("MPC_XY_VEL_MAX", 8)
+    assert changes.value == reg.version == 1
+    reg.reset()
+    assert changes.value == reg.version == 2
+
+
 @pytest.mark.parametrize(("name", "value", "words"), [
     ("MPC_XY_VEL_MAX", math.nan, "finite"),
     ("MPC_XY_VEL_MAX", math.inf, "finite"),
