@@ -39,7 +39,7 @@ def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
         session.link.close()
         session.sticks.close()
     if interrupted:
-        out.write(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}\n")
+        click.echo(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}", err=True)
         return 130
     unlanded = session.landing_missing()
     if session.armed_seen:

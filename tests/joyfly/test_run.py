@@ -65,13 +65,15 @@ def test_ctrl_c_before_arming_says_nothing_was_flown() -> None:
     assert "distance flown" not in out
 
 
-def test_a_double_ctrl_c_prints_the_view_once_and_names_the_state_the_vehicle_was_left_in() -> None:
+def test_a_double_ctrl_c_prints_the_view_once_and_names_the_state_the_vehicle_was_left_in(capsys: Any) -> None:
+    """The closing sentence goes to stderr (README: the summary and a line on stderr say how joyfly ended)."""
     status, out, vehicle = fly([7.0, 7.5], live=True)
+    err = capsys.readouterr().err
     assert status == 130
     final = out.split("\x1b[J")[-1]  # what stays on the terminal after the last redraw
-    assert final.count("fence margin") == 1 and final.index("fence margin") < final.index("interrupted twice")
-    assert out.count("interrupted twice") == 1
-    assert "the vehicle was left armed in AUTO.LAND" in final and vehicle.armed
+    assert final.count("fence margin") == 1 and "interrupted twice" not in out
+    assert err.count("interrupted twice") == 1 and len(err.splitlines()) == 1
+    assert "the vehicle was left armed in AUTO.LAND" in err and vehicle.armed
 
 
 class Events:
