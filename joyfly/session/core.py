@@ -84,6 +84,7 @@ class Note:
     time_s: float
     level: Level
     text: str
+    closing: bool = False  # the session's failure: joyfly ends with this sentence on stderr, the terminal prints none
 
 
 @dataclass(frozen=True, slots=True)
@@ -262,8 +263,8 @@ class SessionCore:
         """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
         self._set_phase(Phase.DONE)
 
-    def _note(self, level: Level, text: str) -> None:
-        note = Note(self.clock.now(), level, text)
+    def _note(self, level: Level, text: str, closing: bool = False) -> None:
+        note = Note(self.clock.now(), level, text, closing)
         self.notes.append(note)
         del self.notes[:-20]
         log.log(level.value, text)
@@ -279,7 +280,7 @@ class SessionCore:
 
     def _fail(self, text: str) -> None:
         self.error = text
-        self._note(Level.ERROR, text)
+        self._note(Level.ERROR, text, closing=True)
         self._set_phase(Phase.FAILED)
 
     def _streaming_allowed(self) -> bool:

@@ -332,3 +332,4 @@ def test_no_vehicle_exits_with_a_clear_message() -> None:
     assert f"No HEARTBEAT from a vehicle on UDP 127.0.0.1:{port}" in proc.stderr
     assert "sitl-emu serve" in proc.stderr and "Traceback" not in proc.stderr
     assert "distance flown" not in proc.stdout  # nothing flew, so no flight summary
+    assert "No HEARTBEAT" not in proc.stdout and proc.stderr.count("No HEARTBEAT") == 1  # said once, on stderr

@@ -46,7 +46,7 @@ def fly(ctrl_c_at_s: list[float], speak: bool = True, live: bool = False,
     out = io.StringIO()
     view = CtrlC(LiveDashboard(out) if live else PlainLog(out), ctrl_c_at_s)
     session = FlightSession(VehicleLink(ours, clock), TimedSticks(clock, [(0.0, StickCommand())]), clock,
-                            SessionSettings(connect_timeout_s=30.0, **settings), on_note=view.note)
+                            SessionSettings(**{"connect_timeout_s": 30.0, **settings}), on_note=view.note)
     status = fly_session(session, view, out)
     return status, out.getvalue(), vehicle
 
@@ -137,3 +137,12 @@ def test_a_flight_that_lands_exits_0_and_one_left_hovering_on_purpose_too(capsys
     assert status == 0 and "Landed and disarmed" in out and "landing               none" not in out
     status, out, vehicle = fly([8.0], on_exit="hold")
     assert status == 0 and "The vehicle holds position." in out and vehicle.armed and not vehicle.landed
+
+
+def test_a_failure_is_said_once_on_stderr_not_also_in_the_view(capsys: Any) -> None:
+    """The session's failure (here: no HEARTBEAT) was an ERROR line in the view and the closing line on stderr."""
+    for live in (False, True):
+        status, out, _ = fly([], speak=False, live=live, connect_timeout_s=1.0)
+        err = capsys.readouterr().err
+        assert status == 1 and "No HEARTBEAT" not in out, out
+        assert err.count("No HEARTBEAT") == 1 and len(err.splitlines()) == 1, err
