@@ -190,6 +190,7 @@ class SessionCore:
         self.notes: list[Note] = []
         self.exit_requested = False
         self.error: str | None = None
+        self.error_is_mistake = False  # the failure is the user's to fix (the joystick sends no js_events): exit 2
         self._start_s = clock.now()
         self._phase_s = self._start_s
         self._period_s = 1.0 / max(settings.rate_hz, 1.0)
@@ -278,8 +279,8 @@ class SessionCore:
             self._phase_s = self.clock.now()
             self._retry = None
 
-    def _fail(self, text: str) -> None:
-        self.error = text
+    def _fail(self, text: str, mistake: bool = False) -> None:
+        self.error, self.error_is_mistake = text, mistake
         self._note(Level.ERROR, text, closing=True)
         self._set_phase(Phase.FAILED)
 
