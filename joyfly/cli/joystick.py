@@ -24,7 +24,7 @@ from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.listing import sdl_lines
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sdl.source import SdlSource
-from joyfly.sticks.sources import open_source, pick_profile
+from joyfly.sticks.sources import check_profile_choice, open_source, pick_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
@@ -106,6 +106,7 @@ def test_cmd(joy: str, sdl_mapping: str | None, profile_name: str, config_path: 
     clock = WallClock()
     try:
         overrides: dict[str, Any] = read_config(config_path) if config_path else {}
+        check_profile_choice(profile_name, overrides)
         opened = open_source(joy, clock, dev_dir=dev_dir, mappings=SdlMappings(sdl_mapping))
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None

@@ -134,3 +134,18 @@ def test_test_reads_a_raw_file_and_refuses_a_plain_one(tmp_path):
     result = run("test", "--joy", str(events), "--duration", "0.2")
     assert result.exit_code == 1 and len(result.output.splitlines()) == 1
     assert result.output.startswith(f"joyfly: {events} is a regular file") and f"raw:{events}" in result.output
+
+
+def test_an_unknown_profile_is_named_before_any_joystick_is_looked_for(tmp_path):
+    """With no joystick, `--profile nosuch` said "No joystick ..." and never named the option's mistake."""
+    from joyfly.cli.main import main
+
+    missing = str(tmp_path / "js9")
+    fly = CliRunner().invoke(main, ["fly", "--joy", missing, "--profile", "nosuch"])
+    assert fly.exit_code == 2 and "Unknown profile 'nosuch'" in fly.output and "No joystick" not in fly.output
+    test = run("test", "--joy", missing, "--dev-dir", str(tmp_path), "--profile", "nosuch")
+    assert test.exit_code == 1 and "Unknown profile 'nosuch'" in test.output and "No joystick" not in test.output
+    config = tmp_path / "joyfly.toml"
+    config.write_text("[profile]\nbase = \"nosuch\"\n")
+    fly = CliRunner().invoke(main, ["fly", "--joy", missing, "--config", str(config)])
+    assert fly.exit_code == 2 and "Unknown profile 'nosuch'" in fly.output and "No joystick" not in fly.output
