@@ -15,6 +15,7 @@ from typing import Any, TextIO
 import click
 
 from joyfly.cli.calibrate import calibrate
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.js.seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
@@ -56,7 +57,7 @@ def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
         for line in lines:  # why SDL could not look
             click.echo(line)
         click.echo(f"No joystick found (SDL sees none, and no {dev_dir}/js*): plug one in, or fly a virtual one "
-                   "with --joy script:examples/joystick_script.txt.")
+                   f"with {virtual_joystick_hint()}.")
         return
     for line in lines:
         click.echo(line)

@@ -19,6 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.js.seam import js_reader, open_js
 from joyfly.sticks.profiles.profile import BUILTIN, ROLES, Profile, apply_overrides, get_profile, load_profile
@@ -82,8 +83,7 @@ def _open_auto(clock: Clock, dev_dir: str, mappings: SdlMappings, loader: Callab
             path = js_reader().default_device(dev_dir)
         except JoystickError:
             raise JoystickError(f"No joystick found: SDL sees no controller and there is no {dev_dir}/js*; plug one "
-                                f"in and {LIST_HINT}, or fly a virtual one with "
-                                "--joy script:examples/joystick_script.txt.") from None
+                                f"in and {LIST_HINT}, or fly a virtual one with {virtual_joystick_hint()}.") from None
         return Opened(open_js(path, clock, dev_dir), f"{path}: the first js device (SDL sees no controller)")
     raise JoystickError(f"No joystick found (SDL sees no controller): plug one in and {LIST_HINT}.")
 

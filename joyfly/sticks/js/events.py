@@ -12,6 +12,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.types import JoyState
 
 JS_EVENT_BUTTON = 0x01
@@ -154,4 +155,4 @@ def no_such_device_error(path: str, dev_dir: str, present: list[str]) -> Joystic
     if others:
         return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
     return NoDeviceError(f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a "
-                         "virtual one with --joy script:examples/joystick_script.txt.")
+                         f"virtual one with {virtual_joystick_hint()}.")

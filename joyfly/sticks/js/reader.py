@@ -28,6 +28,7 @@ import select
 import stat
 from dataclasses import dataclass
 
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import (
     AXIS_MAX,
     EVENT_FORMAT,
@@ -379,7 +380,7 @@ def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/in
     prefix, _, rest = spec.partition(":")
     if not spec or (f"{prefix}:" in ("script:", "replay:", RAW_PREFIX) and not rest):
         raise JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
-                            "script:FILE or replay:FILE, for example --joy script:examples/joystick_script.txt.")
+                            f"script:FILE or replay:FILE, for example {virtual_joystick_hint()}.")
     if spec.startswith("script:"):
         return ScriptSource.from_file(spec[len("script:") :], clock)
     if spec.startswith("replay:"):
