@@ -149,6 +149,12 @@ class JsStreamCheck:
         return None
 
 
+def names_no_file_error(spec: str) -> JoystickError:
+    """`--joy script:` (or replay:, raw:, or nothing) names no file: say what --joy takes."""
+    return JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
+                         f"script:FILE or replay:FILE, for example {virtual_joystick_hint()}.")
+
+
 def no_such_device_error(path: str, dev_dir: str, present: list[str]) -> JoystickError:
     """No joystick at `path`: name the ones `present` in `dev_dir`, or say how to fly without one."""
     others = [p for p in present if p != path]

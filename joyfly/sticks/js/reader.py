@@ -28,7 +28,6 @@ import select
 import stat
 from dataclasses import dataclass
 
-from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import (
     AXIS_MAX,
     EVENT_FORMAT,
@@ -43,6 +42,7 @@ from joyfly.sticks.js.events import (
     JsStreamCheck,
     NoDeviceError,
     PermissionDeniedError,
+    names_no_file_error,
     no_such_device_error,
     not_js_events_error,
     pack_event,
@@ -379,8 +379,7 @@ def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/in
     clock = clock or WallClock()
     prefix, _, rest = spec.partition(":")
     if not spec or (f"{prefix}:" in ("script:", "replay:", RAW_PREFIX) and not rest):
-        raise JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
-                            f"script:FILE or replay:FILE, for example {virtual_joystick_hint()}.")
+        raise names_no_file_error(spec)
     if spec.startswith("script:"):
         return ScriptSource.from_file(spec[len("script:") :], clock)
     if spec.startswith("replay:"):
