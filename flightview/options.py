@@ -11,7 +11,16 @@ import click
 from flightview.launch import ViewOptions
 from flightview.server import INSTALL_COMMAND
 
-PORT_RANGE = click.IntRange(1, 65535)
+
+class PortRange(click.IntRange):
+    """A TCP port, its range said as both programs say theirs ("1 to 65535": px4common.cli_style.describe_range,
+    which flightview does not import)."""
+
+    def _describe_range(self) -> str:
+        return f"{self.min} to {self.max}"
+
+
+PORT_RANGE = PortRange(1, 65535)
 
 
 def view_options(command: Callable[..., Any]) -> Callable[..., Any]:
@@ -21,11 +30,11 @@ def view_options(command: Callable[..., Any]) -> Callable[..., Any]:
                            metavar="FILE.rrd", help="Save the view's recording to this file (replay it with "
                                                     "`rerun FILE.rrd`); works with or without --view.")(command)
     command = click.option("--view-grpc-port", type=PORT_RANGE, default=None,
+                           show_default="a free one",
                            help="Port of the view's data stream (Rerun's gRPC proxy, which the page reads) on "
-                                "127.0.0.1 (implies --view) [default: a free one].")(command)
-    command = click.option("--view-port", type=PORT_RANGE, default=None,
-                           help="Port of the view's web page on 127.0.0.1 (implies --view) [default: a free one].")(
-        command)
+                                "127.0.0.1 (implies --view).")(command)
+    command = click.option("--view-port", type=PORT_RANGE, default=None, show_default="a free one",
+                           help="Port of the view's web page on 127.0.0.1 (implies --view).")(command)
     return click.option("--view", is_flag=True, help="Show the flight live in a web browser on this machine: the "
                          "vehicle, trail, setpoint, home and fence in 3D, and plots (needs the view extra: "
                          f"{INSTALL_COMMAND} in the joyfly clone).")(command)

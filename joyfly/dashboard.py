@@ -134,6 +134,8 @@ class LiveDashboard:
         self._last: SessionView | None = None
 
     def note(self, note: Note) -> None:
+        if note.closing:  # joyfly's last line on stderr says it
+            return
         self._block.erase()
         mark = {Level.WARN: "! ", Level.ERROR: "!! "}.get(note.level, "")
         self.out.write(f"{mark}{note.text}\n")
@@ -166,6 +168,8 @@ class PlainLog:
         self._t_s = 0.0
 
     def note(self, note: Note) -> None:
+        if note.closing:  # joyfly's last line on stderr says it
+            return
         level = {Level.WARN: "WARNING ", Level.ERROR: "ERROR "}.get(note.level, "")
         self.out.write(f"[{self._t_s:7.2f}] {level}{note.text}\n")
         self.out.flush()

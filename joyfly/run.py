@@ -2,8 +2,9 @@
 (what happened, the summary, or in what state the vehicle was left).
 
 The first Ctrl-C or SIGTERM asks the session to perform --on-exit; a second one quits at once (exit status 130).
-Exit status: 0 a flight (or none) that ended well, 1 a failure joyfly reports, 3 the vehicle breached the fence,
-4 a flight ended without a landing, 130 quit at once.
+Exit status: 0 a flight (or none) that ended well, 1 a failure joyfly reports, 2 a joystick that sent something
+other than js_event records before anything armed (a mistake, as px4common's UserError), 3 the vehicle breached the
+fence, 4 a flight ended without a landing, 130 quit at once.
 """
 
 from __future__ import annotations
@@ -20,14 +21,15 @@ from joyfly.dashboard import breach_words, summary_lines
 from joyfly.session.core import Phase
 from joyfly.session.loop import SessionLoop
 
+EXIT_MISTAKE = 2  # a mistake the user can fix (px4common.cli_style.UserError): here, a joystick that is none
 EXIT_FENCE_BREACHED = 3  # the flight went outside the fence (joyfly/session/fence_watch.py)
 EXIT_NOT_LANDED = 4  # a flight ended in the air: the vehicle restarted, or was left flying (not --on-exit hold)
 
 
 def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
     """Run the session with Ctrl-C/SIGTERM handling, close everything, then say how it ended; returns the exit
-    status (0 done, 1 failed, 3 the fence was breached, 4 a flight ended in the air, 130 quit at once by a second
-    Ctrl-C)."""
+    status (0 done, 1 failed, 2 the joystick sent no js_events before arming, 3 the fence was breached, 4 a flight
+    ended in the air, 130 quit at once by a second Ctrl-C)."""
     interrupted = False
     try:
         with exit_signals(session):
@@ -39,7 +41,7 @@ def fly_session(session: SessionLoop, view: Any, out: Any) -> int:
         session.link.close()
         session.sticks.close()
     if interrupted:
-        out.write(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}\n")
+        click.echo(f"joyfly: interrupted twice, quitting at once: {left_behind(session)}", err=True)
         return 130
     unlanded = session.landing_missing()
     if session.armed_seen:
@@ -54,7 +56,7 @@ def closing_status(session: SessionLoop, unlanded: str | None) -> int:
     """Say on stderr what went wrong, if anything; the exit status of the worst (failed, not landed, breach)."""
     if session.phase is Phase.FAILED:
         click.echo(f"joyfly: {session.error}", err=True)
-        return 1
+        return EXIT_MISTAKE if session.error_is_mistake else 1
     status = 0
     if session.stats.fence_breaches:
         click.echo(f"joyfly: the vehicle went outside the {session.fence.half_width_m:g} m fence "

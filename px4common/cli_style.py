@@ -104,16 +104,34 @@ class OneLineGroup(click.Group):
             raise error from None
 
 
+def describe_range(low: float | None, high: float | None) -> str:
+    """A range as help texts and errors say it, in both programs: "0.1 to 100", "at least 0", "at most 5"."""
+    def text(number: float | None) -> str:
+        return format(number, ".15g")  # 100.0 as 100, 4294967295 in full
+
+    if low is None:
+        return f"at most {text(high)}"
+    return f"at least {text(low)}" if high is None else f"{text(low)} to {text(high)}"
+
+
 class WholeRange(click.IntRange):
-    """click.IntRange that calls its values whole numbers ("not a valid integer", not "integer range")."""
+    """click.IntRange that calls its values whole numbers ("not a valid integer", not "integer range"), and its range
+    "0 to 65535" (click: "0<=x<=65535"), as joyfly's option help does."""
 
     name = "integer"
 
+    def _describe_range(self) -> str:
+        return describe_range(self.min, self.max)
+
 
 class FiniteRange(click.FloatRange):
-    """click.FloatRange that also refuses nan (nan compares false with both bounds, so FloatRange lets it through)."""
+    """click.FloatRange that also refuses nan (nan compares false with both bounds, so FloatRange lets it through); its
+    range reads "0.1 to 100" as WholeRange's."""
 
     name = "float"
+
+    def _describe_range(self) -> str:
+        return describe_range(self.min, self.max)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         number = super().convert(value, param, ctx)

@@ -15,6 +15,7 @@ from typing import Any, TextIO
 import click
 
 from joyfly.cli.calibrate import calibrate
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.js.seam import js_reader_or_none
 from joyfly.sticks.manual import to_manual
@@ -24,7 +25,7 @@ from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.listing import sdl_lines
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.sdl.source import SdlSource
-from joyfly.sticks.sources import open_source, pick_profile
+from joyfly.sticks.sources import check_profile_choice, open_source, pick_profile
 from joyfly.sticks.virtual import TimedSource, record_to
 from joyfly.term import LiveBlock
 from joyfly.types import Clock, JoyState, JoystickSource, StickCommand
@@ -56,7 +57,7 @@ def list_cmd(dev_dir: str, sdl_mapping: str | None) -> None:
         for line in lines:  # why SDL could not look
             click.echo(line)
         click.echo(f"No joystick found (SDL sees none, and no {dev_dir}/js*): plug one in, or fly a virtual one "
-                   "with --joy script:examples/joystick_script.txt.")
+                   f"with {virtual_joystick_hint()}.")
         return
     for line in lines:
         click.echo(line)
@@ -106,6 +107,7 @@ def test_cmd(joy: str, sdl_mapping: str | None, profile_name: str, config_path: 
     clock = WallClock()
     try:
         overrides: dict[str, Any] = read_config(config_path) if config_path else {}
+        check_profile_choice(profile_name, overrides)
         opened = open_source(joy, clock, dev_dir=dev_dir, mappings=SdlMappings(sdl_mapping))
     except JoystickError as exc:
         raise click.ClickException(str(exc)) from None

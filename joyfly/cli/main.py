@@ -27,7 +27,7 @@ from joyfly.rumble import Haptics, HapticView, device_of, rumbler_of
 from joyfly.run import fly_session
 from joyfly.session.core import Level, Note
 from joyfly.session.factory import make_session
-from joyfly.session.fence_watch import FENCE_ACTIONS, FENCE_GRACE_S
+from joyfly.session.fence_watch import FENCE_ACTIONS, FENCE_GRACE_S, FENCE_TOLERANCE_M, RETURN_M_S, RETURN_WINDOW_S
 from joyfly.session.manual_session import MANUAL_CONTROLS, MANUAL_MODES
 from joyfly.session.manual_session import RATE_HZ as MANUAL_RATE_HZ
 from joyfly.sticks.js.events import JoystickError
@@ -35,7 +35,7 @@ from joyfly.sticks.mapping import open_sticks
 from joyfly.sticks.sdl.mappings import SdlMappings
 from joyfly.sticks.takeoff_check import takeoff_warning
 from joyfly.view import add_browser_view, check_view_options
-from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError
+from px4common.cli_style import CONTEXT, VERSION_MESSAGE, FiniteRange, OneLineGroup, UserError, describe_range
 from px4common.clock import SPEED_MAX, SPEED_MIN, ScaledClock, WallClock
 from px4common.signing_key import SigningKeyError, read_signing_key
 
@@ -66,7 +66,7 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
     default = getattr(D, key)
     shown = [] if default is None else [f"default: {default_text or default}"]
     if key in BOUNDS and show_range:
-        shown.append(f"{BOUNDS[key].lo:g} to {BOUNDS[key].hi:g}")
+        shown.append(describe_range(BOUNDS[key].lo, BOUNDS[key].hi))
     return click.option(name, type=kind, default=None, help=f"{help_text} [{'; '.join(shown)}]" if shown
                         else help_text, **kw)
 
@@ -96,9 +96,11 @@ def _opt(name: str, kind: Any, help_text: str, show_range: bool = True, default_
 @_opt("--max-yaw-rate", float, "Yaw rate at full yaw stick (OFFBOARD), deg/s.")
 @_opt("--fence", float, "Half-width of the square fence around this flight's home (where joyfly arms the vehicle), "
       "metres; 0 disables. In position/altitude control joyfly limits the sticks near it.")
-@_opt("--fence-action", click.Choice(list(FENCE_ACTIONS)), "When the vehicle is outside the fence (wind joyfly's "
-      f"setpoints cannot beat): joyfly warns at once and, if it stays outside {FENCE_GRACE_S:g} s, warn: only warns; "
-      "hold: PX4's Hold; rtl: PX4's Return; land: lands where it is. A breach makes the exit status 3.")
+@_opt("--fence-action", click.Choice(list(FENCE_ACTIONS)), "What joyfly does when the vehicle is more than "
+      f"{FENCE_TOLERANCE_M:g} m outside the fence (wind joyfly's setpoints cannot beat): it warns at once, and once "
+      f"the vehicle has been outside {FENCE_GRACE_S:g} s and is not coming back (closing in at under {RETURN_M_S:g} "
+      f"m/s over the last {RETURN_WINDOW_S:g} s) it acts: land lands where it is, hold is PX4's Hold, rtl PX4's "
+      "Return, warn does nothing more. A breach makes the exit status 3.")
 @_opt("--min-alt", float, "Lowest altitude, metres above home.")
 @_opt("--max-alt", float, "Highest altitude, metres above home.")
 @_opt("--rate", float, "Stream rate, Hz: setpoints (OFFBOARD), or MANUAL_CONTROL (position, altitude).",

@@ -84,6 +84,7 @@ class Note:
     time_s: float
     level: Level
     text: str
+    closing: bool = False  # the session's failure: joyfly ends with this sentence on stderr, the terminal prints none
 
 
 @dataclass(frozen=True, slots=True)
@@ -189,6 +190,7 @@ class SessionCore:
         self.notes: list[Note] = []
         self.exit_requested = False
         self.error: str | None = None
+        self.error_is_mistake = False  # the failure is the user's to fix (the joystick sends no js_events): exit 2
         self._start_s = clock.now()
         self._phase_s = self._start_s
         self._period_s = 1.0 / max(settings.rate_hz, 1.0)
@@ -262,8 +264,8 @@ class SessionCore:
         """Finish at once: no exit action, the vehicle keeps its mode (and PX4's offboard-loss failsafe acts)."""
         self._set_phase(Phase.DONE)
 
-    def _note(self, level: Level, text: str) -> None:
-        note = Note(self.clock.now(), level, text)
+    def _note(self, level: Level, text: str, closing: bool = False) -> None:
+        note = Note(self.clock.now(), level, text, closing)
         self.notes.append(note)
         del self.notes[:-20]
         log.log(level.value, text)
@@ -277,9 +279,9 @@ class SessionCore:
             self._phase_s = self.clock.now()
             self._retry = None
 
-    def _fail(self, text: str) -> None:
-        self.error = text
-        self._note(Level.ERROR, text)
+    def _fail(self, text: str, mistake: bool = False) -> None:
+        self.error, self.error_is_mistake = text, mistake
+        self._note(Level.ERROR, text, closing=True)
         self._set_phase(Phase.FAILED)
 
     def _streaming_allowed(self) -> bool:

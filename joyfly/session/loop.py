@@ -119,12 +119,13 @@ class SessionLoop(SessionWatch):
 
     def _sticks_gone_before_arming(self) -> bool:
         """A joystick gone for good (it sent no js_events, its capture ended) before anything armed ends the session
-        with its sentence; after that it is a lost joystick (hold, then land)."""
+        with its sentence, a mistake in the joystick (exit status 2); after that it is a lost joystick (hold, then
+        land)."""
         if self.phase not in (Phase.CONNECTING, Phase.PRESTREAM, Phase.ARMING, Phase.ENTERING) or self._maybe_armed():
             return False
         why: str | None = getattr(self.sticks, "gone", lambda: None)()
         if why is not None:
-            self._fail(why)
+            self._fail(why, mistake=True)
         return why is not None
 
     # --- buttons -----------------------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from typing import Any
 from joyfly.sticks.js.events import AXIS_MAX, JoystickError
 from joyfly.sticks.profiles.profile import AxisMap, Profile, rest_problems
 from joyfly.sticks.sdl.mappings import SdlMappings
-from joyfly.sticks.sources import open_source, pick_profile
+from joyfly.sticks.sources import check_profile_choice, open_source, pick_profile
 from joyfly.sticks.virtual import record_to
 from joyfly.types import Action, Clock, JoyState, JoystickSource, StickCommand
 from px4common.clock import WallClock
@@ -220,6 +220,7 @@ def open_sticks(spec: str, clock: Clock | None = None, profile: str = "auto",
     """One call for `joyfly fly`: open `--joy` (auto, sdl[:N|:NAME], path, raw:, script:, replay:; see
     joyfly/sticks/sources.py), pick the profile (`--profile`, the config's `[profile]` table), optionally `--record`,
     and map. `why` on the result says which device `auto`/`sdl` chose. Raises JoystickError (one sentence)."""
+    check_profile_choice(profile, overrides)
     opened = open_source(spec, clock or WallClock(), dev_dir=dev_dir, mappings=mappings)
     source = opened.source
     try:

@@ -19,9 +19,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.sticks.js.events import JoystickError
 from joyfly.sticks.js.seam import js_reader, open_js
-from joyfly.sticks.profiles.profile import BUILTIN, ROLES, Profile, apply_overrides, load_profile
+from joyfly.sticks.profiles.profile import BUILTIN, ROLES, Profile, apply_overrides, get_profile, load_profile
 from joyfly.sticks.profiles.user import find_user_profile
 from joyfly.sticks.sdl.api import SdlApi, SdlDevice, SdlUnavailable, sdl_api
 from joyfly.sticks.sdl.mappings import SdlMappings, apply_mappings
@@ -82,8 +83,7 @@ def _open_auto(clock: Clock, dev_dir: str, mappings: SdlMappings, loader: Callab
             path = js_reader().default_device(dev_dir)
         except JoystickError:
             raise JoystickError(f"No joystick found: SDL sees no controller and there is no {dev_dir}/js*; plug one "
-                                f"in and {LIST_HINT}, or fly a virtual one with "
-                                "--joy script:examples/joystick_script.txt.") from None
+                                f"in and {LIST_HINT}, or fly a virtual one with {virtual_joystick_hint()}.") from None
         return Opened(open_js(path, clock, dev_dir), f"{path}: the first js device (SDL sees no controller)")
     raise JoystickError(f"No joystick found (SDL sees no controller): plug one in and {LIST_HINT}.")
 
@@ -111,6 +111,18 @@ def _described(table: Mapping[str, Any]) -> bool:
     """The config's [profile] table names a base profile or maps an axis: the user described the device."""
     inner = table.get("profile", table)
     return isinstance(inner, Mapping) and ("base" in inner or any(role in inner for role in (*ROLES, "throttle")))
+
+
+def check_profile_choice(name_or_auto: str | None, overrides: Mapping[str, Any] | None) -> None:
+    """Refuse an unknown --profile (or `[profile] base`) before any joystick is looked for: it needs no device."""
+    table = dict(overrides or {})
+    inner = table.get("profile", table)
+    name = (name_or_auto or AUTO).strip()
+    base = inner.get("base") if isinstance(inner, Mapping) else None
+    if name.lower() != AUTO:
+        get_profile(name)
+    elif base:
+        get_profile(str(base))
 
 
 def pick_profile(source: JoystickSource, name_or_auto: str | None, overrides: Mapping[str, Any] | None) -> Profile:

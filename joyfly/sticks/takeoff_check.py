@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from joyfly.sticks.examples import POSITION_SCRIPT, example_script
 from joyfly.sticks.manual import Z_CENTRE, to_manual
 from joyfly.sticks.mapping import map_state
 from joyfly.sticks.profiles.profile import Profile
@@ -21,7 +22,6 @@ from joyfly.types import JoyState
 WANT_TAKEOFF_THROTTLE = 0.3  # PX4's FlightTaskManualAltitude::_checkTakeoff (z / 500 - 1 above this)
 TAKEOFF_Z = round(Z_CENTRE * (1.0 + WANT_TAKEOFF_THROTTLE))  # 650: z must be above it (in float32, 650 is not)
 PREFLIGHT_DISARM_S = 10.0  # PX4's COM_DISARM_PRFLT default: disarmed again if still on the ground by then
-POSITION_SCRIPT = "examples/joystick_script_position.txt"
 
 
 def first_takeoff_throttle_s(source: TimedSource, profile: Profile) -> float | None:
@@ -53,7 +53,7 @@ def takeoff_warning(source: Any, profile: Profile, mode: str) -> str | None:
 
 def _timed_warning(source: TimedSource, profile: Profile, mode: str) -> str | None:
     first_s = first_takeoff_throttle_s(source, profile)
-    fix = f"see {POSITION_SCRIPT} for a script that takes off in this mode"
+    fix = f"see {example_script(POSITION_SCRIPT)} for a script that takes off in this mode"
     if first_s is None:
         return (f"The joystick {source.path} never pushes the throttle (up) above {WANT_TAKEOFF_THROTTLE:g}, so in "
                 f"{mode} the vehicle cannot take off (only the throttle takes off there): {fix}.")

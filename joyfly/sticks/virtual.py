@@ -42,6 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO
 
+from joyfly.sticks.examples import missing_example
 from joyfly.sticks.js.events import AXIS_MAX, JoystickError
 from joyfly.types import Clock, JoyState, JoystickSource
 
@@ -198,6 +199,9 @@ def _read_text(path: str, what: str) -> str:
     try:
         return Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
+        example = missing_example(path)
+        if example is not None:
+            raise JoystickError(f"No {what} file at {path} in this folder: joyfly's example is {example}.") from None
         raise JoystickError(f"No {what} file at {path}: check the path after '{what}:'.") from None
     except OSError as exc:
         raise JoystickError(f"Cannot read the {what} file {path} ({exc.strerror}): check the path.") from None

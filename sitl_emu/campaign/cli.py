@@ -12,6 +12,7 @@ from typing import Any, NoReturn
 import click
 
 from px4common.cli_style import FiniteRange, UserError, WholeRange
+from sitl_emu.cli.extras import in_clone
 from sitl_emu.cli.options import SEED_MAX
 
 __all__ = ["campaign"]
@@ -28,8 +29,8 @@ LIMIT = FiniteRange(0.001, 1e7)
               help="Results: one CSV row per case, written as each finishes (and FILE.parquet when pyarrow is "
                    "installed), in a folder that exists; cases already in it are skipped; '-' writes no file.")
 @click.option("--engine", type=click.Choice(["local", "ray", "serial"]), default="local", show_default=True,
-              help="local: worker processes on this machine; ray: a Ray cluster (pip install ray); serial: this "
-                   "process, one case after another (for a debugger).")
+              help=f"local: worker processes on this machine; ray: a Ray cluster (the ray extra: {in_clone('ray')}); "
+                   "serial: this process, one case after another (for a debugger).")
 @click.option("--workers", type=WholeRange(1, 4096), default=None,
               help="Worker processes (local; default: one per core) or CPUs of a Ray started here.")
 @click.option("--address", default=None, help="Ray only: the address of an existing cluster (default: start one here).")

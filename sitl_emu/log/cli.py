@@ -11,19 +11,24 @@ from typing import Any
 import click
 
 from px4common.cli_style import UserError
+from sitl_emu.cli.extras import in_clone
 from sitl_emu.log.summary import LogError, LogSummary, format_summary, read_ulog, summarise
 
 __all__ = ["log"]
 
 
-@click.command(short_help="Summarise a ULog file; --plot draws it to a PNG.")
+HELP = ("Summarise FILE.ulg (a log sitl-emu or PX4 wrote): duration, modes over time, maximum altitude above the start "
+        "and horizontal speed, and the logged texts with their times. Reads it with pyulog (the plot extra: "
+        f"{in_clone('plot')}).")
+
+
+@click.command(short_help="Summarise a ULog file; --plot draws it to a PNG.", help=HELP)
 @click.argument("ulg_file", metavar="FILE.ulg", type=click.Path(path_type=Path))
 @click.option("--plot", "plot_out", metavar="OUT.png", type=click.Path(path_type=Path), default=None,
               help="Also draw position against setpoint per axis and the modes over time to OUT.png "
-                   "(needs matplotlib: pip install 'joyfly[plot]').")
+                   f"(needs matplotlib, the plot extra: {in_clone('plot')}).")
 def log(ulg_file: Path, plot_out: Path | None) -> None:
-    """Summarise FILE.ulg (a log sitl-emu or PX4 wrote): duration, modes over time, maximum altitude above the
-    start and horizontal speed, and the logged texts with their times."""
+    """Summarise a ULog file (the command's help is HELP)."""
     try:
         ulog = read_ulog(ulg_file)
     except LogError as err:

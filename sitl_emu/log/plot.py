@@ -2,7 +2,7 @@
 
 The position is vehicle_local_position x/y/z; the setpoint vehicle_local_position_setpoint x/y/z, or where that is
 not logged trajectory_setpoint position[0..2] (PX4 topic and field names, as summary.py reads them). matplotlib is
-the optional extra `plot` (pip install 'joyfly[plot]'); it draws off screen (Agg), so no display is needed.
+the optional extra `plot` (pip install -e '.[plot]' in the clone); it draws off screen (Agg), so no display is needed.
 """
 
 from __future__ import annotations
@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from sitl_emu.log.summary import LogSummary, series
+from sitl_emu.cli.extras import install_command
+from sitl_emu.log.summary import PLOT_PACKAGES, LogSummary, series
 
 __all__ = ["INSTALL_HINT", "PlotUnavailable", "plot_log"]
 
-INSTALL_HINT = "--plot needs matplotlib: pip install 'joyfly[plot]' (or pip install matplotlib)."
+INSTALL_HINT = f"--plot needs matplotlib, which is not installed: {install_command('plot', PLOT_PACKAGES)}"
 AXES = (("x", 0, "North x [m]"), ("y", 1, "East y [m]"), ("z", 2, "Down z [m]"))
 
 

@@ -17,12 +17,14 @@ from typing import Any
 
 import numpy as np
 
+from sitl_emu.cli.extras import install_command
 from sitl_emu.px4 import UI_NAMES, NavState
 
 __all__ = ["LogError", "LogSummary", "ModeSpan", "Text", "format_summary", "mode_label", "read_ulog",
            "series", "summarise"]
 
 US = 1e-6
+PLOT_PACKAGES = "'pyulog>=1.0' 'matplotlib>=3.7'"  # the plot extra (pyproject.toml), where there is no clone
 HEADER_LEN = 16  # ULog file header: magic, version, timestamp
 MESSAGE_HEADER = struct.Struct("<HB")  # every message: uint16 msg_size, uint8 msg_type (PX4 docs, ULog file format)
 
@@ -63,7 +65,8 @@ def read_ulog(path: str | Path) -> Any:
         from pyulog import ULog  # the extras `plot` and `test` have it; imported late to keep the CLI light
         from pyulog.exceptions import ULogException
     except ImportError:
-        raise LogError("Reading ULog files needs pyulog: pip install 'joyfly[plot]' (or pip install pyulog).") from None
+        raise LogError("Reading ULog files needs pyulog, which is not installed: "
+                       f"{install_command('plot', PLOT_PACKAGES)}") from None
 
     path = Path(path)
     if not path.exists():

@@ -231,8 +231,8 @@ def test_second_sigint_quits_at_once(tmp_path: Path) -> None:
         _kill(joy, emu)
     assert joy.returncode == 130 and quit_s < 2.0
     assert "Traceback" not in stderr
-    assert stdout.count("interrupted twice") == 1
-    assert "the vehicle was left armed in AUTO.LAND: it lands and disarms by itself." in stdout
+    assert stderr.count("interrupted twice") == 1 and "interrupted twice" not in stdout
+    assert "the vehicle was left armed in AUTO.LAND: it lands and disarms by itself." in stderr
 
 
 def test_a_script_joystick_that_ends_after_landing_exits_0_with_a_summary(tmp_path: Path) -> None:
@@ -332,3 +332,4 @@ def test_no_vehicle_exits_with_a_clear_message() -> None:
     assert f"No HEARTBEAT from a vehicle on UDP 127.0.0.1:{port}" in proc.stderr
     assert "sitl-emu serve" in proc.stderr and "Traceback" not in proc.stderr
     assert "distance flown" not in proc.stdout  # nothing flew, so no flight summary
+    assert "No HEARTBEAT" not in proc.stdout and proc.stderr.count("No HEARTBEAT") == 1  # said once, on stderr

@@ -46,7 +46,7 @@ def fly(ctrl_c_at_s: list[float], speak: bool = True, live: bool = False,
     out = io.StringIO()
     view = CtrlC(LiveDashboard(out) if live else PlainLog(out), ctrl_c_at_s)
     session = FlightSession(VehicleLink(ours, clock), TimedSticks(clock, [(0.0, StickCommand())]), clock,
-                            SessionSettings(connect_timeout_s=30.0, **settings), on_note=view.note)
+                            SessionSettings(**{"connect_timeout_s": 30.0, **settings}), on_note=view.note)
     status = fly_session(session, view, out)
     return status, out.getvalue(), vehicle
 
@@ -65,13 +65,15 @@ def test_ctrl_c_before_arming_says_nothing_was_flown() -> None:
     assert "distance flown" not in out
 
 
-def test_a_double_ctrl_c_prints_the_view_once_and_names_the_state_the_vehicle_was_left_in() -> None:
+def test_a_double_ctrl_c_prints_the_view_once_and_names_the_state_the_vehicle_was_left_in(capsys: Any) -> None:
+    """The closing sentence goes to stderr (README: the summary and a line on stderr say how joyfly ended)."""
     status, out, vehicle = fly([7.0, 7.5], live=True)
+    err = capsys.readouterr().err
     assert status == 130
     final = out.split("\x1b[J")[-1]  # what stays on the terminal after the last redraw
-    assert final.count("fence margin") == 1 and final.index("fence margin") < final.index("interrupted twice")
-    assert out.count("interrupted twice") == 1
-    assert "the vehicle was left armed in AUTO.LAND" in final and vehicle.armed
+    assert final.count("fence margin") == 1 and "interrupted twice" not in out
+    assert err.count("interrupted twice") == 1 and len(err.splitlines()) == 1
+    assert "the vehicle was left armed in AUTO.LAND" in err and vehicle.armed
 
 
 class Events:
@@ -135,3 +137,12 @@ def test_a_flight_that_lands_exits_0_and_one_left_hovering_on_purpose_too(capsys
     assert status == 0 and "Landed and disarmed" in out and "landing               none" not in out
     status, out, vehicle = fly([8.0], on_exit="hold")
     assert status == 0 and "The vehicle holds position." in out and vehicle.armed and not vehicle.landed
+
+
+def test_a_failure_is_said_once_on_stderr_not_also_in_the_view(capsys: Any) -> None:
+    """The session's failure (here: no HEARTBEAT) was an ERROR line in the view and the closing line on stderr."""
+    for live in (False, True):
+        status, out, _ = fly([], speak=False, live=live, connect_timeout_s=1.0)
+        err = capsys.readouterr().err
+        assert status == 1 and "No HEARTBEAT" not in out, out
+        assert err.count("No HEARTBEAT") == 1 and len(err.splitlines()) == 1, err

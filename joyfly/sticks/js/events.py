@@ -12,6 +12,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
+from joyfly.sticks.examples import virtual_joystick_hint
 from joyfly.types import JoyState
 
 JS_EVENT_BUTTON = 0x01
@@ -148,10 +149,16 @@ class JsStreamCheck:
         return None
 
 
+def names_no_file_error(spec: str) -> JoystickError:
+    """`--joy script:` (or replay:, raw:, or nothing) names no file: say what --joy takes."""
+    return JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
+                         f"script:FILE or replay:FILE, for example {virtual_joystick_hint()}.")
+
+
 def no_such_device_error(path: str, dev_dir: str, present: list[str]) -> JoystickError:
     """No joystick at `path`: name the ones `present` in `dev_dir`, or say how to fly without one."""
     others = [p for p in present if p != path]
     if others:
         return NoDeviceError(f"No joystick at {path}; joysticks present: {', '.join(others)} (pass one with --joy).")
     return NoDeviceError(f"No joystick at {path}, and none is connected (no {dev_dir}/js*): plug one in, or fly a "
-                         "virtual one with --joy script:examples/joystick_script.txt.")
+                         f"virtual one with {virtual_joystick_hint()}.")

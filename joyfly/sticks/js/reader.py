@@ -42,6 +42,7 @@ from joyfly.sticks.js.events import (
     JsStreamCheck,
     NoDeviceError,
     PermissionDeniedError,
+    names_no_file_error,
     no_such_device_error,
     not_js_events_error,
     pack_event,
@@ -378,8 +379,7 @@ def open_joystick(spec: str, clock: Clock | None = None, dev_dir: str = "/dev/in
     clock = clock or WallClock()
     prefix, _, rest = spec.partition(":")
     if not spec or (f"{prefix}:" in ("script:", "replay:", RAW_PREFIX) and not rest):
-        raise JoystickError(f"--joy {spec!r} names no file: give a device (/dev/input/js0), a FIFO, raw:FILE, "
-                            "script:FILE or replay:FILE, for example --joy script:examples/joystick_script.txt.")
+        raise names_no_file_error(spec)
     if spec.startswith("script:"):
         return ScriptSource.from_file(spec[len("script:") :], clock)
     if spec.startswith("replay:"):

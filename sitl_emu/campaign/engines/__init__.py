@@ -1,5 +1,5 @@
 """Where the cases run: `serial` (this process, one after another: for rerunning one case under a debugger),
-`local` (a pool of worker processes on this machine, the default) and `ray` (a Ray cluster, the extra sitl-emu[ray]).
+`local` (a pool of worker processes on this machine, the default) and `ray` (a Ray cluster, the ray extra).
 
 Every engine runs `scenario.run_case` for each case and yields (case, row) as cases finish, in any order; a case
 that passes its wall-time limit or whose worker dies is yielded as that case's failure and the others go on.

@@ -1,4 +1,4 @@
-"""The Ray engine (`pip install 'sitl-emu[ray]'`, i.e. the joyfly package's `ray` extra): each case a Ray task.
+"""The Ray engine (the `ray` extra: `pip install -e '.[ray]'` in the clone): each case a Ray task.
 
 `address` joins an existing cluster (`ray start --head` printed it; "auto" finds a local one); without it a local
 Ray is started for the campaign and shut down after it. The scenario must be importable on every node (a shared
@@ -21,19 +21,21 @@ from typing import Any
 from sitl_emu.campaign.cases import Case
 from sitl_emu.campaign.errors import CampaignError
 from sitl_emu.campaign.scenario import Limits, Row, failure_row, one_line, prepare_worker, run_case
+from sitl_emu.cli.extras import install_command
 
 __all__ = ["RayEngine"]
 
 PRELOAD_HOLD_S = 0.2
 PROBE_TIMEOUT_S = 5.0
+RAY_PACKAGES = "'ray>=2.9'"  # the ray extra (pyproject.toml), where joyfly does not run from a clone
 
 
 def _ray() -> Any:
     try:
         import ray
     except ImportError:
-        raise CampaignError("the ray engine needs Ray: pip install 'joyfly[ray]' (or pip install ray), or use "
-                            "--engine local.") from None
+        raise CampaignError("the ray engine needs Ray, which is not installed: "
+                            f"{install_command('ray', RAY_PACKAGES)}, or use --engine local.") from None
     return ray
 
 

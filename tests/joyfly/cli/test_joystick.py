@@ -7,6 +7,7 @@ import os
 import threading
 
 from click.testing import CliRunner
+from support import REPO_ROOT
 
 from joyfly.cli.joystick import LiveView, joystick
 from joyfly.sticks.js.reader import JS_EVENT_AXIS, JS_EVENT_BUTTON, JS_EVENT_INIT, pack_event
@@ -14,6 +15,9 @@ from joyfly.sticks.profiles.profile import get_profile
 from joyfly.types import JoyState, StickCommand
 
 SCRIPT = "0 forward=0.5\n0.05 arm=1\n+0.1 arm=0\n+0.05 end\n"
+
+
+EXAMPLE = os.path.join(REPO_ROOT, "examples", "joystick_script.txt")
 
 
 def run(*args: str):
@@ -34,7 +38,25 @@ def test_list_without_joysticks_says_what_to_do(tmp_path):
     result = run("list", "--dev-dir", str(tmp_path))
     assert result.exit_code == 0  # an answer, not a failure
     assert result.output.endswith(f"No joystick found (SDL sees none, and no {tmp_path}/js*): plug one in, or fly a "
-                                  "virtual one with --joy script:examples/joystick_script.txt.\n"), result.output
+                                  f"virtual one with --joy script:{EXAMPLE}.\n"), result.output
+
+
+def test_the_no_joystick_hints_name_a_script_that_exists_from_any_folder(tmp_path, monkeypatch):
+    """The hints said `--joy script:examples/joystick_script.txt`, a path only the clone's root has: from any other
+    folder the suggested command failed with "No script file at examples/joystick_script.txt"."""
+    from joyfly.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    missing = str(tmp_path / "js9")
+    fly = CliRunner().invoke(main, ["fly", "--joy", missing])
+    assert fly.exit_code == 2 and fly.output.rstrip().endswith(f"--joy script:{EXAMPLE}."), fly.output
+    listed = run("list", "--dev-dir", str(tmp_path))
+    for output in (fly.output, listed.output):
+        hinted = output.rsplit("--joy script:", 1)[1].rstrip().rstrip(".")
+        assert os.path.isabs(hinted) and os.path.isfile(hinted), output
+    test = run("test", "--joy", "script:examples/joystick_script.txt", "--duration", "0.1")
+    assert test.exit_code == 1 and test.output == (
+        f"joyfly: No script file at examples/joystick_script.txt in this folder: joyfly's example is {EXAMPLE}.\n")
 
 
 def test_test_prints_plain_lines_and_stops_at_the_script_end(tmp_path):
@@ -134,3 +156,28 @@ def test_test_reads_a_raw_file_and_refuses_a_plain_one(tmp_path):
     result = run("test", "--joy", str(events), "--duration", "0.2")
     assert result.exit_code == 1 and len(result.output.splitlines()) == 1
     assert result.output.startswith(f"joyfly: {events} is a regular file") and f"raw:{events}" in result.output
+
+
+def test_an_unknown_profile_is_named_before_any_joystick_is_looked_for(tmp_path):
+    """With no joystick, `--profile nosuch` said "No joystick ..." and never named the option's mistake."""
+    from joyfly.cli.main import main
+
+    missing = str(tmp_path / "js9")
+    fly = CliRunner().invoke(main, ["fly", "--joy", missing, "--profile", "nosuch"])
+    assert fly.exit_code == 2 and "Unknown profile 'nosuch'" in fly.output and "No joystick" not in fly.output
+    test = run("test", "--joy", missing, "--dev-dir", str(tmp_path), "--profile", "nosuch")
+    assert test.exit_code == 1 and "Unknown profile 'nosuch'" in test.output and "No joystick" not in test.output
+    config = tmp_path / "joyfly.toml"
+    config.write_text("[profile]\nbase = \"nosuch\"\n")
+    fly = CliRunner().invoke(main, ["fly", "--joy", missing, "--config", str(config)])
+    assert fly.exit_code == 2 and "Unknown profile 'nosuch'" in fly.output and "No joystick" not in fly.output
+
+
+def test_without_the_clone_the_hint_says_where_the_example_lives(tmp_path, monkeypatch):
+    """Installed without the source tree (a wheel has no examples/), the hint says where the example is instead."""
+    from joyfly.sticks import examples
+
+    monkeypatch.setattr(examples, "EXAMPLES_DIR", tmp_path / "examples")
+    assert examples.virtual_joystick_hint() == (
+        "--joy script:FILE (such as examples/joystick_script.txt in joyfly's source repository)")
+    assert examples.missing_example("examples/joystick_script.txt") is None

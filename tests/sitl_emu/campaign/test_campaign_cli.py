@@ -13,6 +13,8 @@ from click.testing import CliRunner, Result
 from support import campaign_scenarios
 
 import sitl_emu.cli.main
+from sitl_emu.campaign.engines.ray_engine import RAY_PACKAGES
+from sitl_emu.cli.extras import install_command
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()
 
@@ -149,7 +151,8 @@ def test_the_ray_engine_without_ray_or_with_no_cluster_at_the_address_is_one_lin
     lines = result.stderr.strip().splitlines()
     assert result.exit_code == 2 and len(lines) == 1, result.output
     if importlib.util.find_spec("ray") is None:
-        assert lines[0].startswith("sitl-emu: the ray engine needs Ray: pip install 'joyfly[ray]'")
+        assert lines[0] == ("sitl-emu: the ray engine needs Ray, which is not installed: "
+                            f"{install_command('ray', RAY_PACKAGES)}, or use --engine local.")
     else:
         assert lines[0].startswith("sitl-emu: no Ray cluster answers at 127.0.0.1:1 (")
     assert not (tmp_path / "x.csv").exists()  # refused before anything was written

@@ -1,5 +1,5 @@
 """The Ray engine (issue 16): a 50-case campaign gives the same rows on a local Ray as on the process pool, and a
-worker that dies or a case that hangs is that case's failure. Ray is the optional extra joyfly[ray]."""
+worker that dies or a case that hangs is that case's failure. Ray is the optional extra ray."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from sitl_emu.campaign import Limits, make_cases, run_campaign
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(importlib.util.find_spec("ray") is None,
-                                 reason="Ray is not installed here (pip install 'joyfly[ray]' runs these tests).")]
+                                 reason="Ray is not installed here (pip install -e '.[ray]' runs these tests).")]
 
 SCENARIOS = Path(campaign_scenarios.__file__).resolve()  # by path: Ray's workers do not have tests/ on sys.path
 

@@ -13,6 +13,7 @@ from support.joyfly_fakes import FakeVehicle
 from support.joyfly_sim import SimClock, memory_pair
 
 from joyfly.link.vehicle_link import VehicleLink
+from joyfly.run import closing_status
 from joyfly.session.core import Phase, SessionSettings
 from joyfly.session.flight_session import FlightSession
 from joyfly.sticks.js.events import (
@@ -177,6 +178,7 @@ def test_a_fifo_that_turns_out_not_to_carry_js_events_ends_the_session_before_ar
         os.close(writer)
     assert session.phase is Phase.FAILED and not vehicle.armed and not vehicle.received("CMD400")
     assert session.error is not None and session.error.startswith(f"{path} sends something other than js_event")
+    assert closing_status(session, None) == 2  # a mistake in the joystick, as README's exit statuses (and raw:)
 
 
 def test_a_capture_that_ends_in_flight_is_a_lost_joystick_hold_then_land(tmp_path: Path) -> None:
@@ -194,6 +196,7 @@ def test_a_capture_that_ends_in_flight_is_a_lost_joystick_hold_then_land(tmp_pat
     notes = "\n".join(n.text for n in session.notes)
     assert "Joystick still lost after 3 s: landing." in notes and vehicle.received("CMD21")
     assert session.phase is Phase.DONE and not vehicle.armed and "The joystick is gone" in notes
+    assert closing_status(session, None) == 0  # in flight the joystick was lost, and the vehicle landed safely
 
 
 def test_a_capture_that_ended_before_the_flight_ends_the_session_in_one_sentence(tmp_path: Path) -> None:
