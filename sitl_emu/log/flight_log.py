@@ -74,6 +74,13 @@ class _Schedule:
         self.pack = pack
 
 
+def _changed(sched: _Schedule, state: Hashable) -> bool:
+    """Whether a watched state differs from the one last written: the same object is the same state (the home
+    position is one object until it is set again), so the equality test, slow for a dataclass, runs only on a new
+    object."""
+    return state is not sched.state and state != sched.state
+
+
 class FlightLogger:
     """Writes vehicle `node.vehicle`'s flights under `directory` (module docstring)."""
 
@@ -198,7 +205,7 @@ class FlightLogger:
         now = inputs.time_us
         for topic, sched in self._plan:
             state = topic.state
-            if now < sched.next_us and (state is None or state(inputs) == sched.state):
+            if now < sched.next_us and (state is None or not _changed(sched, state(inputs))):
                 continue
             if state is not None:
                 sched.state = state(inputs)

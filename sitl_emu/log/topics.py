@@ -34,6 +34,7 @@ from sitl_emu.mavlink.telemetry.actuators import servo_outputs
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
+from sitl_emu.vehicle.vehicle import Vehicle
 
 NAN = math.nan
 NAN3 = (NAN, NAN, NAN)
@@ -56,7 +57,7 @@ class Inputs:
 
     __slots__ = ("_snap", "_take_snapshot", "estimate", "sysid", "time_us", "vehicle")
 
-    def __init__(self, vehicle: Any, sysid: int, take_snapshot: Callable[[], VehicleSnapshot]) -> None:
+    def __init__(self, vehicle: Vehicle, sysid: int, take_snapshot: Callable[[], VehicleSnapshot]) -> None:
         self.vehicle = vehicle
         self.sysid = sysid
         self._take_snapshot = take_snapshot
