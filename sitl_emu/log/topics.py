@@ -36,8 +36,7 @@ from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
 from sitl_emu.vehicle.vehicle import Vehicle
 
-NAN = math.nan
-NAN3 = (NAN, NAN, NAN)
+NAN: Final = math.nan
 ARMING_STATE_DISARMED: Final = 1  # msg/VehicleStatus.msg
 ARMING_STATE_ARMED: Final = 2
 VEHICLE_TYPE_ROTARY_WING: Final = 1
@@ -109,13 +108,15 @@ def _thrust_body(snap: VehicleSnapshot) -> tuple[float, float, float]:
 @fields("timestamp", "timestamp_sample", "q")
 def _attitude(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, *i.estimate.q_wxyz
+    w, x, y, z = i.estimate.q_wxyz
+    return t, t, w, x, y, z
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
 def _angular_velocity(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, *i.estimate.rates_frd_rad_s
+    roll, pitch, yaw = i.estimate.rates_frd_rad_s
+    return t, t, roll, pitch, yaw
 
 
 @fields("timestamp", "timestamp_sample", "ref_lat", "ref_lon", "x", "y", "z", "vx", "vy", "vz", "z_deriv", "ax", "ay",
@@ -128,7 +129,7 @@ def _local_position(i: Inputs) -> Row:
     ok = i.vehicle.position_valid()
     return (t, t, ref.lat_deg, ref.lon_deg, x, y, z, vx, vy, vz, vz, ax, ay, az,
             yaw_from_q(e.q_wxyz), ref.alt_amsl_m, -z, 0.3 if ok else 1e3, 0.4 if ok else 1e3,
-            *(ok,) * 8)  # the valid and global flags
+            ok, ok, ok, ok, ok, ok, ok, ok)  # the valid and global flags
 
 
 @fields("timestamp", "timestamp_sample", "lat", "lon", "alt", "alt_ellipsoid")
@@ -145,9 +146,9 @@ def _local_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    (x, y, z), (vx, vy, vz) = sp.position_ned_m, sp.velocity_ned_m_s
-    return (s.time_us, x, y, z, vx, vy, vz, *sp.acceleration_ned_m_s2, *_thrust_body(s), sp.yaw_rad,
-            sp.yawspeed_rad_s)
+    (x, y, z), (vx, vy, vz), (ax, ay, az) = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, tx, ty, tz, sp.yaw_rad, sp.yawspeed_rad_s
 
 
 @fields("timestamp", "position", "velocity", "acceleration", "jerk", "yaw", "yawspeed")
@@ -155,16 +156,19 @@ def _trajectory_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    return (s.time_us, *sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2, *NAN3, sp.yaw_rad,
-            sp.yawspeed_rad_s)
+    (x, y, z), (vx, vy, vz), (ax, ay, az) = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
+    return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, NAN, NAN, NAN, sp.yaw_rad, sp.yawspeed_rad_s  # (no jerk)
 
 
 @fields("timestamp", "q_d", "thrust_body")
 def _attitude_setpoint(i: Inputs) -> Row | None:
     s = i.snap
-    if s.attitude_setpoint_q_wxyz is None or not s.armed:
+    q = s.attitude_setpoint_q_wxyz
+    if q is None or not s.armed:
         return None
-    return s.time_us, *s.attitude_setpoint_q_wxyz, *_thrust_body(s)
+    w, x, y, z = q
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, w, x, y, z, tx, ty, tz
 
 
 @fields("timestamp", "roll", "pitch", "yaw", "thrust_body")
@@ -173,7 +177,8 @@ def _rates_setpoint(i: Inputs) -> Row | None:
         return None
     s = i.snap
     roll, pitch, yaw = s.rates_setpoint_rad_s
-    return s.time_us, roll, pitch, yaw, *_thrust_body(s)
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, roll, pitch, yaw, tx, ty, tz
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
@@ -181,7 +186,8 @@ def _thrust_setpoint(i: Inputs) -> Row | None:
     if not i.vehicle.commander.armed:
         return None
     s = i.snap
-    return s.time_us, s.time_us, *_thrust_body(s)
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, s.time_us, tx, ty, tz
 
 
 @fields("timestamp", "timestamp_sample", "control")

@@ -185,7 +185,8 @@ class DataPacker:
             raise ValueError(f"{len(values)} values for {self._count}")
         if self._gather is not None:
             values = self._gather(values + self._constants)
-        return self._head + self._pack(*values)
+        pack = self._pack  # (compiled, a starred call of an attribute would look the attribute up by name)
+        return self._head + pack(*values)
 
 
 def message(kind: bytes, body: bytes) -> bytes:
