@@ -92,6 +92,7 @@ class FlightLogger:
         self.files: list[Path] = []  # the logs written, in order
         self.path: Path | None = None  # the log being written
         self._file: IO[bytes] | None = None
+        self._pending = bytearray()  # written, not yet in the file (_write)
         self._failed = False  # this flight's log failed: wait for the next arming
         self._last_us = -1
         self._event_seq = 0
@@ -141,6 +142,8 @@ class FlightLogger:
 
     def close(self) -> None:
         """End the log being written (disarm, shutdown)."""
+        if self._file is not None:
+            self._flush()  # (a failure says so and closes the file)
         f, self._file = self._file, None
         if f is None:
             return
@@ -199,10 +202,12 @@ class FlightLogger:
         assert inputs is not None  # set by _start
         inputs.new_tick()
         events = vehicle.events_after(self._event_seq)
-        out = [self._log_texts(events, write=False)] if events else []
+        if events:
+            self._log_texts(events)
         if vehicle.params.version != self._param_version:
-            out.append(self._changed_params())
+            self._write(self._changed_params())
         now = inputs.time_us
+        pending = self._pending
         for topic, sched in self._plan:
             state = topic.state
             if now < sched.next_us and (state is None or not _changed(sched, state(inputs))):
@@ -214,22 +219,21 @@ class FlightLogger:
                 sched.next_us = now + topic.interval_us
             values = topic.values.read(inputs)
             if values is not None:
-                out.append(sched.pack(values))
+                pending += sched.pack(values)
         if now >= self._next_sync_us:
-            out.append(ulog.sync())
+            pending += ulog.sync()
             self._next_sync_us = now + SYNC_INTERVAL_US
-        if out:
-            self._write(b"".join(out))
+        if len(pending) >= BUFFER_BYTES:
+            self._flush()
 
-    def _log_texts(self, events: list[Any], write: bool = True) -> bytes:
+    def _log_texts(self, events: list[Any]) -> None:
         """'L' messages for the STATUSTEXTs among `events` (level: their MAVLink severity, as PX4's log_message)."""
         if events:
             self._event_seq = events[-1].seq
         out = b"".join(ulog.log_text(int(e.severity), e.time_us, e.statustext_text)
                        for e in events if e.statustext)
-        if write and out:
+        if out:
             self._write(out)
-        return out
 
     def _changed_params(self) -> bytes:
         params = self.node.vehicle.params
@@ -243,16 +247,25 @@ class FlightLogger:
         return b"".join(out)
 
     def _write(self, data: bytes) -> None:
+        """To the file in BUFFER_BYTES chunks (a write per tick cost more than packing a message)."""
         if self._file is None:
             return
-        try:
-            self._file.write(data)
-        except OSError as err:
-            self._fail(err)
+        self._pending += data
+        if len(self._pending) >= BUFFER_BYTES:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._file is not None:
+            try:
+                self._file.write(self._pending)
+            except OSError as err:
+                self._fail(err)
+        self._pending.clear()
 
     def _fail(self, err: OSError) -> None:
         """One warning; the rest of this flight is not logged."""
         self._failed = True
+        self._pending.clear()
         f, self._file = self._file, None
         if f is not None:
             with contextlib.suppress(OSError):  # the buffered rest cannot be written either: already said
