@@ -37,6 +37,7 @@ from sitl_emu.log.info import parameter_messages, version_infos
 from sitl_emu.log.topics import Inputs, Topic, default_topics
 from sitl_emu.params import ParamType
 from sitl_emu.px4 import Severity
+from sitl_emu.vehicle.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -114,7 +115,7 @@ class FlightLogger:
         if now_us == self._last_us:
             return
         self._last_us = now_us
-        vehicle = self.node.vehicle
+        vehicle: Vehicle = self.node.vehicle  # (typed: compiled, its attributes are read natively)
         armed = vehicle.commander.armed
         if not self._wanted(armed):
             self._failed = False
@@ -198,8 +199,9 @@ class FlightLogger:
     # --- every tick --------------------------------------------------------------------------------------------
     def _record(self) -> None:
         """This tick's texts, changed parameters, due topics (a snapshot only if one of them reads it) and sync."""
-        vehicle, inputs = self.node.vehicle, self._inputs
+        inputs = self._inputs
         assert inputs is not None  # set by _start
+        vehicle = inputs.vehicle
         inputs.new_tick()
         events = vehicle.events_after(self._event_seq)
         if events:

@@ -130,7 +130,9 @@ def _angular_velocity(i: Inputs) -> Row:
         "xy_global", "z_global", "dist_bottom_valid")
 def _local_position(i: Inputs) -> Row:
     t, e, ref = i.time_us, i.estimate, i.vehicle.ref
-    (x, y, z), (vx, vy, vz), (ax, ay, az) = e.pos_ned_m, e.vel_ned_m_s, e.acc_ned_m_s2
+    x, y, z = e.pos_ned_m  # (one vector a statement: compiled, a tuple of them is built and iterated)
+    vx, vy, vz = e.vel_ned_m_s
+    ax, ay, az = e.acc_ned_m_s2
     ok = i.vehicle.position_valid()
     return (t, t, ref.lat_deg, ref.lon_deg, x, y, z, vx, vy, vz, vz, ax, ay, az,
             yaw_from_q(e.q_wxyz), ref.alt_amsl_m, -z, EPH_M if ok else INVALID_ACCURACY_M,
@@ -153,7 +155,9 @@ def _local_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    (x, y, z), (vx, vy, vz), (ax, ay, az) = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
+    x, y, z = sp.position_ned_m
+    vx, vy, vz = sp.velocity_ned_m_s
+    ax, ay, az = sp.acceleration_ned_m_s2
     tx, ty, tz = _thrust_body(s)
     return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, tx, ty, tz, sp.yaw_rad, sp.yawspeed_rad_s
 
@@ -163,7 +167,9 @@ def _trajectory_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    (x, y, z), (vx, vy, vz), (ax, ay, az) = sp.position_ned_m, sp.velocity_ned_m_s, sp.acceleration_ned_m_s2
+    x, y, z = sp.position_ned_m
+    vx, vy, vz = sp.velocity_ned_m_s
+    ax, ay, az = sp.acceleration_ned_m_s2
     return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, NAN, NAN, NAN, sp.yaw_rad, sp.yawspeed_rad_s  # (no jerk)
 
 
