@@ -153,6 +153,8 @@ class DataPacker:
         constants: list[bytes] = []
 
         def add_defaults(run: bytes) -> None:
+            if not run:
+                return
             if not any(run):
                 codes.append(f"{len(run)}x")
             else:
@@ -166,13 +168,11 @@ class DataPacker:
             if name not in starts:
                 run += fmt.default_bytes(i)
                 continue
-            if run:
-                add_defaults(run)
-                run = b""
+            add_defaults(run)
+            run = b""
             codes.append(code)
             sources.extend(range(starts[name], starts[name] + counts[name]))
-        if run:
-            add_defaults(run)
+        add_defaults(run)
         self._head = _HEAD.pack(_DATA_ID.size + fmt.size, ord("D")) + _DATA_ID.pack(msg_id)
         self._pack = struct.Struct("<" + "".join(codes)).pack
         self._constants = tuple(constants)
