@@ -37,6 +37,7 @@ from sitl_emu.log.info import parameter_messages, version_infos
 from sitl_emu.log.topics import Inputs, Topic, default_topics
 from sitl_emu.params import ParamType
 from sitl_emu.px4 import Severity
+from sitl_emu.vehicle.vehicle import Vehicle
 
 log = logging.getLogger(__name__)
 
@@ -74,6 +75,13 @@ class _Schedule:
         self.pack = pack
 
 
+def _changed(sched: _Schedule, state: Hashable) -> bool:
+    """Whether a watched state differs from the one last written: the same object is the same state (the home
+    position is one object until it is set again), so the equality test, slow for a dataclass, runs only on a new
+    object."""
+    return state is not sched.state and state != sched.state
+
+
 class FlightLogger:
     """Writes vehicle `node.vehicle`'s flights under `directory` (module docstring)."""
 
@@ -85,6 +93,7 @@ class FlightLogger:
         self.files: list[Path] = []  # the logs written, in order
         self.path: Path | None = None  # the log being written
         self._file: IO[bytes] | None = None
+        self._pending = bytearray()  # written, not yet in the file (_write)
         self._failed = False  # this flight's log failed: wait for the next arming
         self._last_us = -1
         self._event_seq = 0
@@ -106,7 +115,7 @@ class FlightLogger:
         if now_us == self._last_us:
             return
         self._last_us = now_us
-        vehicle = self.node.vehicle
+        vehicle: Vehicle = self.node.vehicle  # (typed: compiled, its attributes are read natively)
         armed = vehicle.commander.armed
         if not self._wanted(armed):
             self._failed = False
@@ -134,6 +143,8 @@ class FlightLogger:
 
     def close(self) -> None:
         """End the log being written (disarm, shutdown)."""
+        if self._file is not None:
+            self._flush()  # (a failure says so and closes the file)
         f, self._file = self._file, None
         if f is None:
             return
@@ -188,17 +199,20 @@ class FlightLogger:
     # --- every tick --------------------------------------------------------------------------------------------
     def _record(self) -> None:
         """This tick's texts, changed parameters, due topics (a snapshot only if one of them reads it) and sync."""
-        vehicle, inputs = self.node.vehicle, self._inputs
+        inputs = self._inputs
         assert inputs is not None  # set by _start
+        vehicle = inputs.vehicle
         inputs.new_tick()
         events = vehicle.events_after(self._event_seq)
-        out = [self._log_texts(events, write=False)] if events else []
+        if events:
+            self._log_texts(events)
         if vehicle.params.version != self._param_version:
-            out.append(self._changed_params())
+            self._write(self._changed_params())
         now = inputs.time_us
+        pending = self._pending
         for topic, sched in self._plan:
             state = topic.state
-            if now < sched.next_us and (state is None or state(inputs) == sched.state):
+            if now < sched.next_us and (state is None or not _changed(sched, state(inputs))):
                 continue
             if state is not None:
                 sched.state = state(inputs)
@@ -207,22 +221,21 @@ class FlightLogger:
                 sched.next_us = now + topic.interval_us
             values = topic.values.read(inputs)
             if values is not None:
-                out.append(sched.pack(values))
+                pending += sched.pack(values)
         if now >= self._next_sync_us:
-            out.append(ulog.sync())
+            pending += ulog.sync()
             self._next_sync_us = now + SYNC_INTERVAL_US
-        if out:
-            self._write(b"".join(out))
+        if len(pending) >= BUFFER_BYTES:
+            self._flush()
 
-    def _log_texts(self, events: list[Any], write: bool = True) -> bytes:
+    def _log_texts(self, events: list[Any]) -> None:
         """'L' messages for the STATUSTEXTs among `events` (level: their MAVLink severity, as PX4's log_message)."""
         if events:
             self._event_seq = events[-1].seq
         out = b"".join(ulog.log_text(int(e.severity), e.time_us, e.statustext_text)
                        for e in events if e.statustext)
-        if write and out:
+        if out:
             self._write(out)
-        return out
 
     def _changed_params(self) -> bytes:
         params = self.node.vehicle.params
@@ -236,16 +249,25 @@ class FlightLogger:
         return b"".join(out)
 
     def _write(self, data: bytes) -> None:
+        """To the file in BUFFER_BYTES chunks (a write per tick cost more than packing a message)."""
         if self._file is None:
             return
-        try:
-            self._file.write(data)
-        except OSError as err:
-            self._fail(err)
+        self._pending += data
+        if len(self._pending) >= BUFFER_BYTES:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._file is not None:
+            try:
+                self._file.write(self._pending)
+            except OSError as err:
+                self._fail(err)
+        self._pending.clear()
 
     def _fail(self, err: OSError) -> None:
         """One warning; the rest of this flight is not logged."""
         self._failed = True
+        self._pending.clear()
         f, self._file = self._file, None
         if f is not None:
             with contextlib.suppress(OSError):  # the buffered rest cannot be written either: already said

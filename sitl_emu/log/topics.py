@@ -14,10 +14,10 @@ Topics PX4 publishes on change (vehicle_status, vehicle_land_detected, home_posi
 written when their state changes and at PX4's publication period.
 
 Each topic's values are a flat tuple, in the order of the field names its `@fields(...)` line gives, an array's
-elements in its place (t, t, *q); the other fields keep the format's defaults. The topics logged at high rate, and
-the states watched every tick (flight_log.py), read the vehicle's estimate and the commander's fields; the
-controllers' setpoints and outputs come from the vehicle snapshot, which is only taken on a tick where such a topic
-is due (Inputs.snap).
+elements in its place (t, t, *q); the other fields keep the format's defaults (CONSTANTS). The topics logged at
+high rate, and the states watched every tick (flight_log.py), read the vehicle's estimate and the commander's
+fields; the controllers' setpoints and outputs come from the vehicle snapshot, which is only taken on a tick where
+such a topic is due (Inputs.snap).
 """
 
 from __future__ import annotations
@@ -34,9 +34,14 @@ from sitl_emu.mavlink.telemetry.actuators import servo_outputs
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.px4 import LandedState, NavState
 from sitl_emu.types import ManualControlSetpoint, VehicleSnapshot
+from sitl_emu.vehicle.vehicle import Vehicle
 
-NAN = math.nan
-NAN3 = (NAN, NAN, NAN)
+NAN: Final = math.nan
+INF: Final = math.inf
+EPH_M: Final = 0.3  # a valid estimate's accuracies: horizontal and vertical position, velocity (EKF2 in SITL)
+EPV_M: Final = 0.4
+EV_M_S: Final = 0.1
+INVALID_ACCURACY_M: Final = 1e3
 ARMING_STATE_DISARMED: Final = 1  # msg/VehicleStatus.msg
 ARMING_STATE_ARMED: Final = 2
 VEHICLE_TYPE_ROTARY_WING: Final = 1
@@ -56,7 +61,7 @@ class Inputs:
 
     __slots__ = ("_snap", "_take_snapshot", "estimate", "sysid", "time_us", "vehicle")
 
-    def __init__(self, vehicle: Any, sysid: int, take_snapshot: Callable[[], VehicleSnapshot]) -> None:
+    def __init__(self, vehicle: Vehicle, sysid: int, take_snapshot: Callable[[], VehicleSnapshot]) -> None:
         self.vehicle = vehicle
         self.sysid = sysid
         self._take_snapshot = take_snapshot
@@ -108,35 +113,41 @@ def _thrust_body(snap: VehicleSnapshot) -> tuple[float, float, float]:
 @fields("timestamp", "timestamp_sample", "q")
 def _attitude(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, *i.estimate.q_wxyz
+    w, x, y, z = i.estimate.q_wxyz
+    return t, t, w, x, y, z
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
 def _angular_velocity(i: Inputs) -> Row:
     t = i.time_us
-    return t, t, *i.estimate.rates_frd_rad_s
+    roll, pitch, yaw = i.estimate.rates_frd_rad_s
+    return t, t, roll, pitch, yaw
 
 
 @fields("timestamp", "timestamp_sample", "ref_lat", "ref_lon", "x", "y", "z", "vx", "vy", "vz", "z_deriv", "ax", "ay",
-        "az", "heading", "ref_alt", "dist_bottom", "eph", "epv",
-        "xy_valid", "z_valid", "v_xy_valid", "v_z_valid", "heading_good_for_control", "xy_global", "z_global",
-        "dist_bottom_valid")
+        "az", "heading", "ref_alt", "dist_bottom", "eph", "epv", "evh", "evv", "vxy_max", "vz_max", "hagl_min",
+        "hagl_max_z", "hagl_max_xy", "xy_valid", "z_valid", "v_xy_valid", "v_z_valid", "heading_good_for_control",
+        "xy_global", "z_global", "dist_bottom_valid")
 def _local_position(i: Inputs) -> Row:
     t, e, ref = i.time_us, i.estimate, i.vehicle.ref
-    (x, y, z), (vx, vy, vz), (ax, ay, az) = e.pos_ned_m, e.vel_ned_m_s, e.acc_ned_m_s2
+    x, y, z = e.pos_ned_m  # (one vector a statement: compiled, a tuple of them is built and iterated)
+    vx, vy, vz = e.vel_ned_m_s
+    ax, ay, az = e.acc_ned_m_s2
     ok = i.vehicle.position_valid()
     return (t, t, ref.lat_deg, ref.lon_deg, x, y, z, vx, vy, vz, vz, ax, ay, az,
-            yaw_from_q(e.q_wxyz), ref.alt_amsl_m, -z, 0.3 if ok else 1e3, 0.4 if ok else 1e3,
-            *(ok,) * 8)  # the valid and global flags
+            yaw_from_q(e.q_wxyz), ref.alt_amsl_m, -z, EPH_M if ok else INVALID_ACCURACY_M,
+            EPV_M if ok else INVALID_ACCURACY_M, EV_M_S, EV_M_S, INF, INF, INF, INF, INF,  # (no speed or height limits)
+            ok, ok, ok, ok, ok, ok, ok, ok)  # the valid and global flags
 
 
-@fields("timestamp", "timestamp_sample", "lat", "lon", "alt", "alt_ellipsoid")
+@fields("timestamp", "timestamp_sample", "lat", "lon", "alt", "alt_ellipsoid", "eph", "epv", "lat_lon_valid",
+        "alt_valid")
 def _global_position(i: Inputs) -> Row | None:
     if not i.vehicle.position_valid():
         return None
     t = i.time_us
     lat, lon, alt = ned_to_global(i.vehicle.ref, i.estimate.pos_ned_m)
-    return t, t, lat, lon, alt, alt
+    return t, t, lat, lon, alt, alt, EPH_M, EPV_M, True, True
 
 
 @fields("timestamp", "x", "y", "z", "vx", "vy", "vz", "acceleration", "thrust", "yaw", "yawspeed")
@@ -144,9 +155,11 @@ def _local_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    (x, y, z), (vx, vy, vz) = sp.position_ned_m, sp.velocity_ned_m_s
-    return (s.time_us, x, y, z, vx, vy, vz, *sp.acceleration_ned_m_s2, *_thrust_body(s), sp.yaw_rad,
-            sp.yawspeed_rad_s)
+    x, y, z = sp.position_ned_m
+    vx, vy, vz = sp.velocity_ned_m_s
+    ax, ay, az = sp.acceleration_ned_m_s2
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, tx, ty, tz, sp.yaw_rad, sp.yawspeed_rad_s
 
 
 @fields("timestamp", "position", "velocity", "acceleration", "jerk", "yaw", "yawspeed")
@@ -154,16 +167,21 @@ def _trajectory_setpoint(i: Inputs) -> Row | None:
     s, sp = i.snap, i.snap.local_setpoint
     if sp is None:
         return None
-    return (s.time_us, *sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2, *NAN3, sp.yaw_rad,
-            sp.yawspeed_rad_s)
+    x, y, z = sp.position_ned_m
+    vx, vy, vz = sp.velocity_ned_m_s
+    ax, ay, az = sp.acceleration_ned_m_s2
+    return s.time_us, x, y, z, vx, vy, vz, ax, ay, az, NAN, NAN, NAN, sp.yaw_rad, sp.yawspeed_rad_s  # (no jerk)
 
 
 @fields("timestamp", "q_d", "thrust_body")
 def _attitude_setpoint(i: Inputs) -> Row | None:
     s = i.snap
-    if s.attitude_setpoint_q_wxyz is None or not s.armed:
+    q = s.attitude_setpoint_q_wxyz
+    if q is None or not s.armed:
         return None
-    return s.time_us, *s.attitude_setpoint_q_wxyz, *_thrust_body(s)
+    w, x, y, z = q
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, w, x, y, z, tx, ty, tz
 
 
 @fields("timestamp", "roll", "pitch", "yaw", "thrust_body")
@@ -172,7 +190,8 @@ def _rates_setpoint(i: Inputs) -> Row | None:
         return None
     s = i.snap
     roll, pitch, yaw = s.rates_setpoint_rad_s
-    return s.time_us, roll, pitch, yaw, *_thrust_body(s)
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, roll, pitch, yaw, tx, ty, tz
 
 
 @fields("timestamp", "timestamp_sample", "xyz")
@@ -180,7 +199,8 @@ def _thrust_setpoint(i: Inputs) -> Row | None:
     if not i.vehicle.commander.armed:
         return None
     s = i.snap
-    return s.time_us, s.time_us, *_thrust_body(s)
+    tx, ty, tz = _thrust_body(s)
+    return s.time_us, s.time_us, tx, ty, tz
 
 
 @fields("timestamp", "timestamp_sample", "control")
@@ -357,11 +377,9 @@ _TABLE: dict[str, tuple[int, Fields, Callable[[Inputs], Hashable] | None]] = {
 }
 
 
-# fields that never change, set once as the format's defaults
+# fields that never change, set once as the format's defaults (the topics logged at every update give theirs in
+# their rows instead, so that their messages are packed without gathering: ulog_writer.DataPacker)
 CONSTANTS: dict[str, Values] = {
-    "vehicle_local_position": {"evh": 0.1, "evv": 0.1, "vxy_max": math.inf, "vz_max": math.inf,
-                               "hagl_min": math.inf, "hagl_max_z": math.inf, "hagl_max_xy": math.inf},
-    "vehicle_global_position": {"eph": 0.3, "epv": 0.4, "lat_lon_valid": True, "alt_valid": True},
     "actuator_outputs": {"noutputs": PWM_OUTPUTS},
     "battery_status": {"scale": 1.0, "time_remaining_s": NAN, "temperature": NAN, "connected": True,
                        "cell_count": BATTERY_CELLS, "id": 1},

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import operator
 import struct
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -133,8 +133,10 @@ class DataPacker:
     message is the 3-byte header, msg_id, then every field in the format's order: a field not in `names` has its
     default (MessageFormat.set_defaults, else zero), padding is zero bytes, the trailing padding is not written.
 
-    The work is done once, here: the message header and each run of fields not in `names` (their defaults, the
-    padding) become constant bytes, so a message packs only the named values and those runs, with one struct.
+    The work is done once, here: the message header becomes constant bytes, and one struct packs the body, in
+    which each run of fields not in `names` is a pad (no argument) when its bytes are all zero and a constant
+    `Ns` argument otherwise. When `names` follow the format's order and no run needs an argument, the values are
+    packed as they come; else they are gathered first, with the constants, into the struct's order.
     """
 
     def __init__(self, fmt: MessageFormat, msg_id: int, names: Sequence[str]) -> None:
@@ -150,31 +152,41 @@ class DataPacker:
         sources: list[int] = []  # per struct argument: its index in values + constants
         constants: list[bytes] = []
 
-        def add_constant(run: bytes) -> None:
-            if run:
+        def add_defaults(run: bytes) -> None:
+            if not run:
+                return
+            if not any(run):
+                codes.append(f"{len(run)}x")
+            else:
                 codes.append(f"{len(run)}s")
                 sources.append(self._count + len(constants))
                 constants.append(run)
 
-        run = _HEAD.pack(_DATA_ID.size + fmt.size, ord("D")) + _DATA_ID.pack(msg_id)
+        run = b""
         for i, code in enumerate(fmt.written_codes):
             name = fmt.fields[i].name
             if name not in starts:
                 run += fmt.default_bytes(i)
                 continue
-            add_constant(run)
+            add_defaults(run)
             run = b""
             codes.append(code)
             sources.extend(range(starts[name], starts[name] + counts[name]))
-        add_constant(run)
-        self._struct = struct.Struct("<" + "".join(codes))
+        add_defaults(run)
+        self._head = _HEAD.pack(_DATA_ID.size + fmt.size, ord("D")) + _DATA_ID.pack(msg_id)
+        self._pack = struct.Struct("<" + "".join(codes)).pack
         self._constants = tuple(constants)
-        self._gather = operator.itemgetter(*sources)  # (the header's run and one field at least: 2 or more)
+        in_order = sources == list(range(self._count))
+        self._gather: Callable[[tuple[Any, ...]], tuple[Any, ...]] | None = \
+            None if in_order else operator.itemgetter(*sources)  # (not in order: 2 sources at least)
 
     def __call__(self, values: tuple[Any, ...]) -> bytes:
         if len(values) != self._count:
             raise ValueError(f"{len(values)} values for {self._count}")
-        return self._struct.pack(*self._gather(values + self._constants))
+        if self._gather is not None:
+            values = self._gather(values + self._constants)
+        pack = self._pack  # (compiled, a starred call of an attribute would look the attribute up by name)
+        return self._head + pack(*values)
 
 
 def message(kind: bytes, body: bytes) -> bytes:
