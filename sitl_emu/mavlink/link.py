@@ -16,6 +16,7 @@ from __future__ import annotations
 import errno
 import logging
 import socket
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
@@ -49,6 +50,8 @@ class UdpLink:
         self.peer_latched = False
         self.stats = LinkStats()
         self._sock = _open_socket(bind_host, port, name)
+        # bound once: the compiled send() then calls it directly, without looking the method up on the socket
+        self._sendto: Callable[[bytes, Address], int] = self._sock.sendto
         self.local_address: Address = self._sock.getsockname()
 
     @property
@@ -90,7 +93,7 @@ class UdpLink:
         if self.remote is None:
             return
         try:
-            self._sock.sendto(data, self.remote)
+            self._sendto(data, self.remote)
         except OSError as err:
             self.stats.tx_errors += 1
             log.debug("%s: sendto %s failed: %s", self.name, self.remote, err)

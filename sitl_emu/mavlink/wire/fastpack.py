@@ -42,8 +42,11 @@ except ImportError:  # pragma: no cover - depends on the installed pymavlink
     _mcrf4xx = None
 
 MAGIC_V2: Final = b"\xfd"
-_HEADER = struct.Struct("<BBBBBBHB")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit), after the magic
-_CRC = struct.Struct("<H")
+_HEADER: Final = struct.Struct("<BBBBBBHB")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit): after magic
+_CRC: Final = struct.Struct("<H")
+# The packers as Final names: compiled, frame_message then calls them directly (no module dict or method look-up)
+_pack_header: Final = _HEADER.pack
+_pack_crc: Final = _CRC.pack
 _BITREV = bytes(int(f"{i:08b}"[::-1], 2) for i in range(256))
 
 
@@ -54,7 +57,7 @@ def _crc_hqx_reflected(data: bytes, crc: int = 0xFFFF) -> int:
     return rev[crc >> 8] | (rev[crc & 0xFF] << 8)
 
 
-x25_crc: Callable[[bytes, int], int] = _mcrf4xx if _mcrf4xx is not None else _crc_hqx_reflected
+x25_crc: Final[Callable[[bytes, int], int]] = _mcrf4xx if _mcrf4xx is not None else _crc_hqx_reflected
 
 
 @dataclass(frozen=True, slots=True)
@@ -99,8 +102,8 @@ def frame_message(msg: Packed, seq: int, sysid: int, compid: int, incompat_flags
         payload = spec.pack(*msg.values)
         body = msg.body = payload.rstrip(b"\0") or payload[:1]
     msg_id = spec.msg_id
-    head = _HEADER.pack(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
-    return MAGIC_V2 + head + _CRC.pack(x25_crc(head + spec.crc_extra, 0xFFFF))
+    head = _pack_header(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
+    return MAGIC_V2 + head + _pack_crc(x25_crc(head + spec.crc_extra, 0xFFFF))
 
 
 # --- per-class specs -------------------------------------------------------------------------------------------------
