@@ -26,6 +26,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 from sitl_emu.events import enums, failsafe_notices, health_events
 from sitl_emu.events.definition import EventDefinition, Px4Event, Values, critical, px4_event
@@ -131,12 +132,22 @@ def to_px4_event(event: VehicleEvent) -> Px4Event | None:
     """The event PX4 sends with this text, or None (not an event, or none catalogued)."""
     if not event.is_event:
         return None
+    found = _entry_for(event.text, event.statustext)
+    if found is None:
+        return None
+    entry, match = found
+    values = entry.values(match)
+    if values is None:
+        return None
+    return px4_event(entry.definition, values, event.time_us)
+
+
+@lru_cache(maxsize=256)
+def _entry_for(text: str, statustext: bool) -> tuple[_Entry, re.Match[str]] | None:
+    """The first entry whose pattern matches the whole text (and its STATUSTEXT condition), with the match: the
+    patterns run once per distinct text (a vehicle says the same few texts again and again)."""
     for entry in ENTRIES:
-        match = entry.text.fullmatch(event.text)
-        if match is None or entry.statustext not in (None, event.statustext):
-            continue
-        values = entry.values(match)
-        if values is None:
-            return None
-        return px4_event(entry.definition, values, event.time_us)
+        match = entry.text.fullmatch(text)
+        if match is not None and entry.statustext in (None, statustext):
+            return entry, match
     return None
