@@ -46,8 +46,7 @@ class Commander:
                  send_event: SendEvent = drop) -> None:
         self.params = params
         self._settings = CommanderSettings.from_params(params)
-        self._param_changes = params.changes
-        self._settings_version = params.version
+        self._params_watch = params.changes.watch()  # params/changes.py
         self._emit, self._send_event = emit, send_event  # texts; PX4 events no text tells (commander/notices.py)
         self._health = HealthReporter()
         self._ned_of = ned_of
@@ -85,9 +84,8 @@ class Commander:
 
     @property
     def settings(self) -> CommanderSettings:
-        if self._param_changes.value != self._settings_version:
+        if self._params_watch.changed():
             self._settings = CommanderSettings.from_params(self.params)
-            self._settings_version = self._param_changes.value
         return self._settings
 
     # ---- inputs -------------------------------------------------------------------------------------------------

@@ -261,17 +261,15 @@ class Task:
 
     def __init__(self, nav: NavInput, params: ParamRegistry) -> None:
         self._params = params
-        self._param_changes = params.changes
-        self._version = params.version
         self._settings = AutoSettings.from_params(params)
+        self._params_watch = params.changes.watch()  # params/changes.py
         self._core = AutoCore(nav, self._settings)
         self._messages: list[tuple[Severity, str]] = []
         self._type = SetpointType.POSITION
 
     def update(self, nav: NavInput, dt_s: float) -> TrajectorySetpoint:
         """The trajectory setpoint for this cycle (NaN = not controlled)."""
-        if self._param_changes.value != self._version:
-            self._version = self._param_changes.value
+        if self._params_watch.changed():
             self._settings = AutoSettings.from_params(self._params)
             self._core.s = self._settings
         wp = self._waypoint(nav)

@@ -96,7 +96,6 @@ class ModeExecutor:
 
     def __init__(self, params: ParamRegistry) -> None:
         self.params = params
-        self._param_changes = params.changes
         self.task: FlightTask | None = None
         self._stabilized: StabilizedMode | None = None  # STABILIZED / MANUAL, while in force
         self._task_mode: NavState | None = None  # the mode self.task flies; None exactly when no task runs
@@ -117,7 +116,7 @@ class ModeExecutor:
         self._mission_land = MissionLandAltitude()  # the mission landing's return altitude (RTL_TYPE 1 and 3)
         self._rtl_check_us = 0  # when Return's destination is evaluated next while Return is inactive
         self._auto_settings: AutoSettings | None = None  # for that evaluation, read again when a parameter changes
-        self._auto_version = -1
+        self._auto_watch = params.changes.watch(current=False)  # params/changes.py
 
     def attach_missions(self, store: MissionStore) -> None:
         """The stored plans AUTO.MISSION flies (the Vehicle's store; the navigator state lives as long as it)."""
@@ -302,8 +301,8 @@ class ModeExecutor:
     def _check_rtl_destination(self, nav: auto.NavInput) -> ReturnDestination | None:
         """RTL::setRtlTypeAndDestination: the destination (the vehicle's choice), the mission landing's altitude."""
         destination = self.rtl_destination(nav) if self.rtl_destination else None
-        if self._auto_settings is None or self._auto_version != self._param_changes.value:
-            self._auto_settings, self._auto_version = AutoSettings.from_params(self.params), self._param_changes.value
+        if self._auto_watch.changed() or self._auto_settings is None:
+            self._auto_settings = AutoSettings.from_params(self.params)
         self._mission_land.evaluate(destination, nav, self._auto_settings)
         return destination
 

@@ -98,7 +98,7 @@ class FlightLogger:
         self._last_us = -1
         self._event_seq = 0
         self._params: dict[str, float] = {}
-        self._param_version = -1
+        self._params_watch = node.vehicle.params.changes.watch()  # params/changes.py; again at each log's start
         self._next_sync_us = 0
         self._plan: list[tuple[Topic, _Schedule]] = []  # in msg_id order: the topic, when it is next due
         self._inputs: Inputs | None = None  # what the topics read, from the start of a log
@@ -192,7 +192,7 @@ class FlightLogger:
         infos = version_infos(int(vehicle.sysid), self.node.epoch_unix_us)
         params = vehicle.params
         self._params = {d.name: params.get(d.name) for d in params}
-        self._param_version = params.version
+        self._params_watch = params.changes.watch()  # params/changes.py
         return b"".join((ulog.file_header(now_us), ulog.flag_bits(), infos, definitions,
                          parameter_messages(params), subscriptions))
 
@@ -206,7 +206,7 @@ class FlightLogger:
         events = vehicle.events_after(self._event_seq)
         if events:
             self._log_texts(events)
-        if vehicle.params.version != self._param_version:
+        if self._params_watch.changed():
             self._write(self._changed_params())
         now = inputs.time_us
         pending = self._pending
@@ -239,7 +239,6 @@ class FlightLogger:
 
     def _changed_params(self) -> bytes:
         params = self.node.vehicle.params
-        self._param_version = params.version
         out = []
         for d in params:
             value = params.get(d.name)

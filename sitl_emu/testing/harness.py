@@ -41,7 +41,7 @@ class ClosedLoop:
         self.registry = registry or default_registry()
         self.cfg = sih_config(self.registry)
         self.control = MulticopterControl(cascade_settings(self.registry))
-        self._settings_version = self.registry.version
+        self._params_watch = self.registry.changes.watch()  # params/changes.py
         self.control.reset(flying=flying)
         self.state = state or RigidBodyState()
         self.dt_s = dt_s
@@ -55,8 +55,7 @@ class ClosedLoop:
         for k in range(round(duration_s / self.dt_s)):
             t = t0_s + k * self.dt_s
             att = attitude(t) if attitude else None
-            if self.registry.version != self._settings_version:  # a parameter changed: new controller settings
-                self._settings_version = self.registry.version
+            if self._params_watch.changed():  # a parameter changed: new controller settings
                 self.control.settings = cascade_settings(self.registry)
             motors = self.control.update(self.state, setpoint(t), att, armed, self.state.on_ground,
                                          self.now_us, self.dt_s)

@@ -83,8 +83,8 @@ class VehicleFaults:
         self._motor_stop = 0  # the motors' OFF mask in `failures`, kept here as it is read every tick
         self.manager_running = int(params["SYS_FAILURE_EN"]) == 1  # reboot_required: read at boot
         self.battery = BatterySimulator()
-        self._param_changes = params.changes
-        self._settings, self._params_version = MonitorSettings.from_params(params), params.version
+        self._settings = MonitorSettings.from_params(params)
+        self._params_watch = params.changes.watch()  # params/changes.py
         self.wind = WindModel(wind, dt_s, _rng([seed, WIND_STREAM])) if wind and wind.active else None
         self.noise = EstimateNoise(noise, _rng(seed)) if noise is not None and noise.active else None
         self._gps_off_us: int | None = None
@@ -113,8 +113,8 @@ class VehicleFaults:
 
     @property
     def settings(self) -> MonitorSettings:
-        if self._param_changes.value != self._params_version:
-            self._settings, self._params_version = MonitorSettings.from_params(self.params), self._param_changes.value
+        if self._params_watch.changed():
+            self._settings = MonitorSettings.from_params(self.params)
         return self._settings
 
     # ---- per commander cycle ------------------------------------------------------------------------------------

@@ -54,8 +54,7 @@ class FenceChecks:
         self.params = params
         self.monitor = GeofenceMonitor()
         self._settings: GeofenceSettings = geofence_settings(params)
-        self._param_changes = params.changes
-        self._version = params.version
+        self._params_watch = params.changes.watch()  # params/changes.py
         self._mission_key: tuple[object, ...] | None = None  # what the mission was last checked against
         # the very objects that key was made of (plans and home are replaced, never changed in place): while they
         # are the same, the check is not due (PX4 checks again only when the mission, fence, home or a parameter
@@ -63,13 +62,13 @@ class FenceChecks:
         self._checked_mission: Plan | None = None
         self._checked_fence: Plan | None = None
         self._checked_home: HomePosition | None = None
-        self._checked_version = -1
+        self._checked_params = params.changes.watch(current=False)  # for the mission check: changed since it ran
         self.avoidance = RtlAvoidance(params)  # Return's way around the fence (rtl_avoidance.py)
 
     @property
     def settings(self) -> GeofenceSettings:
-        if self._param_changes.value != self._version:
-            self._settings, self._version = geofence_settings(self.params), self._param_changes.value
+        if self._params_watch.changed():
+            self._settings = geofence_settings(self.params)
         return self._settings
 
     def step(self, now_us: int, store: MissionStore, c: Commander, estimate_ned_m: Vec3, truth_ned_m: Vec3,
@@ -131,12 +130,11 @@ class FenceChecks:
 
     def _inputs_replaced(self, mission: Plan, fence: Plan, c: Commander) -> bool:
         """Whether a plan, home or the parameters were replaced since the last call (maybe with equal values)."""
-        version = self._param_changes.value
-        if (mission is self._checked_mission and fence is self._checked_fence and c.home is self._checked_home
-                and version == self._checked_version):
+        params_changed = self._checked_params.changed()
+        if (not params_changed and mission is self._checked_mission and fence is self._checked_fence
+                and c.home is self._checked_home):
             return False
         self._checked_mission, self._checked_fence, self._checked_home = mission, fence, c.home
-        self._checked_version = version
         return True
 
     def check_commands(self, c: Commander, ref: GeoRef, here_ned_m: Vec3, emit: Emit) -> None:

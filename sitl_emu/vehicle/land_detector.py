@@ -122,8 +122,7 @@ class LandDetector:
 
     def __init__(self, params: ParamRegistry) -> None:
         self._params = params
-        self._param_changes = params.changes
-        self._version = -1
+        self._params_watch = params.changes.watch(current=False)  # params/changes.py
         self._s = _Settings.from_params(params)
         self._freefall = Hysteresis(False, FREEFALL_TRIGGER_US)
         self._ground_contact = Hysteresis(True)
@@ -157,9 +156,8 @@ class LandDetector:
                                  self._freefall.state)
 
     def _refresh(self) -> None:
-        if self._param_changes.value == self._version:
+        if not self._params_watch.changed():
             return
-        self._version = self._param_changes.value
         self._s = _Settings.from_params(self._params)
         for h in (self._ground_contact, self._maybe_landed, self._landed):
             h.time_from_false_us = self._s.stage_us

@@ -77,7 +77,6 @@ class Vehicle:
         flight: disturbance/estimate.py) are off by default (faults.py).
         """
         self.params: ParamRegistry = params if params is not None else default_registry()
-        self._param_changes = self.params.changes  # params/changes.py
         self.sysid = sysid
         self._home_tuple = home
         self._seed = seed
@@ -97,8 +96,8 @@ class Vehicle:
         self._state = RigidBodyState()
         self._estimate = self._state
         self._motor_commands: Vec4 = (0.0, 0.0, 0.0, 0.0)  # the mixer's output of the last tick
-        self._sih_version = -1
         self._sih = sih_config(self.params)
+        self._sih_watch = self.params.changes.watch()  # params/changes.py
         self.commander = Commander(self.params, self._emit, self._ned_of, self._here, self._send_px4_event)
         self.chain = ControlChain(self.params)
         self._setpoint_type = SetpointType.NONE
@@ -184,8 +183,8 @@ class Vehicle:
         return self._fence.rtl_avoidance(nav.pos_ned_m, destination_ned_m, self.ref, self._emit)
 
     def _sih_config(self) -> SihConfig:
-        if self._param_changes.value != self._sih_version:
-            self._sih, self._sih_version = sih_config(self.params), self._param_changes.value
+        if self._sih_watch.changed():
+            self._sih = sih_config(self.params)
         return self._sih
 
     # ---- inputs -------------------------------------------------------------------------------------------------

@@ -65,6 +65,19 @@ def test_a_reader_that_keeps_the_change_count_sees_every_change(reg):
     assert changes.value == reg.version == 2
 
 
+def test_a_watch_says_changed_once_after_any_number_of_changes(reg):
+    """Settings built from the parameters are rebuilt when `watch.changed()` says so (params/changes.py)."""
+    built_now, built_at_first_use = reg.changes.watch(), reg.changes.watch(current=False)
+    assert not built_now.changed()
+    assert built_at_first_use.changed() and not built_at_first_use.changed()
+    reg.set("MPC_XY_VEL_MAX", 8)
+    reg.set("MPC_XY_VEL_MAX", 9)
+    assert built_now.changed() and not built_now.changed()
+    assert built_at_first_use.changed() and not built_at_first_use.changed()
+    reg.set("MPC_XY_VEL_MAX", 9)  # the same value: no change, nothing to rebuild
+    assert not built_now.changed()
+
+
 @pytest.mark.parametrize(("name", "value", "words"), [
     ("MPC_XY_VEL_MAX", math.nan, "finite"),
     ("MPC_XY_VEL_MAX", math.inf, "finite"),
