@@ -86,6 +86,11 @@ def core_speed_with_io() -> float:
     campaign case: the API link streams its default set to a scripted client in this process (testing/client.py,
     which talks first and reads every CLIENT_POLL_US; its CPU counts), the GCS link has no peer and builds nothing.
     A link is read when the runners' socket watch says so."""
+    return io_run()[0]
+
+
+def io_run() -> tuple[float, float, int]:
+    """core_speed_with_io's run: (simulated s per CPU s, simulated s, datagrams the API link sent)."""
     from sitl_emu.runtime.runner import SocketWatch
     from sitl_emu.testing.client import FlightClient
     from sitl_emu.testing.sim import Sim
@@ -110,4 +115,4 @@ def core_speed_with_io() -> float:
         client.close()
         if client.seen.pos_ned_m is None:
             raise RuntimeError("the scripted client heard no position: the API link did not stream")
-        return v.time_us / 1e6 / cpu
+        return v.time_us / 1e6 / cpu, v.time_us / 1e6, node.api.link.stats.tx_datagrams
