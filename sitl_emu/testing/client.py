@@ -6,7 +6,8 @@ its clock. With `Sim.clock` (lockstep) a whole flight runs as fast as the CPU al
 `px4common.clock.ScaledClock(speed)` the same script flies `sitl-emu serve --speed speed` in another process.
 
 It decodes only the messages it reads (OBSERVED, and what `watch()` adds; testing/frames.py): the other ~80 % of
-an API link's streams are skipped by their header's message id.
+an API link's streams are skipped by their header's message id, on Linux already in the kernel
+(testing/kernel_filter.py: they never reach Python; `kernel_filter=False` turns that off, with the same results).
 
 `fly_square()` is the reference flight of the tests and the benchmark: wait until healthy, arm, take off, OFFBOARD
 square (PX4's rule: setpoints stream before the switch, reference 4.2), land, wait for the auto-disarm.
@@ -24,6 +25,7 @@ from typing import Any, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from sitl_emu.px4 import MODE_FLAG_SAFETY_ARMED, MavCmd, MavResult, NavState, custom_mode, decode_custom_mode, main_sub
+from sitl_emu.testing import kernel_filter
 from sitl_emu.testing.frames import MessageFilter
 
 NAN = math.nan
@@ -83,7 +85,7 @@ class FlightClient:
     """A MAVLink peer of one vehicle's link at `address`, identifying as sysid/compid (default: onboard 255/190)."""
 
     def __init__(self, address: tuple[str, int], clock: Clock, target_sysid: int = 1,
-                 sysid: int = 255, compid: int = 190) -> None:
+                 sysid: int = 255, compid: int = 190, kernel_filter: bool = True) -> None:
         self.clock = clock
         self.address = address
         self.target = (target_sysid, 1)
@@ -94,6 +96,8 @@ class FlightClient:
         self.mav = dialect.MAVLink(None, srcSystem=sysid, srcComponent=compid)
         self._parser = MessageFilter(OBSERVED)
         self._parser.keep_last(*KEPT_LAST)
+        self._kernel_filter = kernel_filter
+        self._prefilter()
         self.seen = Observed(last=self._parser.last)
         self.setpoint_ned_m: tuple[float, float, float] | None = None
         self._next_heartbeat_s = -math.inf
@@ -102,12 +106,20 @@ class FlightClient:
 
     # --- I/O -----------------------------------------------------------------------------------------------------
     def watch(self, *names: str) -> None:
-        """Decode these messages too (e.g. "ORBIT_EXECUTION_STATUS"), for a subclass's `_observe` to read."""
+        """Decode these messages too (e.g. "ORBIT_EXECUTION_STATUS"), for a subclass's `_observe` to read; those that
+        arrive from now on (best called before the first pump())."""
         self._parser.add(*names)
+        self._prefilter()
 
     def watch_all(self) -> None:
         """Decode every message (a client that records everything it hears)."""
         self._parser.add_all()
+        self._prefilter()
+
+    def _prefilter(self) -> None:
+        """The kernel drops the single-frame datagrams of messages the parser skips (nothing off Linux)."""
+        if self._kernel_filter:
+            kernel_filter.attach(self.sock, self._parser.ids_read())
 
     def send(self, msg: Any) -> None:
         self.sock.sendto(msg.pack(self.mav), self.address)

@@ -49,7 +49,7 @@ class MessageFilter:
     def __init__(self, names: Iterable[str] = ()) -> None:
         self.wanted: set[int] = set()
         self.every = False  # add_all(): decode every frame (a recorder)
-        self.skipped = 0  # frames not decoded
+        self.skipped = 0  # frames not decoded (of those that reach parse(): a kernel prefilter drops others first)
         self._parser = _new_parser()
         self._kept: set[int] = set()  # keep_last(): the newest frame kept, decoded on demand
         self._newest: dict[int, bytes] = {}  # kept frames not decoded yet
@@ -66,6 +66,12 @@ class MessageFilter:
     def keep_last(self, *names: str) -> None:
         """Keep only the newest frame of these messages, decoded when last() asks (not returned by parse())."""
         self._kept.update(message_id(name) for name in names)
+
+    def ids_read(self) -> frozenset[int] | None:
+        """The message ids whose single frames parse() uses (wanted and kept); None when it decodes every frame.
+
+        For a prefilter that drops the other single frames before they reach parse() (testing/kernel_filter.py)."""
+        return None if self.every else frozenset(self.wanted | self._kept)
 
     def last(self, name: str) -> Any:
         """The newest valid message `name` of those kept (keep_last), decoded now if it is new; None before one."""
