@@ -92,6 +92,13 @@ class MulticopterControl:
         return ls
 
     @property
+    def position_output(self) -> PositionOutput | None:
+        """The last position-control cycle's output while position control runs (None when local_setpoint is None):
+        what local_setpoint is built from, for a reader of a field or two (the navigator's input, the land
+        detector's) that needs no setpoint object."""
+        return self._local_out
+
+    @property
     def attitude_setpoint_q_wxyz(self) -> Vec4 | None:
         return self._q_sp if self._has_q_sp else None
 
