@@ -20,7 +20,7 @@ from sitl_emu.control.mixer import mix
 from sitl_emu.control.position import PositionControl, PositionControlSettings, PositionOutput, input_valid
 from sitl_emu.control.qmath import constrain, isfinite, q_normalized, yaw_from_q
 from sitl_emu.control.rate import RateControl, RateControlSettings
-from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState
+from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState, before_ramp
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint, Vec3, Vec4
 
@@ -184,7 +184,7 @@ class MulticopterControl:
         return motors
 
     def _disarmed(self, now_us: int) -> Vec4:
-        if self.takeoff.state != TakeoffState.DISARMED or self._thrust != 0.0:
+        if self.takeoff.state is not TakeoffState.DISARMED or self._thrust != 0.0:
             self.reset()
         self.takeoff.update_state(False, True, False, now_us)
         return ZERO4
@@ -223,11 +223,11 @@ class MulticopterControl:
         if want_takeoff is None:
             want_takeoff = landed and _setpoint_wants_takeoff(sp, state.pos_ned_m[2])
         tko = self.takeoff.update_state(True, landed, want_takeoff, now_us)
-        flying = tko >= TakeoffState.FLIGHT
+        flying = tko is TakeoffState.FLIGHT  # PX4's `>= flight`: the last state
         if not flying:
             sp = _without_acc_z(sp)
             self.position.set_hover_thrust(s.thr_hover)
-        if tko < TakeoffState.RAMPUP or (flying and ground_contact):
+        if before_ramp(tko) or (flying and ground_contact):
             sp = IDLE_SETPOINT
             self.position.reset_integral()
         self._set_limits(flying, dt_s)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Any, Final
 
 from sitl_emu.control.qmath import atan2, hypot, isfinite
-from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.control.takeoff import before_ramp
 from sitl_emu.motion_planning.heading import HeadingSmoother, wrap_pi
 from sitl_emu.motion_planning.smoothing import PositionSmoother
 from sitl_emu.navigator.setpoint import NO_FEEDFORWARD, NavInput, SetpointType
@@ -158,7 +158,7 @@ class AutoCore:
         self._kind_prev = kind
         ax, ay, az = self.smoother.axes
         out = TrajectorySetpoint((ax.x, ay.x, az.x), (ax.v, ay.v, az.v), (ax.a, ay.a, az.a), yaw, yawspeed)
-        if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
+        if before_ramp(nav.takeoff_state):  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
             out = self._hold_before_ramp(nav, out)
         return out
 
