@@ -26,7 +26,6 @@ from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint, Vec3, Vec4
 
 IDLE_SETPOINT: Final = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, 100.0))  # "no thrust" (not yet taken off)
 TILT_SLEW_RAD_S: Final = 0.2  # MulticopterPositionControl _tilt_limit_slew_rate
-ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 # mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
 # Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
 POSITION_PERIOD_US: Final = 8000
@@ -177,7 +176,7 @@ class MulticopterControl:
         else:
             self.takeoff.update_state(armed, landed, False, now_us)
             self._idle()
-            return ZERO4
+            return 0.0, 0.0, 0.0, 0.0  # motors off (a literal: a module tuple is a dict look-up, compiled)
         self._rates_sp, self._thrust = rates_sp, thrust
         torque = self.rate.update(state.rates_frd_rad_s, rates_sp, dt_s, landed, self._sat_pos, self._sat_neg)
         motors, self._sat_pos, self._sat_neg = mix(torque, thrust)
@@ -187,7 +186,7 @@ class MulticopterControl:
         if self.takeoff.state is not TakeoffState.DISARMED or self._thrust != 0.0:
             self.reset()
         self.takeoff.update_state(False, True, False, now_us)
-        return ZERO4
+        return 0.0, 0.0, 0.0, 0.0  # motors off
 
     def _idle(self) -> None:
         self.position.reset_integral()
