@@ -302,7 +302,7 @@ class Commander:
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
                                          settings=st.fallback, terminated=self.terminated, now_us=now_us,
                                          manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss,
-                                         faults=(self.fault_flags, st.faults),
+                                         faults=self.fault_flags, fault_settings=st.faults,
                                          geofence=self.geofence, fail_act_us=st.manual_loss.fail_act_us)
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state

@@ -175,8 +175,8 @@ class Failsafe:
     def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False, now_us: int = 0, manual_lost: bool = False,
                manual_loss: ManualLossSettings | None = None,
-               faults: tuple[FaultFlags, FaultSettings] | None = None, geofence: GeofenceResult | None = None,
-               fail_act_us: int = 0) -> Decision:
+               faults: FaultFlags | None = None, fault_settings: FaultSettings | None = None,
+               geofence: GeofenceResult | None = None, fail_act_us: int = 0) -> Decision:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.reset()
@@ -192,9 +192,8 @@ class Failsafe:
         if manual_loss is not None:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
             action = _worse(action, user, wanted, self.manual_loss.disarm, CAUSE_MANUAL_CONTROL_LOSS)
-        if faults is not None:
-            flags, fault_settings = faults  # a starred call would go through Python's call protocol
-            for want in self.faults.wanted(now_us, user, flags, fault_settings):
+        if faults is not None and fault_settings is not None:  # two arguments: a tuple would be built every cycle
+            for want in self.faults.wanted(now_us, user, faults, fault_settings):
                 action = _worse(action, user, want.mode, want.disarm, want.cause)
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)
