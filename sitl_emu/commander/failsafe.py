@@ -162,6 +162,8 @@ class Failsafe:
         self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
         self._calm = Decision(NavState.MANUAL, False)  # the last no-failsafe decision (_no_failsafe)
+        # the last answer of _user_mode_can_run, and what it was for
+        self._can_run: tuple[NavState, CheckInputs | None, bool] = (NavState.MANUAL, None, False)
 
     def reset(self, *, user_mode_change: bool = False) -> None:
         """Arming, disarming or a user mode change ends every failsafe action (a mode change during the
@@ -186,7 +188,7 @@ class Failsafe:
         action: _Action = (0, user, False, CAUSE_GENERIC)
         # framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with
         # its Hold first): for the user's own mode, missing sticks are not a reason to fall back at once
-        if not can_run(user, inputs, ignoring=Req.MANUAL):
+        if not self._user_mode_can_run(user, inputs):
             fallback = resolve_fallback(user, settings, inputs)
             action = _worse(action, user, fallback, fallback is None)
         if manual_loss is not None:
@@ -207,6 +209,15 @@ class Failsafe:
         decision = self._decide(mode, disarm, text if rank > self._rank else "", (rank, delayed, cause, hold_s))
         self._rank = rank
         return decision
+
+    def _user_mode_can_run(self, user: NavState, inputs: CheckInputs) -> bool:
+        """can_run for the user's mode, leaving out the sticks (see update); worked out again only for another mode
+        or other inputs: the commander shares one read-only CheckInputs while its values stay the same."""
+        mode, checked, answer = self._can_run
+        if user is not mode or inputs is not checked:
+            answer = can_run(user, inputs, ignoring=Req.MANUAL)
+            self._can_run = (user, inputs, answer)
+        return answer
 
     def _no_failsafe(self, user: NavState) -> Decision:
         """The user's mode, no failsafe: one Decision kept while the user's mode stays (a Decision is read-only), not
