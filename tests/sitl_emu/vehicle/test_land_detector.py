@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -126,5 +127,5 @@ def test_the_published_state_is_made_again_only_when_a_flag_changes():
     states = [det.update(inp(i * STEP_US)) for i in range(300)]  # 1.2 s of landing: contact, maybe landed, landed
     flags = [(s.landed, s.maybe_landed, s.ground_contact, s.freefall) for s in states]
     assert flags[-1] == (True, True, True, False)
-    changes = 1 + sum(a != b for a, b in zip(flags, flags[1:]))
+    changes = 1 + sum(a != b for a, b in itertools.pairwise(flags))
     assert len({id(s) for s in states}) == changes == 4  # one read-only state per stage, shared in between
