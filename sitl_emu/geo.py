@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Final
 
+from sitl_emu.control.qmath import acos, asin, atan2, degrees, hypot, radians
 from sitl_emu.types import Vec3
 
 EARTH_RADIUS_M: Final = 6371000.0  # PX4 lib/geo/geo.h CONSTANTS_RADIUS_OF_EARTH
@@ -49,26 +50,26 @@ def ned_to_global(ref: GeoRef, pos_ned_m: Vec3) -> tuple[float, float, float]:
     """(lat_deg, lon_deg, alt_amsl_m) of a local NED position."""
     x_rad = pos_ned_m[0] / EARTH_RADIUS_M
     y_rad = pos_ned_m[1] / EARTH_RADIUS_M
-    c = math.hypot(x_rad, y_rad)
+    c = hypot(x_rad, y_rad)
     if c > 0.0:
         sin_c, cos_c = math.sin(c), math.cos(c)
         sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
-        lat = math.asin(_unit_clamped(cos_c * sin_ref + x_rad * sin_c * cos_ref / c))
-        lon = ref.lon_rad + math.atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
+        lat = asin(_unit_clamped(cos_c * sin_ref + x_rad * sin_c * cos_ref / c))
+        lon = ref.lon_rad + atan2(y_rad * sin_c, c * cos_ref * cos_c - x_rad * sin_ref * sin_c)
     else:
         lat, lon = ref.lat_rad, ref.lon_rad
-    lon_deg = (math.degrees(lon) + 180.0) % 360.0 - 180.0
-    return math.degrees(lat), lon_deg, ref.alt_amsl_m - pos_ned_m[2]
+    lon_deg = (degrees(lon) + 180.0) % 360.0 - 180.0
+    return degrees(lat), lon_deg, ref.alt_amsl_m - pos_ned_m[2]
 
 
 def global_to_ned(ref: GeoRef, lat_deg: float, lon_deg: float, alt_amsl_m: float) -> Vec3:
     """Local NED position (m) of a geodetic point."""
-    lat = math.radians(lat_deg)
-    d_lon = math.radians(lon_deg - ref.lon_deg)
+    lat = radians(lat_deg)
+    d_lon = radians(lon_deg - ref.lon_deg)
     sin_ref, cos_ref = ref.sin_lat, ref.cos_lat
     sin_lat, cos_lat = math.sin(lat), math.cos(lat)
     cos_d_lon = math.cos(d_lon)
-    c = math.acos(_unit_clamped(sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))
+    c = acos(_unit_clamped(sin_ref * sin_lat + cos_ref * cos_lat * cos_d_lon))
     k = 1.0 if abs(c) < 1e-12 else c / math.sin(c)
     north = k * (cos_ref * sin_lat - sin_ref * cos_lat * cos_d_lon) * EARTH_RADIUS_M
     east = k * cos_lat * math.sin(d_lon) * EARTH_RADIUS_M

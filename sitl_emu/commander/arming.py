@@ -136,6 +136,25 @@ class CheckInputs:
         return have
 
 
+class CheckInputsCache:
+    """The last CheckInputs, made again only when one of its values changed: they are read-only, so the commander
+    cycles share one while nothing changes (ARCHITECTURE.md, On the tick path)."""
+
+    def __init__(self) -> None:
+        self._key = (False, False, False, False, False, False, False)
+        self._inputs = CheckInputs(False, False, False)
+
+    def of(self, estimator_ready: bool, home_valid: bool, offboard_signal: bool, manual_control: bool,
+           mission_valid: bool, position_lost: bool, mission_required: bool) -> CheckInputs:
+        key = (estimator_ready, home_valid, offboard_signal, manual_control, mission_valid, position_lost,
+               mission_required)
+        if key != self._key:
+            self._key = key
+            self._inputs = CheckInputs(estimator_ready, home_valid, offboard_signal, manual_control, mission_valid,
+                                       position_lost, mission_required)
+        return self._inputs
+
+
 def offboard_available(mode: OffboardControlMode, estimate: int) -> bool:
     """offboardCheck.cpp, for a fresh signal of these setpoint kinds: the estimate they need is there (a local
     position for positions, a local velocity (valid with the position here) for velocities, an attitude for

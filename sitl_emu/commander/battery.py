@@ -64,19 +64,19 @@ class BatterySimulator:
 
     def __init__(self) -> None:
         self.fraction = 1.0
-        self._last_us: int | None = None
+        self._last_us = -1  # the last update while armed (-1: none since arming; an int, not None: see update)
         self.voltage_v = 16.2
         self.remaining = 1.0
         self.warning = WARNING_NONE
         self.failed = False  # failure battery off
 
     def update(self, now_us: int, armed: bool, s: BatterySettings) -> None:
-        if armed:
-            if self._last_us is not None:
+        if armed:  # compiled, an `int | None` attribute would box now_us into a new Python int every tick
+            if self._last_us >= 0:
                 self.fraction -= (now_us - self._last_us) / s.drain_us
             self._last_us = now_us
         else:
-            self.fraction, self._last_us = 1.0, None
+            self.fraction, self._last_us = 1.0, -1
         self.fraction = max(self.fraction, s.min_fraction)
         self.voltage_v = ((1.0 - self.fraction) * s.v_empty + self.fraction * s.v_charged) * s.cells
         self.remaining = 0.0 if self.failed else self.fraction

@@ -49,8 +49,7 @@ class Commander:
         self._params_watch = params.changes.watch()  # params/changes.py
         self._emit, self._send_event = emit, send_event  # texts; PX4 events no text tells (commander/notices.py)
         self._health = HealthReporter()
-        self._ned_of = ned_of
-        self._here = here
+        self._ned_of, self._here = ned_of, here
         self.intention = ModeIntention(NavState.AUTO_LOITER)
         self._failsafe = Failsafe()
         self.armed = False
@@ -80,6 +79,7 @@ class Commander:
         self.geofence: GeofenceResult = NO_BREACH  # the navigator's geofence_result (navigator/geofence_monitor.py)
         self._checks_key: tuple[object, ...] = ()  # what pre_flight_checks_pass last ran for
         self._checks_pass = False
+        self._inputs = arming.CheckInputsCache()  # the last check inputs (read-only: shared while unchanged)
         self.mission_store: MissionStore | None = None  # the stored plans (the Vehicle's), for AUTO.MISSION's checks
 
     @property
@@ -169,12 +169,12 @@ class Commander:
         return self._check_inputs(self.now_us if now_us is None else now_us, self.settings)
 
     def _check_inputs(self, now_us: int, st: CommanderSettings) -> arming.CheckInputs:
-        """check_inputs with the settings already at hand (the commander cycle reads them once)."""
-        return arming.CheckInputs(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
-                                  offboard_signal=self._offboard_available(now_us, st),
-                                  manual_control=self.manual.valid(now_us, st.rc_loss_us),
-                                  mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost,
-                                  mission_required=st.arm_mission_required)
+        """check_inputs with the settings already at hand (the commander cycle reads them once), shared while equal."""
+        return self._inputs.of(estimator_ready=self.estimator_ready, home_valid=self.home is not None,
+                               offboard_signal=self._offboard_available(now_us, st),
+                               manual_control=self.manual.valid(now_us, st.rc_loss_us),
+                               mission_valid=self.mission_valid, position_lost=self.fault_flags.position_lost,
+                               mission_required=st.arm_mission_required)
 
     def _offboard_available(self, now_us: int, st: CommanderSettings) -> bool:
         """offboardCheck.cpp: a fresh signal, with the estimate its setpoints need (commander/arming.py)."""
@@ -300,7 +300,7 @@ class Commander:
         decision = self._failsafe.update(armed=self.armed, user=self.intention.user_intended, inputs=inputs,
                                          settings=st.fallback, terminated=self.terminated, now_us=now_us,
                                          manual_lost=self._manual_lost(inputs), manual_loss=st.manual_loss,
-                                         faults=(self.fault_flags, st.faults),
+                                         faults=self.fault_flags, fault_settings=st.faults,
                                          geofence=self.geofence, fail_act_us=st.manual_loss.fail_act_us)
         if not (self.armed and self.nav_state is NavState.TERMINATION):
             self.nav_state = decision.nav_state

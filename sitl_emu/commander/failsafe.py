@@ -162,6 +162,8 @@ class Failsafe:
         self.geofence = GeofenceFailsafe()
         self._rank = 0  # the action in force (0: none)
         self._calm = Decision(NavState.MANUAL, False)  # the last no-failsafe decision (_no_failsafe)
+        # the last answer of _user_mode_can_run, and what it was for
+        self._can_run: tuple[NavState, CheckInputs | None, bool] = (NavState.MANUAL, None, False)
 
     def reset(self, *, user_mode_change: bool = False) -> None:
         """Arming, disarming or a user mode change ends every failsafe action (a mode change during the
@@ -175,8 +177,8 @@ class Failsafe:
     def update(self, *, armed: bool, user: NavState, inputs: CheckInputs, settings: FallbackSettings,
                terminated: bool = False, now_us: int = 0, manual_lost: bool = False,
                manual_loss: ManualLossSettings | None = None,
-               faults: tuple[FaultFlags, FaultSettings] | None = None, geofence: GeofenceResult | None = None,
-               fail_act_us: int = 0) -> Decision:
+               faults: FaultFlags | None = None, fault_settings: FaultSettings | None = None,
+               geofence: GeofenceResult | None = None, fail_act_us: int = 0) -> Decision:
         """The mode in force for the user's mode `user`, given what the checks see (`inputs`)."""
         if not armed:
             self.reset()
@@ -186,15 +188,14 @@ class Failsafe:
         action: _Action = (0, user, False, CAUSE_GENERIC)
         # framework.cpp modeCanRun leaves the manual-control requirement to the manual-control loss failsafe (with
         # its Hold first): for the user's own mode, missing sticks are not a reason to fall back at once
-        if not can_run(user, inputs, ignoring=Req.MANUAL):
+        if not self._user_mode_can_run(user, inputs):
             fallback = resolve_fallback(user, settings, inputs)
             action = _worse(action, user, fallback, fallback is None)
         if manual_loss is not None:
             wanted = self.manual_loss.update(now_us, manual_lost, user, manual_loss)
             action = _worse(action, user, wanted, self.manual_loss.disarm, CAUSE_MANUAL_CONTROL_LOSS)
-        if faults is not None:
-            flags, fault_settings = faults  # a starred call would go through Python's call protocol
-            for want in self.faults.wanted(now_us, user, flags, fault_settings):
+        if faults is not None and fault_settings is not None:  # two arguments: a tuple would be built every cycle
+            for want in self.faults.wanted(now_us, user, faults, fault_settings):
                 action = _worse(action, user, want.mode, want.disarm, want.cause)
         if geofence is not None:
             action = self._geofence(now_us, geofence, user, fail_act_us, action)
@@ -208,6 +209,15 @@ class Failsafe:
         decision = self._decide(mode, disarm, text if rank > self._rank else "", (rank, delayed, cause, hold_s))
         self._rank = rank
         return decision
+
+    def _user_mode_can_run(self, user: NavState, inputs: CheckInputs) -> bool:
+        """can_run for the user's mode, leaving out the sticks (see update); worked out again only for another mode
+        or other inputs: the commander shares one read-only CheckInputs while its values stay the same."""
+        mode, checked, answer = self._can_run
+        if user is not mode or inputs is not checked:
+            answer = can_run(user, inputs, ignoring=Req.MANUAL)
+            self._can_run = (user, inputs, answer)
+        return answer
 
     def _no_failsafe(self, user: NavState) -> Decision:
         """The user's mode, no failsafe: one Decision kept while the user's mode stays (a Decision is read-only), not

@@ -100,7 +100,7 @@ class ReportInputs:
         stays interpreted; the reporter compares every 100 ms)."""
         if not isinstance(other, ReportInputs):
             return NotImplemented
-        return (self.nav_state == other.nav_state and self.armed == other.armed
+        return (self.nav_state is other.nav_state and self.armed == other.armed
                 and self.missing == other.missing and self.geofence == other.geofence
                 and self.gcs_lost == other.gcs_lost and self.battery_warning == other.battery_warning
                 and self.manual_control == other.manual_control
@@ -108,12 +108,13 @@ class ReportInputs:
                 and self.datalink_required == other.datalink_required
                 and self.mission_required == other.mission_required)
 
-    @classmethod
-    def of(cls, nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
+    @staticmethod
+    def of(nav_state: NavState, armed: bool, c: CheckInputs, geofence: GeofenceResult, faults: FaultFlags,
            stick_input_disabled: bool, datalink_required: bool) -> ReportInputs:
-        return cls(nav_state, armed, _CHECKED & ~c.available(), geofence,
-                   faults.gcs_connection_lost, faults.battery_warning, c.manual_control, stick_input_disabled,
-                   datalink_required, c.mission_required)
+        # the class by name, not a classmethod's `cls`: compiled, that is a call through Python's type call
+        return ReportInputs(nav_state, armed, _CHECKED & ~c.available(), geofence,
+                            faults.gcs_connection_lost, faults.battery_warning, c.manual_control,
+                            stick_input_disabled, datalink_required, c.mission_required)
 
 
 class _Builder:

@@ -20,13 +20,12 @@ from sitl_emu.control.mixer import mix
 from sitl_emu.control.position import PositionControl, PositionControlSettings, PositionOutput, input_valid
 from sitl_emu.control.qmath import constrain, isfinite, q_normalized, yaw_from_q
 from sitl_emu.control.rate import RateControl, RateControlSettings
-from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState
+from sitl_emu.control.takeoff import TakeoffHandling, TakeoffState, before_ramp
 from sitl_emu.physics import RigidBodyState
 from sitl_emu.types import NAN, AttitudeSetpoint, TrajectorySetpoint, Vec3, Vec4
 
 IDLE_SETPOINT: Final = TrajectorySetpoint(acceleration_ned_m_s2=(0.0, 0.0, 100.0))  # "no thrust" (not yet taken off)
 TILT_SLEW_RAD_S: Final = 0.2  # MulticopterPositionControl _tilt_limit_slew_rate
-ZERO4: Vec4 = (0.0, 0.0, 0.0, 0.0)
 # mc_pos_control runs on each vehicle_local_position update: EKF2 at 100 Hz (EKF2_PREDICT_US 10 ms) in PX4 SITL.
 # Here every 8 ms (every second 250 Hz physics tick); attitude and rate control run every tick.
 POSITION_PERIOD_US: Final = 8000
@@ -90,6 +89,13 @@ class MulticopterControl:
         if ls is None and self._local_out is not None:  # built on first read after a position-control cycle
             ls = self._local_setpoint = self._local_out.local_setpoint
         return ls
+
+    @property
+    def position_output(self) -> PositionOutput | None:
+        """The last position-control cycle's output while position control runs (None when local_setpoint is None):
+        what local_setpoint is built from, for a reader of a field or two (the navigator's input, the land
+        detector's) that needs no setpoint object."""
+        return self._local_out
 
     @property
     def attitude_setpoint_q_wxyz(self) -> Vec4 | None:
@@ -170,17 +176,17 @@ class MulticopterControl:
         else:
             self.takeoff.update_state(armed, landed, False, now_us)
             self._idle()
-            return ZERO4
+            return 0.0, 0.0, 0.0, 0.0  # motors off (a literal: a module tuple is a dict look-up, compiled)
         self._rates_sp, self._thrust = rates_sp, thrust
         torque = self.rate.update(state.rates_frd_rad_s, rates_sp, dt_s, landed, self._sat_pos, self._sat_neg)
         motors, self._sat_pos, self._sat_neg = mix(torque, thrust)
         return motors
 
     def _disarmed(self, now_us: int) -> Vec4:
-        if self.takeoff.state != TakeoffState.DISARMED or self._thrust != 0.0:
+        if self.takeoff.state is not TakeoffState.DISARMED or self._thrust != 0.0:
             self.reset()
         self.takeoff.update_state(False, True, False, now_us)
-        return ZERO4
+        return 0.0, 0.0, 0.0, 0.0  # motors off
 
     def _idle(self) -> None:
         self.position.reset_integral()
@@ -216,11 +222,11 @@ class MulticopterControl:
         if want_takeoff is None:
             want_takeoff = landed and _setpoint_wants_takeoff(sp, state.pos_ned_m[2])
         tko = self.takeoff.update_state(True, landed, want_takeoff, now_us)
-        flying = tko >= TakeoffState.FLIGHT
+        flying = tko is TakeoffState.FLIGHT  # PX4's `>= flight`: the last state
         if not flying:
             sp = _without_acc_z(sp)
             self.position.set_hover_thrust(s.thr_hover)
-        if tko < TakeoffState.RAMPUP or (flying and ground_contact):
+        if before_ramp(tko) or (flying and ground_contact):
             sp = IDLE_SETPOINT
             self.position.reset_integral()
         self._set_limits(flying, dt_s)

@@ -14,17 +14,27 @@ then add yaw, reduce yaw (with 15 % headroom above the maximum), and reduce thru
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Final
 
 from sitl_emu.control.qmath import constrain, isfinite
 from sitl_emu.types import Vec3, Vec4
 
 _K: Final = 1.0 / math.sqrt(2.0)
-# The effectiveness columns. Not Final: mypyc miscompiles reading a Final tuple of floats (mypyc/mypyc#1183).
-ROLL: Vec4 = (-_K, _K, _K, -_K)
-PITCH: Vec4 = (_K, -_K, _K, -_K)
-YAW: Vec4 = (1.0, 1.0, -1.0, -1.0)
-THRUST: Vec4 = (1.0, 1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True, slots=True)
+class Effectiveness:
+    """The effectiveness columns. Fields of one Final instance, not module tuples: mypyc miscompiles reading a Final
+    tuple of floats (mypyc/mypyc#1183), and compiled, a plain module name is a dict look-up at every read."""
+
+    roll: Vec4 = (-_K, _K, _K, -_K)
+    pitch: Vec4 = (_K, -_K, _K, -_K)
+    yaw: Vec4 = (1.0, 1.0, -1.0, -1.0)
+    thrust: Vec4 = (1.0, 1.0, 1.0, 1.0)
+
+
+COLUMNS: Final = Effectiveness()
 YAW_HEADROOM: Final = 1.15  # mixYaw: some yaw authority above full thrust
 SATURATION_TOLERANCE: Final = 1e-4
 Flags3 = tuple[bool, bool, bool]
@@ -41,18 +51,18 @@ def mix(torque: Vec3, thrust: float) -> tuple[Vec4, Flags3, Flags3]:
     roll, pitch, yaw = (roll if isfinite(roll) else 0.0, pitch if isfinite(pitch) else 0.0,
                         yaw if isfinite(yaw) else 0.0)
     thrust = thrust if isfinite(thrust) else 0.0
-    r, p = _K * roll, _K * pitch  # the ROLL and PITCH columns above, row by row
+    r, p = _K * roll, _K * pitch  # the roll and pitch columns above, row by row
     u = (thrust - r + p, thrust + r - p, thrust + r + p, thrust - r - p)
     saturated = not _within(u, 1.0)
     if saturated:  # unsaturate with thrust (reducing it only), then roll, then pitch
-        u = _desaturate(u, THRUST, 1.0, reduce_only=True)
-        u = _desaturate(u, ROLL, 1.0)
-        u = _desaturate(u, PITCH, 1.0)
-    u = (u[0] + yaw, u[1] + yaw, u[2] - yaw, u[3] - yaw)  # mixYaw: the YAW column
+        u = _desaturate(u, COLUMNS.thrust, 1.0, reduce_only=True)
+        u = _desaturate(u, COLUMNS.roll, 1.0)
+        u = _desaturate(u, COLUMNS.pitch, 1.0)
+    u = (u[0] + yaw, u[1] + yaw, u[2] - yaw, u[3] - yaw)  # mixYaw: the yaw column
     if not _within(u, 1.0):  # unsaturate with yaw (with headroom), then by reducing thrust
         saturated = True
-        u = _desaturate(u, YAW, YAW_HEADROOM)
-        u = _desaturate(u, THRUST, 1.0, reduce_only=True)
+        u = _desaturate(u, COLUMNS.yaw, YAW_HEADROOM)
+        u = _desaturate(u, COLUMNS.thrust, 1.0, reduce_only=True)
     if not saturated:  # every desaturation gain would be zero: the demand is met exactly
         return u, _NO_SAT, _NO_SAT
     out = (constrain(u[0], 0.0, 1.0), constrain(u[1], 0.0, 1.0), constrain(u[2], 0.0, 1.0), constrain(u[3], 0.0, 1.0))
@@ -111,7 +121,8 @@ def _saturation_flags(achieved: Vec3, demand: Vec3) -> tuple[Flags3, Flags3]:
 
 def allocated_torque(u: Vec4) -> Vec3:
     """Normalised torque that motor commands u produce (inverse of the mix above)."""
-    return _dot4(ROLL, u) / (4 * _K * _K), _dot4(PITCH, u) / (4 * _K * _K), _dot4(YAW, u) / 4.0
+    c = COLUMNS
+    return _dot4(c.roll, u) / (4 * _K * _K), _dot4(c.pitch, u) / (4 * _K * _K), _dot4(c.yaw, u) / 4.0
 
 
 def _dot4(a: Vec4, b: Vec4) -> float:

@@ -18,6 +18,8 @@ atan2: Final = math.atan2
 acos: Final = math.acos
 asin: Final = math.asin
 hypot: Final = math.hypot
+degrees: Final = math.degrees
+radians: Final = math.radians
 
 
 def q_mul(a: Vec4, b: Vec4) -> Vec4:

@@ -25,6 +25,12 @@ class TakeoffState(IntEnum):
     FLIGHT = 5
 
 
+def before_ramp(state: TakeoffState) -> bool:
+    """PX4's `takeoff_state < rampup` (disarmed, spooling up or ready for takeoff), written with `is`: compiled, an
+    IntEnum's `<` or `==` is Python's rich comparison (ARCHITECTURE.md, On the tick path)."""
+    return state is not TakeoffState.RAMPUP and state is not TakeoffState.FLIGHT
+
+
 class TakeoffHandling:
     def __init__(self, spoolup_time_s: float = 1.0, ramp_time_s: float = 3.0, vel_p_acc_z: float = 4.0) -> None:
         self.state = TakeoffState.DISARMED
@@ -51,14 +57,14 @@ class TakeoffHandling:
             self._armed_since_us = now_us
         if st <= TakeoffState.DISARMED:
             st = TakeoffState.SPOOLUP
-        if st == TakeoffState.SPOOLUP and now_us - self._armed_since_us >= self.spoolup_time_s * 1e6:
+        if st is TakeoffState.SPOOLUP and now_us - self._armed_since_us >= self.spoolup_time_s * 1e6:
             st = TakeoffState.READY_FOR_TAKEOFF
-        if st == TakeoffState.READY_FOR_TAKEOFF and want_takeoff:
+        if st is TakeoffState.READY_FOR_TAKEOFF and want_takeoff:
             st = TakeoffState.RAMPUP
             self._ramp_progress = 0.0
-        if st == TakeoffState.RAMPUP and self._ramp_progress >= 1.0:
+        if st is TakeoffState.RAMPUP and self._ramp_progress >= 1.0:
             st = TakeoffState.FLIGHT
-        if st == TakeoffState.FLIGHT and landed:
+        if st is TakeoffState.FLIGHT and landed:
             st = TakeoffState.READY_FOR_TAKEOFF
         if skip_takeoff:
             st = TakeoffState.FLIGHT
@@ -69,9 +75,9 @@ class TakeoffHandling:
         """updateRamp: the upward velocity limit for this cycle (m/s, positive up)."""
         if self.state is TakeoffState.FLIGHT:
             return desired_vz_up
-        if self.state < TakeoffState.RAMPUP:
+        if before_ramp(self.state):
             return self.ramp_vz_init
-        if self.state == TakeoffState.RAMPUP:
+        if self.state is TakeoffState.RAMPUP:
             if self.ramp_time_s > dt_s:
                 self._ramp_progress += dt_s / self.ramp_time_s
             else:

@@ -9,6 +9,7 @@ its base type. `group` and `type` are the metadata's: the health and arming chec
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 from sitl_emu.events import enums
 from sitl_emu.events.library import Log, event_id, log_levels, pack_arguments
@@ -38,7 +39,7 @@ class EventDefinition:
 
     @property
     def base_types(self) -> tuple[str, ...]:
-        return tuple(_BASE_OF.get(t, t) for t in self.arguments)
+        return _base_types(self.arguments)
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +56,12 @@ def px4_event(d: EventDefinition, values: Values, time_us: int, levels: int | No
     """The event `d` sent now with these argument values (`levels`: other than the definition's, as a check event
     whose level depends on the situation)."""
     return Px4Event(d.id, d.levels if levels is None else levels, time_us // 1000, pack_arguments(d.base_types, values))
+
+
+@cache
+def _base_types(arguments: tuple[str, ...]) -> tuple[str, ...]:
+    """Each argument's base type (an enum's is the enum's), worked out once per distinct list."""
+    return tuple(_BASE_OF.get(t, t) for t in arguments)
 
 
 def critical(name: str, message: str, arguments: tuple[str, ...] = ()) -> EventDefinition:

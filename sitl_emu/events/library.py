@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import struct
 from enum import IntEnum
+from functools import cache
 
 FNV_OFFSET_BASIS = 0x811C9DC5
 FNV_PRIME = 0x01000193
@@ -47,8 +48,10 @@ def hash_32_fnv1a(text: str) -> int:
     return value
 
 
+@cache
 def sub_id(name: str) -> int:
-    """The lower 24 bits of the id: the key of the event in the metadata."""
+    """The lower 24 bits of the id: the key of the event in the metadata (worked out once per name: a vehicle sends
+    the same few events again and again)."""
     return hash_32_fnv1a(name) & 0xFFFFFF
 
 
@@ -64,7 +67,13 @@ def log_levels(external: Log, internal: Log | None = None) -> int:
 
 def pack_arguments(base_types: tuple[str, ...], values: tuple[float, ...]) -> bytes:
     """The 40 argument bytes: each value as its base type, little endian, back to back, zero-filled."""
-    data = struct.pack("<" + "".join(BASE_TYPES[t] for t in base_types), *values)
-    if len(data) > MAX_ARGUMENTS_SIZE:
-        raise ValueError(f"event arguments take {len(data)} bytes, more than {MAX_ARGUMENTS_SIZE}")
-    return data.ljust(MAX_ARGUMENTS_SIZE, b"\0")
+    return _packer(base_types).pack(*values).ljust(MAX_ARGUMENTS_SIZE, b"\0")
+
+
+@cache
+def _packer(base_types: tuple[str, ...]) -> struct.Struct:
+    """The packer of these base types, made once per distinct list."""
+    packer = struct.Struct("<" + "".join(BASE_TYPES[t] for t in base_types))
+    if packer.size > MAX_ARGUMENTS_SIZE:
+        raise ValueError(f"event arguments take {packer.size} bytes, more than {MAX_ARGUMENTS_SIZE}")
+    return packer

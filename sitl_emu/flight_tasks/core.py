@@ -19,10 +19,10 @@ from dataclasses import dataclass
 from typing import Any, Final
 
 from sitl_emu.control.qmath import atan2, hypot, isfinite
-from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.control.takeoff import before_ramp
 from sitl_emu.motion_planning.heading import HeadingSmoother, wrap_pi
 from sitl_emu.motion_planning.smoothing import PositionSmoother
-from sitl_emu.navigator.setpoint import NO_FEEDFORWARD, NavInput, SetpointType
+from sitl_emu.navigator.setpoint import NavInput, SetpointType
 from sitl_emu.params import ParamRegistry
 from sitl_emu.px4 import Severity
 from sitl_emu.types import NAN, TrajectorySetpoint, Vec3
@@ -143,7 +143,7 @@ class AutoCore:
         if kind is SetpointType.IDLE:
             return self._idle(nav)
         self._set_constraints(nav, wp)
-        target, ff = wp.target_ned_m, NO_FEEDFORWARD
+        target, ff = wp.target_ned_m, (NAN, NAN, NAN)  # no feed-forward (written out: a module tuple is a dict look-up)
         if kind is SetpointType.LAND:
             target, ff = (target[0], target[1], NAN), (NAN, NAN, self._land_speed(nav))
         # MPC_YAW_MODE 4, yaw first: no motion while the heading is not aligned (FlightTaskAuto::_generateSetpoints
@@ -158,7 +158,7 @@ class AutoCore:
         self._kind_prev = kind
         ax, ay, az = self.smoother.axes
         out = TrajectorySetpoint((ax.x, ay.x, az.x), (ax.v, ay.v, az.v), (ax.a, ay.a, az.a), yaw, yawspeed)
-        if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
+        if before_ramp(nav.takeoff_state):  # FlightModeManager.cpp: takeoff_state < TAKEOFF_STATE_RAMPUP
             out = self._hold_before_ramp(nav, out)
         return out
 

@@ -25,7 +25,7 @@ from typing import Final
 
 from sitl_emu.commander.manual_control import CENTRED
 from sitl_emu.control.qmath import constrain, isfinite
-from sitl_emu.control.takeoff import TakeoffState
+from sitl_emu.control.takeoff import TakeoffState, before_ramp
 from sitl_emu.flight_tasks.sticks import (
     FLT_EPSILON,
     NAN,
@@ -181,7 +181,7 @@ class ManualAltitudeTask:
         self.want_takeoff = sticks.throttle > WANT_TAKEOFF_THROTTLE
         axis = self._z.axis
         sp = self._horizontal(nav, yaw_sp, dt_s, (locked_z, axis.v, axis.a), yawspeed)
-        if nav.takeoff_state < TakeoffState.RAMPUP:  # FlightModeManager re-activates the task until the ramp
+        if before_ramp(nav.takeoff_state):  # FlightModeManager re-activates the task until the ramp
             self._activate(nav, TrajectorySetpoint(velocity_ned_m_s=(NAN, NAN, axis.v),
                                                    acceleration_ned_m_s2=(0.0, 0.0, 0.0)))  # FlightTask::reActivate
         return sp
@@ -233,7 +233,7 @@ class ManualPositionTask(ManualAltitudeTask):
     def _horizontal(self, nav: NavInput, yaw_sp: float, dt_s: float, z: tuple[float, float, float],
                     yawspeed: float) -> TrajectorySetpoint:
         s, sticks, xy = self.s, self.sticks, self._xy
-        tilt = s.tilt_air_rad if nav.takeoff_state >= TakeoffState.FLIGHT else s.tilt_lnd_rad
+        tilt = s.tilt_air_rad if nav.takeoff_state is TakeoffState.FLIGHT else s.tilt_lnd_rad
         xy.update((stick_expo(sticks.pitch, s.deadzone), stick_expo(sticks.roll, s.deadzone)), nav.yaw_rad, yaw_sp,
                   (nav.pos_ned_m[0], nav.pos_ned_m[1]), (nav.vel_sp_ned_m_s[0], nav.vel_sp_ned_m_s[1]), dt_s, tilt)
         (px, py), (vx, vy), (ax, ay) = xy.pos_sp, xy.vel_sp, xy.acc_sp

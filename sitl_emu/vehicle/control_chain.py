@@ -12,6 +12,7 @@ from typing import Final
 
 from sitl_emu.commander.commander import Commander
 from sitl_emu.control.cascade import MulticopterControl
+from sitl_emu.control.position import PositionOutput
 from sitl_emu.control.qmath import isfinite, norm
 from sitl_emu.flight_tasks.core import IDLE_ACC_Z_M_S2
 from sitl_emu.flight_tasks.mode_executor import ExecutorOutput, ModeExecutor
@@ -52,12 +53,12 @@ class ControlChain:
     def nav_input(self, now_us: int, est: RigidBodyState, c: Commander, ref: GeoRef) -> NavInput:
         """What the navigator task sees (flight_tasks/core.py NavInput)."""
         home = c.home
-        local = self.control.local_setpoint
+        local = self.control.position_output
         return NavInput(now_us, est.pos_ned_m, est.vel_ned_m_s, self.control.heading_rad(est),
                         home.pos_ned_m if home is not None else (0.0, 0.0, 0.0),
                         home.yaw_rad if home is not None else 0.0, c.landed, c.armed,
                         self.control.takeoff.state, ref.alt_amsl_m,
-                        local.velocity_ned_m_s if local is not None else NAN3)
+                        local.velocity_sp_ned_m_s if local is not None else NAN3)
 
     def control_update(self, est: RigidBodyState, out: ExecutorOutput, armed: bool, landed: bool, now_us: int,
                        dt_s: float) -> Vec4:
@@ -78,7 +79,7 @@ class ControlChain:
         state = self._detector.update(LandDetectorInput(
             time_us=now_us, armed=armed, vel_ned_m_s=est.vel_ned_m_s, rates_frd_rad_s=est.rates_frd_rad_s,
             specific_force_norm_m_s2=norm(est.specific_force_frd), thrust_setpoint=ctrl.thrust_setpoint,
-            hover_thrust=ctrl.hover_thrust, setpoint_vz_m_s=descent_vz(ctrl.local_setpoint),
+            hover_thrust=ctrl.hover_thrust, setpoint_vz_m_s=descent_vz(ctrl.position_output),
             in_descent_mode=climb_rate_controlled(out)))
         self.ground_contact = state.ground_contact
         return state
@@ -114,8 +115,9 @@ def _position_controlled(nav_state: NavState, offboard_last: OffboardControlMode
     return nav_state in POSITION_CONTROLLED
 
 
-def descent_vz(sp: TrajectorySetpoint | None) -> float:
-    """The vertical velocity setpoint the land detector judges "descending" by.
+def descent_vz(sp: PositionOutput | None) -> float:
+    """The vertical velocity setpoint the land detector judges "descending" by (from the last position-control
+    cycle's output, the local setpoint's source).
 
     MulticopterLandDetector.cpp _get_ground_contact_state also counts the idle setpoint (acceleration z >= 100,
     which the controller commands once it has ground contact) as descending; LandDetectorInput only carries vz,
@@ -123,7 +125,7 @@ def descent_vz(sp: TrajectorySetpoint | None) -> float:
     """
     if sp is None:
         return math.nan
-    acc_z = sp.acceleration_ned_m_s2[2]
+    acc_z = sp.acceleration_sp_ned_m_s2[2]
     if isfinite(acc_z) and acc_z >= IDLE_ACC_Z_M_S2:
         return 1e3
-    return sp.velocity_ned_m_s[2]
+    return sp.velocity_sp_ned_m_s[2]

@@ -128,6 +128,7 @@ class LandDetector:
         self._ground_contact = Hysteresis(True)
         self._maybe_landed = Hysteresis(True)
         self._landed = Hysteresis(True)
+        self._published = LandDetectorState(True, True, True, False)  # the last state made (see state)
         self._refresh()
 
     def reset(self, landed: bool = True) -> None:
@@ -152,8 +153,14 @@ class LandDetector:
 
     @property
     def state(self) -> LandDetectorState:
-        return LandDetectorState(self._landed.state, self._maybe_landed.state, self._ground_contact.state,
-                                 self._freefall.state)
+        """The published state: the last one again while no flag changed (it is read-only, and made 50 times a
+        second)."""
+        landed, maybe, contact, freefall = (self._landed.state, self._maybe_landed.state, self._ground_contact.state,
+                                            self._freefall.state)
+        last = self._published
+        if (last.landed, last.maybe_landed, last.ground_contact, last.freefall) != (landed, maybe, contact, freefall):
+            last = self._published = LandDetectorState(landed, maybe, contact, freefall)
+        return last
 
     def _refresh(self) -> None:
         if not self._params_watch.changed():

@@ -170,3 +170,15 @@ def test_gps_lost_in_position_mode_falls_back_to_altitude_and_position_is_refuse
     texts = [(e.severity, e.text) for e in v.events_after(seq) if e.statustext]
     assert texts == [(Severity.CRITICAL, "Switching to Position is currently not available")]
     assert _fly_with_sticks(v, 1.0) == [NavState.ALTCTL]
+
+
+def test_check_inputs_are_shared_while_equal_and_made_again_when_a_value_changes() -> None:
+    cache = arming.CheckInputsCache()
+    values = dict(estimator_ready=True, home_valid=True, offboard_signal=False, manual_control=False,
+                  mission_valid=True, position_lost=False, mission_required=False)
+    first = cache.of(**values)
+    assert cache.of(**values) is first  # the commander's next cycle, nothing changed: the same read-only inputs
+    assert (first.estimator_ready, first.home_valid, first.mission_valid) == (True, True, True)
+    lost = cache.of(**{**values, "position_lost": True})
+    assert lost is not first and lost.position_lost and not first.position_lost
+    assert cache.of(**values) is not lost and cache.of(**values).available() == first.available()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -119,3 +120,12 @@ def test_reset_sets_the_state():
     assert not det.state.landed
     det.reset()
     assert det.state.landed and det.state.ground_contact
+
+
+def test_the_published_state_is_made_again_only_when_a_flag_changes():
+    det = flying_detector()
+    states = [det.update(inp(i * STEP_US)) for i in range(300)]  # 1.2 s of landing: contact, maybe landed, landed
+    flags = [(s.landed, s.maybe_landed, s.ground_contact, s.freefall) for s in states]
+    assert flags[-1] == (True, True, True, False)
+    changes = 1 + sum(a != b for a, b in itertools.pairwise(flags))
+    assert len({id(s) for s in states}) == changes == 4  # one read-only state per stage, shared in between
