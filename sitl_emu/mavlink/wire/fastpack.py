@@ -70,8 +70,8 @@ class MessageSpec:
     `encode(*args)` takes pymavlink's `MAVLink.<name>_encode` arguments, positionally: the fields in their declared
     order, the last `len(defaults)` of them optional. It puts them in wire order (`wire`: per argument on the wire,
     its position and array length) as pymavlink's generated pack() does: an array element by element (a short one
-    fails with IndexError), a char array (bytes) whole: the arrays' elements are spliced into the arguments, then the
-    values picked in wire order (`picks`; most messages declare their fields in wire order and need neither)."""
+    fails with IndexError), a char array (bytes) whole. Most messages declare their scalar fields in wire order
+    already: their arguments are their values."""
 
     def __init__(self, msg_id: int, name: str, crc_extra: bytes, pack: Callable[..., bytes], arity: int,
                  defaults: tuple[Any, ...], wire: tuple[Term, ...]) -> None:
@@ -82,16 +82,24 @@ class MessageSpec:
         self.arity = arity  # how many arguments encode takes
         self.defaults = defaults  # the values of the last arguments when a call leaves them out
         self.wire = wire
-        self.arrays = tuple(sorted((position, length) for position, length in wire if length))
-        self.picks = _wire_picks(arity, self.arrays, wire)
+        self.in_wire_order = wire == tuple((position, 0) for position in range(arity))
 
     def encode(self, *args: Any) -> Packed:
         if len(args) != self.arity:
             args = self._completed(args)
-        if self.arrays:
-            args = self._spliced(args)
-        picks = self.picks
-        return Packed(self, args if picks is None else tuple(args[i] for i in picks))
+        if self.in_wire_order:
+            return Packed(self, args)
+        values: list[Any] = []
+        for position, length in self.wire:
+            value = args[position]
+            if length:
+                elements = value[:length]
+                if len(elements) < length:
+                    raise IndexError(f"{self.name}: an array of {len(elements)} values where {length} are sent")
+                values.extend(elements)
+            else:
+                values.append(value)
+        return Packed(self, tuple(values))
 
     def _completed(self, args: tuple[Any, ...]) -> tuple[Any, ...]:
         """The arguments with the defaults of those left out, or TypeError as for a Python call."""
@@ -100,26 +108,6 @@ class MessageSpec:
             raise TypeError(f"{self.name.lower()}_encode takes {self.arity - len(self.defaults)} to {self.arity} "
                             f"arguments ({len(args)} given)")
         return args + self.defaults[len(self.defaults) - missing:]
-
-    def _spliced(self, args: tuple[Any, ...]) -> tuple[Any, ...]:
-        """The arguments with each array replaced by its first `length` elements."""
-        flat = list(args)
-        for position, length in reversed(self.arrays):  # from the last: the positions before it stay
-            elements = flat[position][:length]
-            if len(elements) < length:
-                raise IndexError(f"{self.name}: an array of {len(elements)} values where {length} are sent")
-            flat[position:position + 1] = elements
-        return tuple(flat)
-
-
-def _wire_picks(arity: int, arrays: tuple[Term, ...], wire: tuple[Term, ...]) -> tuple[int, ...] | None:
-    """Where each wire-ordered value is among the spliced arguments (None: they are in wire order already)."""
-    lengths = dict(arrays)
-    first: list[int] = []  # where each argument's first value lands among the spliced arguments
-    for position in range(arity):
-        first.append(first[-1] + max(lengths.get(position - 1, 1), 1) if position else 0)
-    picks = tuple(first[position] + i for position, length in wire for i in range(max(length, 1)))
-    return None if picks == tuple(range(len(picks))) else picks
 
 
 class Packed:
