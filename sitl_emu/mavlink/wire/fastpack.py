@@ -71,7 +71,7 @@ class MessageSpec:
     order, the last `len(defaults)` of them optional. It puts them in wire order (`wire`: per argument on the wire,
     its position and array length) as pymavlink's generated pack() does: an array element by element (a short one
     fails with IndexError), a char array (bytes) whole. Most messages declare their scalar fields in wire order
-    already: their arguments are their values."""
+    already: their arguments are their values; a message without arrays picks them (`picks`)."""
 
     def __init__(self, msg_id: int, name: str, crc_extra: bytes, pack: Callable[..., bytes], arity: int,
                  defaults: tuple[Any, ...], wire: tuple[Term, ...]) -> None:
@@ -82,13 +82,18 @@ class MessageSpec:
         self.arity = arity  # how many arguments encode takes
         self.defaults = defaults  # the values of the last arguments when a call leaves them out
         self.wire = wire
-        self.in_wire_order = wire == tuple((position, 0) for position in range(arity))
+        # without arrays: the arguments' positions in wire order (most messages: in order already)
+        self.picks = None if any(length for _, length in wire) else tuple(position for position, _ in wire)
+        self.in_wire_order = self.picks == tuple(range(arity))
 
     def encode(self, *args: Any) -> Packed:
         if len(args) != self.arity:
             args = self._completed(args)
         if self.in_wire_order:
             return Packed(self, args)
+        picks = self.picks
+        if picks is not None:
+            return Packed(self, tuple(args[i] for i in picks))
         values: list[Any] = []
         for position, length in self.wire:
             value = args[position]
