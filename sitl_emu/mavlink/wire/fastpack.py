@@ -42,7 +42,7 @@ except ImportError:  # pragma: no cover - depends on the installed pymavlink
     _mcrf4xx = None
 
 MAGIC_V2: Final = b"\xfd"
-_HEADER: Final = struct.Struct("<BBBBBBHB")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit): after magic
+_HEADER: Final = struct.Struct("<BBBBBB3s")  # len, incompat, compat, seq, sysid, compid, msgid (24 bit): after magic
 _CRC: Final = struct.Struct("<H")
 # The packers as Final names: compiled, frame_message then calls them directly (no module dict or method look-up)
 _pack_header: Final = _HEADER.pack
@@ -76,6 +76,7 @@ class MessageSpec:
     def __init__(self, msg_id: int, name: str, crc_extra: bytes, pack: Callable[..., bytes], arity: int,
                  defaults: tuple[Any, ...], wire: tuple[Term, ...]) -> None:
         self.msg_id = msg_id
+        self.msg_id_bytes = msg_id.to_bytes(3, "little")  # as the header carries it
         self.name = name
         self.crc_extra = crc_extra  # one byte, appended to the checksummed data
         self.pack = pack  # the class's struct: wire-ordered values -> whole payload
@@ -148,8 +149,7 @@ def frame_message(msg: Packed, seq: int, sysid: int, compid: int, incompat_flags
         pack = spec.pack  # a local: compiled, a starred call of an attribute looks it up by name
         payload = pack(*msg.values)
         body = msg.body = _rstrip(payload, b"\0") or payload[:1]  # trailing zeros cut, one byte kept
-    msg_id = spec.msg_id
-    head = _pack_header(len(body), incompat_flags, 0, seq, sysid, compid, msg_id & 0xFFFF, msg_id >> 16) + body
+    head = _pack_header(len(body), incompat_flags, 0, seq, sysid, compid, spec.msg_id_bytes) + body
     return MAGIC_V2 + head + _pack_crc(x25_crc(head + spec.crc_extra, 0xFFFF))
 
 

@@ -238,7 +238,7 @@ class _PymavlinkEncoder:
     """pymavlink's encoder behind fastpack's type (a compiled builder returns only a Packed): the message a builder
     gets is a Packed whose one value is pymavlink's own message object, which the test then packs with pymavlink."""
 
-    SPEC = fastpack.MessageSpec(-1, "PYMAVLINK", b"\0", lambda *values: b"", 1, (), ((0, 0),))
+    SPEC = fastpack.MessageSpec(0xFFFFFF, "PYMAVLINK", b"\0", lambda *values: b"", 1, (), ((0, 0),))  # no such id
 
     def __init__(self, mav: Any) -> None:
         self._mav = mav
