@@ -93,6 +93,7 @@ DEFAULT_MODULES = (
     "sitl_emu/mavlink/telemetry/actuators.py",  # 1.0, 1.8
     "sitl_emu/mavlink/link.py",  # 1.0, 1.1
     "sitl_emu/mavlink/telemetry/sensors.py",  # 0.7, 0.5
+    "sitl_emu/mavlink/telemetry/fields.py",  # the builders' float-to-integer conversions (split from messages.py)
     "sitl_emu/mavlink/context.py",  # 0.3, 0.2
     "sitl_emu/runtime/timeline.py",  # 0.0, 1.7
     "sitl_emu/mavlink/setpoints.py",  # 0.0, 0.6

@@ -190,9 +190,12 @@ class Handler(Protocol):
         it until then. None or True: tick it again next time."""
 
 
-def vehicle_news(vehicle: LinkVehicle) -> tuple[int, int, bool, int]:
+VehicleNews = tuple[int, int, bool, int]
+
+
+def vehicle_news(vehicle: LinkVehicle) -> VehicleNews:
     """What protocol handlers act on between messages: the parameters' version (protocols/params.py sends changed
     values, as PX4's parameter_update subscription) and the navigator's mission progress (protocols/mission.py reports
-    it, as PX4's mission_result subscription)."""
+    it, as PX4's mission_result subscription). The version read as its compiled count (params/changes.py)."""
     store = vehicle.mission_store()
-    return vehicle.params.version, store.current_seq, store.finished, store.seq_reached
+    return vehicle.params.changes.value, store.current_seq, store.finished, store.seq_reached

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Final, Protocol
 from pymavlink.dialects.v20 import development as dialect
 
 from px4common.signing_key import KEY_LEN
-from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, vehicle_news
+from sitl_emu.mavlink.context import EndpointStats, LinkVehicle, NodeView, VehicleNews, vehicle_news
 from sitl_emu.mavlink.link import UdpLink
 from sitl_emu.mavlink.link_commands import CommandHandler
 from sitl_emu.mavlink.receiver import Receiver
@@ -94,6 +94,8 @@ class Endpoint:
         self.link_id = link_id  # PX4's mavlink instance number: the link id of what it signs
         self.link = link
         self.node = node
+        self.vehicle: LinkVehicle = node.vehicle  # attributes, not properties: the handlers read these every tick
+        self.now_us = 0  # simulated time of the pass under way (poll, emit)
         self.sysid = node.sysid
         self.compid = COMPID
         self.encoder = ENCODER  # builds what this link sends (sitl_emu/mavlink/wire/fastpack.py)
@@ -107,7 +109,6 @@ class Endpoint:
         self.last_gcs_heartbeat_us: int | None = None
         # mavlink_log messages wait (uORB queue of 8) until a GCS is connected; older than 5 s they are dropped
         self._pending_texts: deque[VehicleEvent] = deque(maxlen=MAVLINK_LOG_QUEUE)
-        self._now_us = 0
         self._handlers: list[Handler] = [cls() for cls in handler_classes]
         self._tickers = [h for h in self._handlers if getattr(h, "TICKS", True)]  # context.py: TICKS False = idle
         # the handlers ticked at the next emit: one whose tick() says it is idle (False) sleeps until a message
@@ -115,21 +116,13 @@ class Endpoint:
         self._awake: list[Handler] = list(self._tickers)
         # some handlers also act on news of the vehicle (context.vehicle_news): a change wakes them all
         self._watches_vehicle = any(getattr(h, "WATCHES_VEHICLE", False) for h in self._tickers)
-        self._news: tuple[int, int, bool, int] | None = None
+        self._news: VehicleNews | None = None
         self._routes: dict[str, list[Handler]] = {}
         for h in self._handlers:
             for msg_type in h.MESSAGES:
                 self._routes.setdefault(msg_type, []).append(h)
 
-    # --- LinkContext ---------------------------------------------------------------------------------------------
-    @property
-    def vehicle(self) -> LinkVehicle:
-        return self.node.vehicle
-
-    @property
-    def now_us(self) -> int:
-        return self._now_us
-
+    # --- LinkContext (also its attributes vehicle and now_us) -------------------------------------------------------
     def send(self, msg: OutMessage) -> None:
         """One message, one datagram (PX4's send_start/send_finish); the frame is the one pymavlink would pack.
         Nothing at all while the link has no peer (link.py: a Sim's link nobody has talked to yet)."""
@@ -140,7 +133,7 @@ class Endpoint:
                 data = frame_message(msg, self.seq, self.sysid, COMPID)
             else:  # with a key, PX4 signs everything it sends
                 data = self.signing.sign(frame_message(msg, self.seq, self.sysid, COMPID, IFLAG_SIGNED),
-                                         self.link_id, self.node.epoch_unix_us + self._now_us)
+                                         self.link_id, self.node.epoch_unix_us + self.now_us)
         except (struct.error, ValueError, TypeError, OverflowError) as err:  # a field out of its wire range
             self.stats.tx_pack_errors += 1
             if self.stats.tx_pack_errors == 1:
@@ -158,7 +151,7 @@ class Endpoint:
     # --- receive -------------------------------------------------------------------------------------------------
     def poll(self, now_us: int, max_datagrams: int = 256) -> int:
         """Read and handle what has arrived; returns the number of datagrams read."""
-        self._now_us = now_us
+        self.now_us = now_us
         datagrams = self.link.receive(max_datagrams)
         for data in datagrams:
             self.stats.rx_bytes += len(data)
@@ -198,7 +191,7 @@ class Endpoint:
         key = bytes(getattr(msg, "secret_key", b"")).ljust(KEY_LEN, b"\0")[:KEY_LEN]
         timestamp = int(getattr(msg, "initial_timestamp", 0))
         result = self.signing.setup(key, timestamp, is_signed(msg.get_msgbuf()), self.node.snapshot().armed,
-                                    self.node.epoch_unix_us + self._now_us)
+                                    self.node.epoch_unix_us + self.now_us)
         log.info("%s link: SETUP_SIGNING: %s", self.link_name, result.value)
         if result is SetupResult.REJECTED_ARMED:
             self.vehicle.report(Severity.CRITICAL, "mavlink", ARMED_TEXT, is_event=False)
@@ -227,7 +220,7 @@ class Endpoint:
 
     def gcs_connected(self) -> bool:
         last = self.last_gcs_heartbeat_us
-        return last is not None and self._now_us - last <= self.GCS_TIMEOUT_US
+        return last is not None and self.now_us - last <= self.GCS_TIMEOUT_US
 
     def _parse(self, data: bytes) -> list[MAVLink_message]:
         """Frames in one datagram. A frame cut short at the datagram's end is dropped, so it cannot swallow the
@@ -251,7 +244,7 @@ class Endpoint:
         A link with no peer (link.py) builds no stream at all: its schedule waits, and the first pass after a peer
         talks sends the heartbeat and every stream at once, as a link just started would."""
         # Called every tick on every link: when nothing is due and nothing happened this costs a few comparisons.
-        self._now_us = now_us
+        self.now_us = now_us
         if now_us >= self.streams.next_due_us and self.link.remote is not None:
             self.streams.emit_due(self, self.node.snapshot)
         if events:
@@ -260,7 +253,7 @@ class Endpoint:
             self.streams.send_statustexts(self, list(self._pending_texts))
             self._pending_texts.clear()
         if self._watches_vehicle:  # news of the vehicle since the last emit wakes the handlers
-            news = vehicle_news(self.node.vehicle)
+            news = vehicle_news(self.vehicle)
             if news != self._news:
                 self._news = news
                 self.wake_handlers()
@@ -268,18 +261,18 @@ class Endpoint:
             self._tick_handlers()
 
     def _tick_handlers(self) -> None:
-        """Tick the awake handlers in their table order; keep awake those that may have more to do."""
-        awake: list[Handler] = []
+        """Tick the awake handlers in their table order; those that say they are idle sleep until woken."""
+        idle: list[Handler] = []
         for handler in self._awake:
             try:
                 if handler.tick(self) is False:
-                    continue  # idle until its next message
+                    idle.append(handler)  # until its next message
             except Exception as err:
                 self.stats.handler_errors += 1
                 log.error("%s link: error in %s.tick: %r", self.link_name, type(handler).__name__, err,
                           exc_info=log.isEnabledFor(logging.DEBUG))
-            awake.append(handler)
-        self._awake = awake
+        if idle:
+            self._awake = [handler for handler in self._awake if handler not in idle]
 
     def wake_handlers(self) -> None:
         """Tick every handler again from the next emit (a message arrived: any of them may have work now)."""

@@ -50,8 +50,10 @@ class UdpLink:
         self.peer_latched = False
         self.stats = LinkStats()
         self._sock = _open_socket(bind_host, port, name)
-        # bound once: the compiled send() then calls it directly, without looking the method up on the socket
-        self._sendto: Callable[[bytes, Address], int] = self._sock.sendto
+        # bound once: the compiled send() then calls it directly, without looking the method up on the socket; the
+        # address is passed as the object it is (typed Address, compiled code would unpack the tuple and build a new
+        # one for every datagram)
+        self._sendto: Callable[..., int] = self._sock.sendto
         self.local_address: Address = self._sock.getsockname()
 
     @property
@@ -90,10 +92,11 @@ class UdpLink:
 
     def send(self, data: bytes) -> None:
         """Send to the peer (or the initial remote); a failed send is counted, never raised (UDP is lossy)."""
-        if self.remote is None:
+        remote: object = self.remote  # the tuple itself (see _sendto)
+        if remote is None:
             return
         try:
-            self._sendto(data, self.remote)
+            self._sendto(data, remote)
         except OSError as err:
             self.stats.tx_errors += 1
             log.debug("%s: sendto %s failed: %s", self.name, self.remote, err)

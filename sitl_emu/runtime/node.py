@@ -84,9 +84,9 @@ class VehicleNode:
         self.signing = MavlinkSigning()
         # link ids (1, 0) are PX4 SITL's mavlink instances: the GCS link starts first (px4-rc.mavlink)
         # a message both links send in a tick is built once (telemetry/streams.py SharedBuilds)
-        shared = SharedBuilds()
-        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us, 1, shared)
-        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us, 0, shared)
+        self.shared = SharedBuilds()
+        self.api = Endpoint("api", api_link, self, StreamMode.ONBOARD, classes, stream_delay_us, 1, self.shared)
+        self.gcs = Endpoint("gcs", gcs_link, self, StreamMode.NORMAL, classes, stream_delay_us, 0, self.shared)
         self.endpoints: tuple[Endpoint, ...] = (self.api, self.gcs)
         self._event_seq = -1
         self._snapshot: VehicleSnapshot | None = None
@@ -135,6 +135,7 @@ class VehicleNode:
                 received = self.api.poll(now_us, self.io_budget)
             if readable & READ_GCS:
                 received += self.gcs.poll(now_us, self.io_budget)
+        self.shared.active = self.api.link.remote is not None and self.gcs.link.remote is not None
         events = self.vehicle.events_after(self._event_seq)
         if events:
             self._event_seq = events[-1].seq

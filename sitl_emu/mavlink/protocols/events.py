@@ -22,7 +22,7 @@ see the same vehicle events in the same order, so their sequences agree as PX4's
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, Final
 
 from sitl_emu.events.catalogue import Px4Event
 from sitl_emu.mavlink.wire.extra_messages import EXTRA, decode, payload_of_unknown, source_of_unknown
@@ -32,13 +32,13 @@ if TYPE_CHECKING:
 
     from sitl_emu.mavlink.context import LinkContext
 
-INITIAL_EVENT_SEQUENCE = 65535 - 10
-BUFFER_CAPACITY = 20
-CURRENT_SEQUENCE_INTERVAL_US = 3_000_000
-MAV_EVENT_CURRENT_SEQUENCE_FLAGS_RESET = 1
-MAV_EVENT_ERROR_REASON_UNAVAILABLE = 0
-MAV_COMP_ID_ALL = 0
-REQUEST_EVENT_ID = 412
+INITIAL_EVENT_SEQUENCE: Final = 65535 - 10
+BUFFER_CAPACITY: Final = 20
+CURRENT_SEQUENCE_INTERVAL_US: Final = 3_000_000  # Final: compiled, read as a constant at every tick
+MAV_EVENT_CURRENT_SEQUENCE_FLAGS_RESET: Final = 1
+MAV_EVENT_ERROR_REASON_UNAVAILABLE: Final = 0
+MAV_COMP_ID_ALL: Final = 0
+REQUEST_EVENT_ID: Final = 412
 
 
 class EventBuffer:

@@ -14,9 +14,9 @@ online, no failures, no errors.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Final
 
+from sitl_emu.control.qmath import isfinite
 from sitl_emu.mavlink.wire.extra_messages import EXTRA
 from sitl_emu.px4 import NavState
 from sitl_emu.types import Vec4, VehicleSnapshot
@@ -30,10 +30,12 @@ ESC_COUNT: Final = 4
 ESC_ONLINE: Final = (1 << ESC_COUNT) - 1
 ESC_CONNECTION_TYPE_PPM: Final = 0
 ESC_PUBLISH_PERIOD_US: Final = 100_000  # esc_status at 10 Hz: its counter counts publications
-_DISARMED_OUTPUTS: Final = (PWM_DISARMED,) * SERVO_CHANNELS
-_FAILSAFE_OUTPUTS: Final = (PWM_FAILSAFE,) * SERVO_CHANNELS
-_UNUSED: Final = (PWM_DISARMED,) * (SERVO_CHANNELS - ESC_COUNT)
-_ZERO4: Final = (0, 0, 0, 0)
+# tuples of any length: compiled, a fixed-length tuple of numbers would be unboxed and boxed again at every read
+_DISARMED_OUTPUTS: Final[tuple[int, ...]] = (PWM_DISARMED,) * SERVO_CHANNELS
+_FAILSAFE_OUTPUTS: Final[tuple[int, ...]] = (PWM_FAILSAFE,) * SERVO_CHANNELS
+_UNUSED: Final[tuple[int, ...]] = (PWM_DISARMED,) * (SERVO_CHANNELS - ESC_COUNT)
+_ZERO4: Final[tuple[int, ...]] = (0, 0, 0, 0)
+_NO_CURRENT_A: tuple[float, ...] = (0.0,) * ESC_COUNT  # disarmed motors draw nothing
 
 
 def servo_outputs(snap: VehicleSnapshot) -> tuple[int, ...]:
@@ -42,11 +44,13 @@ def servo_outputs(snap: VehicleSnapshot) -> tuple[int, ...]:
         return _DISARMED_OUTPUTS
     if snap.nav_state is NavState.TERMINATION:
         return _FAILSAFE_OUTPUTS
-    return (*(_pwm(u) for u in snap.motor_commands), *_UNUSED)
+    u0, u1, u2, u3 = snap.motor_commands
+    # a concatenation: compiled, a starred element builds the tuple through the iterator protocol
+    return (_pwm(u0), _pwm(u1), _pwm(u2), _pwm(u3)) + _UNUSED  # noqa: RUF005
 
 
 def _pwm(u: float) -> int:
-    if not math.isfinite(u):  # output_limit_calc: an invalid value gets the disarmed output
+    if not isfinite(u):  # output_limit_calc: an invalid value gets the disarmed output
         return PWM_DISARMED
     return int(PWM_MIN + (PWM_MAX - PWM_MIN) * min(max(u, 0.0), 1.0))
 
@@ -55,20 +59,38 @@ def servo_output_raw(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     return ctx.encoder.servo_output_raw_encode(snap.time_us & 0xFFFFFFFF, 0, *servo_outputs(snap))
 
 
-def _levels(motors: Vec4) -> tuple[float, float, float, float]:
-    return tuple(abs(u) if math.isfinite(u) else 0.0 for u in motors)  # type: ignore[return-value]
+def _levels(motors: Vec4) -> Vec4:
+    """Each motor's level |u| (0 for a non-finite state)."""
+    u0, u1, u2, u3 = motors
+    return _level(u0), _level(u1), _level(u2), _level(u3)
+
+
+def _level(u: float) -> float:
+    return abs(u) if isfinite(u) else 0.0
+
+
+def _per_motor(levels: Vec4, offset: float, slope: float) -> Vec4:
+    """offset + slope * u for each motor's level u (the simulated-ESC model's telemetry)."""
+    u0, u1, u2, u3 = levels
+    return offset + slope * u0, offset + slope * u1, offset + slope * u2, offset + slope * u3
+
+
+def _truncated(values: Vec4) -> tuple[int, int, int, int]:
+    """Each value as C converts a float to an integer field (towards zero)."""
+    a, b, c, d = values
+    return int(a), int(b), int(c), int(d)
 
 
 def esc_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     u = _levels(snap.motors)
-    rpm = [int(6000.0 * x) for x in u]
-    voltage = [11.1 + 3.0 * x for x in u]
-    current = [1.0 + 15.0 * x for x in u] if snap.armed else [0.0] * ESC_COUNT
+    rpm = _truncated(_per_motor(u, 0.0, 6000.0))
+    voltage = _per_motor(u, 11.1, 3.0)
+    current = _per_motor(u, 1.0, 15.0) if snap.armed else _NO_CURRENT_A
     return EXTRA.esc_status_encode(0, snap.time_us, rpm, voltage, current)
 
 
 def esc_info(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
-    temperature_cdeg = [int((20.0 + 40.0 * x) * 100.0) for x in _levels(snap.motors)]
+    temperature_cdeg = _truncated(_per_motor(_per_motor(_levels(snap.motors), 20.0, 40.0), 0.0, 100.0))
     counter = (snap.time_us // ESC_PUBLISH_PERIOD_US) & 0xFFFF
     return EXTRA.esc_info_encode(0, snap.time_us, counter, ESC_COUNT, ESC_CONNECTION_TYPE_PPM, ESC_ONLINE, _ZERO4,
                                  _ZERO4, temperature_cdeg)

@@ -11,6 +11,20 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Final
 
 from sitl_emu import px4
+from sitl_emu.control.qmath import atan2, hypot, isfinite
+from sitl_emu.mavlink.telemetry.fields import (
+    INT16_MAX,
+    INT32_MAX,
+    INT32_MIN,
+    clamp_int,
+    cm_s,
+    degrees,
+    e7,
+    iround,
+    itrunc,
+    mm,
+    time_boot_ms,
+)
 from sitl_emu.mavlink.telemetry.modes import STANDARD_MODE
 from sitl_emu.px4 import MavFrame, MavState, NavState
 from sitl_emu.types import VehicleSnapshot
@@ -20,7 +34,10 @@ if TYPE_CHECKING:
 
 NAN = math.nan
 UINT16_MAX: Final = 0xFFFF
-INT16_MAX: Final = 0x7FFF
+
+# ODOMETRY's pose and velocity covariances: unknown (a NaN first element), as ODOMETRY.hpp sends them. Typed as a
+# tuple of any length: compiled, a fixed-length float tuple would be unboxed and boxed again at every read.
+ODOMETRY_COVARIANCE: tuple[float, ...] = (NAN,) + (0.0,) * 20
 
 MAV_TYPE_QUADROTOR: Final = 2
 MAV_AUTOPILOT_PX4: Final = 12
@@ -84,19 +101,20 @@ def extended_sys_state(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessag
 def attitude(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     r, p, y = snap.euler_rad
     wx, wy, wz = snap.rates_frd_rad_s
-    return ctx.encoder.attitude_encode(_ms(snap), r, p, y, wx, wy, wz)
+    return ctx.encoder.attitude_encode(time_boot_ms(snap.time_us), r, p, y, wx, wy, wz)
 
 
 def attitude_quaternion(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     w, x, y, z = snap.q_wxyz
     wx, wy, wz = snap.rates_frd_rad_s
-    return ctx.encoder.attitude_quaternion_encode(_ms(snap), w, x, y, z, wx, wy, wz, (0.0, 0.0, 0.0, 0.0))
+    return ctx.encoder.attitude_quaternion_encode(time_boot_ms(snap.time_us), w, x, y, z, wx, wy, wz,
+                                                  (0.0, 0.0, 0.0, 0.0))
 
 
 def local_position_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     x, y, z = snap.pos_ned_m
     vx, vy, vz = snap.vel_ned_m_s
-    return ctx.encoder.local_position_ned_encode(_ms(snap), x, y, z, vx, vy, vz)
+    return ctx.encoder.local_position_ned_encode(time_boot_ms(snap.time_us), x, y, z, vx, vy, vz)
 
 
 def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
@@ -105,10 +123,10 @@ def global_position_int(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessa
         return None
     vx, vy, vz = snap.vel_ned_m_s
     rel_m = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else snap.alt_amsl_m
-    hdg_cdeg = _iround(math.degrees(_wrap_2pi(snap.euler_rad[2])) * 100.0) % 36000
+    hdg_cdeg = iround(degrees(_wrap_2pi(snap.euler_rad[2])) * 100.0) % 36000
     return ctx.encoder.global_position_int_encode(
-        _ms(snap), _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m), _mm(rel_m),
-        _cm_s(vx), _cm_s(vy), _cm_s(vz), hdg_cdeg)
+        time_boot_ms(snap.time_us), e7(snap.lat_deg), e7(snap.lon_deg), mm(snap.alt_amsl_m), mm(rel_m),
+        cm_s(vx), cm_s(vy), cm_s(vz), hdg_cdeg)
 
 
 def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
@@ -116,17 +134,20 @@ def position_target_local_ned(ctx: EndpointContext, snap: VehicleSnapshot) -> Ou
     sp = snap.local_setpoint
     if sp is None:
         return None
-    values = (*sp.position_ned_m, *sp.velocity_ned_m_s, *sp.acceleration_ned_m_s2)
-    mask = 0
-    for bit, v in enumerate(values):
-        if not math.isfinite(v):
-            mask |= 1 << bit
-    if not math.isfinite(sp.yaw_rad):
-        mask |= 1024
-    if not math.isfinite(sp.yawspeed_rad_s):
-        mask |= 2048
-    return ctx.encoder.position_target_local_ned_encode(_ms(snap), MavFrame.LOCAL_NED, mask, *values, sp.yaw_rad,
-                                                    sp.yawspeed_rad_s)
+    x, y, z = sp.position_ned_m
+    vx, vy, vz = sp.velocity_ned_m_s
+    ax, ay, az = sp.acceleration_ned_m_s2
+    mask = (_unset(x, 1) | _unset(y, 2) | _unset(z, 4) | _unset(vx, 8) | _unset(vy, 16) | _unset(vz, 32)
+            | _unset(ax, 64) | _unset(ay, 128) | _unset(az, 256) | _unset(sp.yaw_rad, 1024)
+            | _unset(sp.yawspeed_rad_s, 2048))
+    return ctx.encoder.position_target_local_ned_encode(time_boot_ms(snap.time_us), MavFrame.LOCAL_NED, mask,
+                                                        x, y, z, vx, vy, vz, ax, ay, az, sp.yaw_rad,
+                                                        sp.yawspeed_rad_s)
+
+
+def _unset(value: float, bit: int) -> int:
+    """A type_mask bit: set for a value that is not controlled (NaN; inf too)."""
+    return 0 if isfinite(value) else bit
 
 
 def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
@@ -134,7 +155,7 @@ def attitude_target(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage |
     if q is None:
         return None
     wx, wy, wz = snap.rates_setpoint_rad_s
-    return ctx.encoder.attitude_target_encode(_ms(snap), 0, q, wx, wy, wz, snap.thrust_setpoint)
+    return ctx.encoder.attitude_target_encode(time_boot_ms(snap.time_us), 0, q, wx, wy, wz, snap.thrust_setpoint)
 
 
 def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
@@ -142,21 +163,21 @@ def home_position(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | N
     home = snap.home
     if home is None:
         return None
-    half = home.yaw_rad / 2.0 if math.isfinite(home.yaw_rad) else NAN
+    half = home.yaw_rad / 2.0 if isfinite(home.yaw_rad) else NAN
     q = (math.cos(half), 0.0, 0.0, math.sin(half))
     x, y, z = home.pos_ned_m
-    return ctx.encoder.home_position_encode(_e7(home.lat_deg), _e7(home.lon_deg), _mm(home.alt_amsl_m), x, y, z, q,
+    return ctx.encoder.home_position_encode(e7(home.lat_deg), e7(home.lon_deg), mm(home.alt_amsl_m), x, y, z, q,
                                         0.0, 0.0, 0.0, snap.time_us)
 
 
 def gps_raw_int(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """SIH's GPS (sensor_gps_sim): 3D fix, 10 satellites, from boot; no fix and no satellites while failed."""
     vn, ve, _ = snap.vel_ned_m_s
-    vel_cm_s = min(_iround(math.hypot(vn, ve) * 100.0), UINT16_MAX - 1)
-    cog = _iround(math.degrees(_wrap_2pi(math.atan2(ve, vn))) * 100.0) % 36000 if vel_cm_s > 0 else 0
+    vel_cm_s = min(iround(hypot(vn, ve) * 100.0), UINT16_MAX - 1)
+    cog = iround(degrees(_wrap_2pi(atan2(ve, vn))) * 100.0) % 36000 if vel_cm_s > 0 else 0
     fix = snap.gps_fix_type
-    return ctx.encoder.gps_raw_int_encode(snap.time_us, fix, _e7(snap.lat_deg), _e7(snap.lon_deg), _mm(snap.alt_amsl_m),
-                                      50, 80, vel_cm_s, cog, 10 if fix else 0, _mm(snap.alt_amsl_m), 500, 800, 200, 0,
+    return ctx.encoder.gps_raw_int_encode(snap.time_us, fix, e7(snap.lat_deg), e7(snap.lon_deg), mm(snap.alt_amsl_m),
+                                      50, 80, vel_cm_s, cog, 10 if fix else 0, mm(snap.alt_amsl_m), 500, 800, 200, 0,
                                       0)
 
 
@@ -164,7 +185,7 @@ def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     cells = 4  # BAT1_N_CELLS in SITL
     cell_mv = int(min(snap.battery_voltage_v / cells * 1000.0, UINT16_MAX - 1))
     voltages = [cell_mv] * cells + [UINT16_MAX] * (10 - cells)
-    remaining = _iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
+    remaining = iround(min(max(snap.battery_remaining, 0.0), 1.0) * 100.0)
     charge_state = min(max(snap.battery_warning, 0), 3) + 1  # BATTERY_STATUS.hpp: WARNING_* -> CHARGE_STATE_*
     return ctx.encoder.battery_status_encode(0, 1, 1, INT16_MAX, voltages, -1, -1, -1, remaining, 0, charge_state,
                                              [0, 0, 0, 0], 0, 0)
@@ -173,9 +194,9 @@ def battery_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 def vfr_hud(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/VFR_HUD.hpp (reference 11.5)."""
     vn, ve, vd = snap.vel_ned_m_s
-    heading_deg = int(math.degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
-    throttle = _iround(min(max(snap.thrust_setpoint, 0.0), 1.0) * 100.0) if snap.armed else 0
-    return ctx.encoder.vfr_hud_encode(NAN, math.hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
+    heading_deg = int(degrees(_wrap_2pi(snap.euler_rad[2]))) % 360
+    throttle = iround(min(max(snap.thrust_setpoint, 0.0), 1.0) * 100.0) if snap.armed else 0
+    return ctx.encoder.vfr_hud_encode(NAN, hypot(vn, ve), heading_deg, throttle, snap.alt_amsl_m, -vd)
 
 
 def altitude(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
@@ -187,10 +208,11 @@ def altitude(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 
 def odometry(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/ODOMETRY.hpp: pose in LOCAL_NED, velocity in the body FRD frame."""
-    v_body = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
-    cov = [NAN] + [0.0] * 20
-    return ctx.encoder.odometry_encode(snap.time_us, MavFrame.LOCAL_NED, MavFrame.BODY_FRD, *snap.pos_ned_m,
-                                   snap.q_wxyz, *v_body, *snap.rates_frd_rad_s, cov, cov, 0, 1, 100)
+    x, y, z = snap.pos_ned_m
+    vx, vy, vz = rotate_ned_to_body(snap.q_wxyz, snap.vel_ned_m_s)
+    wx, wy, wz = snap.rates_frd_rad_s
+    return ctx.encoder.odometry_encode(snap.time_us, MavFrame.LOCAL_NED, MavFrame.BODY_FRD, x, y, z, snap.q_wxyz,
+                                       vx, vy, vz, wx, wy, wz, ODOMETRY_COVARIANCE, ODOMETRY_COVARIANCE, 0, 1, 100)
 
 
 def timesync(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
@@ -205,7 +227,7 @@ def ping(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
 
 
 def system_time(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
-    return ctx.encoder.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, _ms(snap))
+    return ctx.encoder.system_time_encode(ctx.node.epoch_unix_us + snap.time_us, time_boot_ms(snap.time_us))
 
 
 def current_mode(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
@@ -224,8 +246,7 @@ def orbit_execution_status(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMe
 
 
 def _trunc_e7(deg: float) -> int:
-    x = deg * 1e7
-    return max(min(int(x), 2147483647), -2147483648) if math.isfinite(x) else 0
+    return clamp_int(itrunc(deg * 1e7), INT32_MIN, INT32_MAX)
 
 
 def rotate_ned_to_body(q_wxyz: tuple[float, float, float, float], v: tuple[float, float, float]
@@ -246,40 +267,6 @@ def _rotate(q: tuple[float, float, float, float], v: tuple[float, float, float])
     # t = 2 q_vec x v; v' = v + w t + q_vec x t
     tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
     return (vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx))
-
-
-def _iround(x: float) -> int:
-    """round() that never raises: non-finite values (a diverged estimate) become 0."""
-    return round(x) if math.isfinite(x) else 0
-
-
-def _ms(snap: VehicleSnapshot) -> int:
-    return (snap.time_us // 1000) & 0xFFFFFFFF
-
-
-def _e7(deg: float) -> int:
-    return _int32(deg * 1e7)
-
-
-def _mm(m: float) -> int:
-    return _int32(m * 1000.0)
-
-
-def _int32(x: float) -> int:
-    """_iround(x) clamped to int32 (written out: called for every position field of the 50 Hz streams)."""
-    if not math.isfinite(x):
-        return 0
-    r = round(x)
-    return 2147483647 if r > 2147483647 else -2147483648 if r < -2147483648 else r
-
-
-def _cm_s(m_s: float) -> int:
-    """_iround(m_s * 100) clamped to int16, written out as _int32."""
-    x = m_s * 100.0
-    if not math.isfinite(x):
-        return 0
-    r = round(x)
-    return 32767 if r > 32767 else -32768 if r < -32768 else r
 
 
 def _wrap_2pi(a: float) -> float:

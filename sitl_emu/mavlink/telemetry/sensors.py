@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Final
 
+from sitl_emu.control.qmath import atan2, hypot, isfinite
+from sitl_emu.mavlink.telemetry.fields import clamp_int, degrees, e7, iround, itrunc, time_boot_ms
 from sitl_emu.mavlink.telemetry.messages import rotate_ned_to_body
 from sitl_emu.types import Vec3, VehicleSnapshot
 
@@ -27,7 +29,7 @@ HIGHRES_FIELDS_ALL: Final = 0x1FFF  # acc, gyro, mag, abs/diff pressure, pressur
 
 def isa_pressure_hpa(alt_amsl_m: float) -> float:
     """International Standard Atmosphere pressure at an altitude (troposphere)."""
-    return 1013.25 * (1.0 - 2.25577e-5 * alt_amsl_m) ** 5.25588 if alt_amsl_m < 11000 else 226.32
+    return 1013.25 * math.pow(1.0 - 2.25577e-5 * alt_amsl_m, 5.25588) if alt_amsl_m < 11000 else 226.32
 
 
 def specific_force_frd(snap: VehicleSnapshot) -> tuple[float, float, float]:
@@ -37,18 +39,19 @@ def specific_force_frd(snap: VehicleSnapshot) -> tuple[float, float, float]:
 
 
 def highres_imu(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
-    acc = specific_force_frd(snap)
-    mag = rotate_ned_to_body(snap.q_wxyz, MAG_NED_GAUSS)
+    ax, ay, az = specific_force_frd(snap)
+    wx, wy, wz = snap.rates_frd_rad_s
+    mx, my, mz = rotate_ned_to_body(snap.q_wxyz, MAG_NED_GAUSS)
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
-    return ctx.encoder.highres_imu_encode(snap.time_us, *acc, *snap.rates_frd_rad_s, *mag, pressure, 0.0,
-                                      snap.alt_amsl_m, TEMPERATURE_C, HIGHRES_FIELDS_ALL, 0)
+    return ctx.encoder.highres_imu_encode(snap.time_us, ax, ay, az, wx, wy, wz, mx, my, mz, pressure, 0.0,
+                                          snap.alt_amsl_m, TEMPERATURE_C, HIGHRES_FIELDS_ALL, 0)
 
 
 def scaled_pressure(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage | None:
     pressure = isa_pressure_hpa(snap.alt_amsl_m)
-    if not math.isfinite(pressure):
+    if not isfinite(pressure):
         return None
-    return ctx.encoder.scaled_pressure_encode((snap.time_us // 1000) & 0xFFFFFFFF, pressure, 0.0,
+    return ctx.encoder.scaled_pressure_encode(time_boot_ms(snap.time_us), pressure, 0.0,
                                           round(TEMPERATURE_C * 100), 0)
 
 
@@ -65,14 +68,14 @@ def range_m(snap: VehicleSnapshot) -> float:
     cos_tilt = 1.0 - 2.0 * (x * x + y * y)  # R(2, 2): the body z axis's vertical component
     height = -snap.pos_ned_m[2]
     distance = height / cos_tilt if cos_tilt > 1e-6 else math.inf
-    if not math.isfinite(distance) or distance > DIST_MAX_M:
+    if not isfinite(distance) or distance > DIST_MAX_M:
         return DIST_OUT_OF_RANGE_M
     return max(distance, 0.0)
 
 
 def distance_sensor(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMessage:
     """streams/DISTANCE_SENSOR.hpp: metres to centimetres (truncated), instance 0, no variance."""
-    return ctx.encoder.distance_sensor_encode((snap.time_us // 1000) & 0xFFFFFFFF, int(DIST_MIN_M * 100),
+    return ctx.encoder.distance_sensor_encode(time_boot_ms(snap.time_us), int(DIST_MIN_M * 100),
                                               int(DIST_MAX_M * 100), int(range_m(snap) * 100.0),
                                               MAV_DISTANCE_SENSOR_LASER, 0, MAV_SENSOR_ROTATION_PITCH_270, 0)
 
@@ -137,15 +140,15 @@ def open_drone_id_location(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMe
     status = ODID_STATUS_GROUND if snap.landed_state == 1 else ODID_STATUS_AIRBORNE
     if snap.armed and snap.failsafe:
         status = ODID_STATUS_EMERGENCY
-    course = math.atan2(ve, vn) if math.isfinite(vn) and math.isfinite(ve) else 0.0
-    direction = min(max(100 * round(math.degrees(course % (2.0 * math.pi))), 0), 35999)
-    speed_h = min(max(_int_or_zero(math.hypot(vn, ve) * 100.0), 0), 25425)
-    speed_v = min(max(_round_or_zero(-vd * 100.0), -6200), 6200)
+    course = atan2(ve, vn) if isfinite(vn) and isfinite(ve) else 0.0
+    direction = clamp_int(100 * iround(degrees(course % (2.0 * math.pi))), 0, 35999)
+    speed_h = clamp_int(itrunc(hypot(vn, ve) * 100.0), 0, 25425)
+    speed_v = clamp_int(iround(-vd * 100.0), -6200, 6200)
     height = snap.alt_amsl_m - snap.home.alt_amsl_m if snap.home is not None else -1000.0
     utc_ms = _utc_us(ctx, snap) // 1000
     return ctx.encoder.open_drone_id_location_encode(
-        0, 0, _ODID_ID_OR_MAC, status, direction, speed_h, speed_v, _e7(snap.lat_deg), _e7(snap.lon_deg),
-        snap.alt_amsl_m, float(_round_or_zero(snap.alt_amsl_m)), 0, height, ODID_HOR_ACC_1_METER,
+        0, 0, _ODID_ID_OR_MAC, status, direction, speed_h, speed_v, e7(snap.lat_deg), e7(snap.lon_deg),
+        snap.alt_amsl_m, float(iround(snap.alt_amsl_m)), 0, height, ODID_HOR_ACC_1_METER,
         ODID_VER_ACC_1_METER, 0, ODID_SPEED_ACC_0_3, (utc_ms % 3_600_000) / 1000.0, ODID_TIME_ACC_1_0_SECOND)
 
 
@@ -157,18 +160,5 @@ def open_drone_id_system(ctx: EndpointContext, snap: VehicleSnapshot) -> OutMess
     utc_s = _utc_us(ctx, snap) // 1_000_000
     timestamp = utc_s - ODID_EPOCH_2019_S if utc_s >= ODID_EPOCH_2019_S else 0
     return ctx.encoder.open_drone_id_system_encode(
-        0, 0, _ODID_ID_OR_MAC, 0, 0, _int_or_zero(home.lat_deg * 1e7), _int_or_zero(home.lon_deg * 1e7), 1, 0,
+        0, 0, _ODID_ID_OR_MAC, 0, 0, itrunc(home.lat_deg * 1e7), itrunc(home.lon_deg * 1e7), 1, 0,
         -1000.0, -1000.0, 0, 0, home.alt_amsl_m, timestamp & 0xFFFFFFFF)
-
-
-def _e7(deg: float) -> int:
-    return min(max(_round_or_zero(deg * 1e7), -(2**31)), 2**31 - 1)
-
-
-def _round_or_zero(x: float) -> int:
-    return round(x) if math.isfinite(x) else 0
-
-
-def _int_or_zero(x: float) -> int:
-    """C's float -> int conversion (towards zero); 0 for non-finite values."""
-    return int(x) if math.isfinite(x) else 0

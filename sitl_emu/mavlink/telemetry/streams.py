@@ -141,6 +141,9 @@ class SharedBuilds:
     def __init__(self) -> None:
         self._snap: VehicleSnapshot | None = None
         self._built: dict[int, OutMessage | None] = {}
+        # whether the links share (the node's step_io says): only while they both send, as a Sim's link builds
+        # nothing until a peer talks, and keeping what one link built for none would cost for nothing
+        self.active = True
 
     def build(self, msg_id: int, builder: tm.Builder, ctx: EndpointContext, snap: VehicleSnapshot
               ) -> OutMessage | None:
@@ -242,7 +245,7 @@ class Streams:
         for msg_id in due:
             builder = tm.heartbeat if msg_id == HEARTBEAT_ID else streams[msg_id]
             try:
-                if shared is None or msg_id in per_link:
+                if shared is None or not shared.active or msg_id in per_link:
                     msg = builder(ctx, snap)
                 else:
                     msg = shared.build(msg_id, builder, ctx, snap)

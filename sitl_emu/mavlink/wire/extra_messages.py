@@ -60,24 +60,12 @@ def _code(mav_type: str, length: int) -> str:
 
 
 def make_spec(msg_id: int, name: str, fields: Sequence[Field]) -> MessageSpec:
-    """A fastpack spec whose encode takes the fields in XML order (arrays as sequences)."""
+    """A fastpack spec whose encode takes the fields in XML order (arrays as sequences), no defaults."""
     wire = wire_order(fields)
     layout = struct.Struct("<" + "".join(_code(t, length) for _, t, length in wire))
     position = {f[0]: i for i, f in enumerate(fields)}
-    plan = [(position[fname], length) for fname, _, length in wire]
-
-    def encode(*values: Any) -> Packed:
-        flat: list[Any] = []
-        for index, length in plan:
-            value = values[index]
-            if length and isinstance(value, (list, tuple)):
-                flat.extend(value[:length])
-            else:
-                flat.append(value)
-        return Packed(spec, tuple(flat))
-
-    spec = MessageSpec(msg_id, name, bytes((crc_extra(name, fields),)), layout.pack, encode)
-    return spec
+    terms = tuple((position[fname], length if ftype != "char" else 0) for fname, ftype, length in wire)
+    return MessageSpec(msg_id, name, bytes((crc_extra(name, fields),)), layout.pack, len(fields), (), terms)
 
 
 # Field lists in XML order, from mavlink/mavlink message_definitions (common.xml, development.xml).

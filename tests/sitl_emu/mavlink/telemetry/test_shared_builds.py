@@ -67,3 +67,19 @@ def test_link_node_status_is_each_links_own(h, monkeypatch):
     api, gcs = h.api.of_type("UNKNOWN_8", None), h.gcs.of_type("UNKNOWN_8", None)  # (no source on unknowns)
     assert len(api) == len(gcs) == 2 and len(calls) == 4
     assert [m.get_msgbuf()[10:-2] for m in api] != [m.get_msgbuf()[10:-2] for m in gcs]  # each counts its own
+
+
+def test_while_one_link_has_no_peer_the_other_keeps_nothing_for_it(h, monkeypatch):
+    """A Sim's link builds nothing until a peer talks (mavlink/link.py), so the sharing is off: the API link builds
+    and sends as alone; once both send again, they share again."""
+    calls = _counting(monkeypatch, ATTITUDE_QUATERNION)
+    gcs_remote = h.node.gcs.link.remote
+    h.node.gcs.link.remote = None
+    h.run(0.5)
+    assert not h.node.shared.active
+    assert len(calls) == len(h.api.of_type("ATTITUDE_QUATERNION")) >= 24 and not h.gcs.of_type("ATTITUDE_QUATERNION")
+    h.node.gcs.link.remote = gcs_remote
+    calls.clear()
+    h.run(0.5)
+    assert h.node.shared.active
+    assert 24 <= len(calls) == len(h.gcs.of_type("ATTITUDE_QUATERNION")) < len(h.api.of_type("ATTITUDE_QUATERNION"))

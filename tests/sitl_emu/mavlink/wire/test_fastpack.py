@@ -107,8 +107,10 @@ def test_fastpack_takes_pymavlinks_encode_arguments_and_defaults():
     def check(cls: Any) -> None:
         name = f"{cls.msgname.lower()}_encode"
         ours, theirs = getattr(fastpack.ENCODER, name), getattr(dialect.MAVLink, name)
-        assert ours.__code__.co_varnames[:ours.__code__.co_argcount] == theirs.__code__.co_varnames[1:][
-            :theirs.__code__.co_argcount - 1]
+        spec = fastpack.spec_for_class(cls)
+        parameters = theirs.__code__.co_varnames[1:theirs.__code__.co_argcount]
+        assert spec.arity == len(parameters) and spec.defaults == (theirs.__defaults__ or ())
+        assert [parameters[position] for position, _ in spec.wire] == list(cls.ordered_fieldnames)
         required = len(cls.fieldnames) - len(theirs.__defaults__ or ())
         args = _args(cls, random.Random(cls.id + 7))[:required]
         mav = dialect.MAVLink(None, srcSystem=1, srcComponent=1)
@@ -206,6 +208,25 @@ def test_a_value_out_of_its_wire_range_fails_like_pymavlink():
             fastpack.frame_message(fastpack.ENCODER.statustext_encode(*args), 0, 1, 1)
     with pytest.raises(IndexError):  # a short array, as pymavlink's element-by-element pack
         fastpack.ENCODER.attitude_quaternion_encode(0, 1, 0, 0, 0, 0, 0, 0, [0.0, 0.0])
+    with pytest.raises(TypeError):  # an array pymavlink cannot index
+        fastpack.ENCODER.attitude_quaternion_encode(0, 1, 0, 0, 0, 0, 0, 0, 5)
+
+
+def test_encode_takes_the_messages_arguments_and_no_more_or_fewer():
+    assert fastpack.ENCODER.heartbeat_encode(6, 8, 0, 0, 0, 2).values[-1] == 2  # the default given
+    for args in ((6, 8, 0, 0), (6, 8, 0, 0, 0, 3, 1)):
+        with pytest.raises(TypeError):
+            fastpack.ENCODER.heartbeat_encode(*args)
+
+
+def test_extra_messages_take_their_arrays_as_pymavlink_takes_arrays():
+    """The one encode serves the messages pymavlink lacks too: arrays sliced to their length (longer ones cut, any
+    sequence), a short one an IndexError."""
+    encode = extra_messages.EXTRA.esc_status_encode
+    sent = fastpack.frame_message(encode(1, 2, [1, 2, 3, 4], (1.0,) * 4, [0.0] * 4), 0, 1, 1)
+    assert fastpack.frame_message(encode(1, 2, range(1, 9), [1.0] * 5, (0.0,) * 4), 0, 1, 1) == sent
+    with pytest.raises(IndexError):
+        encode(1, 2, [1, 2, 3], [1.0] * 4, [0.0] * 4)
 
 
 # --- telemetry builders ---------------------------------------------------------------------------------------------
@@ -217,7 +238,7 @@ class _PymavlinkEncoder:
     """pymavlink's encoder behind fastpack's type (a compiled builder returns only a Packed): the message a builder
     gets is a Packed whose one value is pymavlink's own message object, which the test then packs with pymavlink."""
 
-    SPEC = fastpack.MessageSpec(-1, "PYMAVLINK", b"\0", lambda *values: b"", lambda *args: None)
+    SPEC = fastpack.MessageSpec(0xFFFFFF, "PYMAVLINK", b"\0", lambda *values: b"", 1, (), ((0, 0),))  # no such id
 
     def __init__(self, mav: Any) -> None:
         self._mav = mav
@@ -377,16 +398,3 @@ def test_a_gcs_session_over_udp_is_byte_identical_to_pymavlink_and_one_sequence_
         assert must <= seen, sorted(must - seen)
     finally:
         h.close()
-
-
-def test_integer_fields_saturate_and_send_zero_for_non_finite_values():
-    from sitl_emu.mavlink.telemetry import messages as tm
-
-    def int32_ref(x: float) -> int:
-        return max(min(round(x) if math.isfinite(x) else 0, 2**31 - 1), -(2**31))
-
-    rng = random.Random(3)
-    values = [0.5, 1.5, -2.5, NAN, math.inf, -math.inf, 2**31 - 0.5, 2**31 - 0.6, -(2**31) - 0.5, 1e300, -1e300]
-    for x in values + [rng.uniform(-5e9, 5e9) for _ in range(2000)]:
-        assert tm._int32(x) == int32_ref(x)
-        assert tm._cm_s(x / 100.0) == max(min(int32_ref(x / 100.0 * 100.0), 32767), -32768)
