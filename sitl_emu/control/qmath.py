@@ -18,8 +18,18 @@ atan2: Final = math.atan2
 acos: Final = math.acos
 asin: Final = math.asin
 hypot: Final = math.hypot
-degrees: Final = math.degrees
-radians: Final = math.radians
+RAD_TO_DEG: Final = 180.0 / math.pi  # CPython's math.degrees and math.radians multiply by these very constants
+DEG_TO_RAD: Final = math.pi / 180.0
+
+
+def degrees(rad: float) -> float:
+    """math.degrees(rad), the same product, compiled without a boxed call."""
+    return rad * RAD_TO_DEG
+
+
+def radians(deg: float) -> float:
+    """math.radians(deg), the same product, compiled without a boxed call."""
+    return deg * DEG_TO_RAD
 
 
 def q_mul(a: Vec4, b: Vec4) -> Vec4:

@@ -178,6 +178,24 @@ def test_the_controllers_isfinite_is_exactly_math_isfinite(x):
     assert isfinite(x) is math.isfinite(x)
 
 
+def test_the_compiled_degrees_and_radians_give_maths_bits():
+    # qmath.degrees / radians are the products CPython's math module computes, compiled without a boxed call
+    import math
+    import random
+    import struct
+
+    from sitl_emu.control.qmath import degrees, radians
+
+    rng = random.Random(5)
+    values = [0.0, -0.0, 5e-324, 1e-300, 1.7976931348623157e308, -1.7976931348623157e308, math.pi, -math.pi / 2,
+              360.0, float("inf"), float("-inf"), float("nan")]
+    values += [rng.uniform(-1e4, 1e4) for _ in range(2000)] + [rng.uniform(-7.0, 7.0) for _ in range(2000)]
+    bits = struct.Struct("<d").pack
+    for x in values:
+        assert bits(degrees(x)) == bits(math.degrees(x)), x
+        assert bits(radians(x)) == bits(math.radians(x)), x
+
+
 def _written_out_dataclass_inits() -> list[tuple[str, ast.ClassDef, ast.FunctionDef]]:
     """Every @dataclass in sitl_emu that writes its own __init__ (for `make speedups`: mypyc compiles only those)."""
     found = []

@@ -17,12 +17,6 @@ INT32_MAX: Final = 0x7FFFFFFF
 INT32_MIN: Final = -0x80000000
 INT16_MAX: Final = 0x7FFF
 INT16_MIN: Final = -0x8000
-RAD_TO_DEG: Final = 180.0 / math.pi
-
-
-def degrees(rad: float) -> float:
-    """math.degrees(rad): the same product (CPython multiplies by 180 / pi)."""
-    return rad * RAD_TO_DEG
 
 
 def iround(x: float) -> int:

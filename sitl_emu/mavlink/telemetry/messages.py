@@ -11,14 +11,13 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Final
 
 from sitl_emu import px4
-from sitl_emu.control.qmath import atan2, hypot, isfinite
+from sitl_emu.control.qmath import atan2, degrees, hypot, isfinite
 from sitl_emu.mavlink.telemetry.fields import (
     INT16_MAX,
     INT32_MAX,
     INT32_MIN,
     clamp_int,
     cm_s,
-    degrees,
     e7,
     iround,
     itrunc,

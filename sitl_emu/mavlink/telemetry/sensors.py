@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Final
 
-from sitl_emu.control.qmath import atan2, hypot, isfinite
-from sitl_emu.mavlink.telemetry.fields import clamp_int, degrees, e7, iround, itrunc, time_boot_ms
+from sitl_emu.control.qmath import atan2, degrees, hypot, isfinite
+from sitl_emu.mavlink.telemetry.fields import clamp_int, e7, iround, itrunc, time_boot_ms
 from sitl_emu.mavlink.telemetry.messages import rotate_ned_to_body
 from sitl_emu.types import Vec3, VehicleSnapshot
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import random
 
+from sitl_emu.control.qmath import degrees
 from sitl_emu.mavlink.telemetry import fields
 
 NAN = math.nan
@@ -44,5 +45,5 @@ def test_integer_fields_saturate_and_send_zero_for_non_finite_values():
 
 def test_degrees_and_time_boot_ms_are_the_usual_ones():
     for x in _samples():
-        assert fields.degrees(x) == math.degrees(x)
+        assert degrees(x) == math.degrees(x)  # the builders' degrees: control/qmath.py's
     assert fields.time_boot_ms(2**32 * 1000 + 5_999) == 5
